@@ -1,0 +1,276 @@
+//! `sweephold decode`: telemetry dumps → CSV or JSON lines, streaming.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use clap::{Args, ValueEnum};
+use sweephold_protocol::{DecodeStats, Decoder, Event, Frame, FrameError, Header};
+
+use crate::table::{axis_name, phase_name, RowWriter};
+
+/// Output format of `decode`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Comma-separated, one header row then one row per Sample.
+    Csv,
+    /// One JSON object per line: `{"type":"sample",...}` per Sample and
+    /// `{"type":"event",...}` / `{"type":"header",...}` in stream order.
+    Jsonl,
+}
+
+/// Arguments of `sweephold decode`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Columns are listed in the README (section `decode`). A summary goes to \
+stderr: good frames, corrupt frames skipped, tick gaps, duration, vehicle, protocol version; \
+with CSV output the events are listed there too.\n\nExit status: 0 when at least one good \
+frame was read; 1 on a missing or unreadable file, a dump of another protocol major version, \
+or no valid frame at all."
+)]
+pub struct DecodeArgs {
+    /// Telemetry dumps (raw frame streams as the flight controller sends them).
+    #[arg(required = true, value_name = "DUMP")]
+    pub dumps: Vec<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Csv)]
+    pub format: Format,
+    /// Write the rows here instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// No summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// What decoding one dump found.
+#[derive(Debug, Default, Clone)]
+pub struct DumpSummary {
+    /// Decoder totals.
+    pub stats: DecodeStats,
+    /// The first Header, if any.
+    pub header: Option<Header>,
+    /// Samples written.
+    pub samples: u64,
+    /// Ticks of the first and last Sample.
+    pub tick_span: Option<(u32, u32)>,
+    /// Events in stream order.
+    pub events: Vec<Event>,
+}
+
+impl DumpSummary {
+    /// Seconds between the first and last Sample, when the rate is known.
+    pub fn duration_s(&self) -> Option<f64> {
+        let (first, last) = self.tick_span?;
+        let rate = f64::from(self.header?.rate_hz);
+        (rate > 0.0).then(|| f64::from(last.wrapping_sub(first)) / rate)
+    }
+}
+
+/// Read size of the streaming loop; memory stays flat whatever the dump size.
+const CHUNK: usize = 256 * 1024;
+
+/// Decode one dump from `input`, writing rows to `rows`. Stops with an error on a Header
+/// of another protocol major version (after flushing what was written).
+pub fn decode_stream<R: Read, W: Write>(
+    mut input: R,
+    rows: &mut RowWriter<W>,
+) -> anyhow::Result<DumpSummary> {
+    let mut decoder = Decoder::new();
+    let mut summary = DumpSummary::default();
+    let mut chunk = vec![0u8; CHUNK];
+    loop {
+        let n = match input.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e).context("read failed"),
+        };
+        for result in decoder.feed(&chunk[..n]) {
+            match result {
+                Ok(frame) => handle_frame(frame, rows, &mut summary)?,
+                Err(mismatch @ FrameError::VersionMismatch { .. }) => bail!("{mismatch}"),
+                Err(_) => {} // counted by the decoder; keep going
+            }
+        }
+    }
+    decoder.finish();
+    summary.stats = decoder.stats();
+    Ok(summary)
+}
+
+fn handle_frame<W: Write>(
+    frame: Frame,
+    rows: &mut RowWriter<W>,
+    summary: &mut DumpSummary,
+) -> anyhow::Result<()> {
+    match frame {
+        Frame::Sample(sample) => {
+            let first = summary.tick_span.map_or(sample.tick, |(first, _)| first);
+            summary.tick_span = Some((first, sample.tick));
+            let time = summary
+                .header
+                .filter(|h| h.rate_hz > 0)
+                .map(|h| f64::from(sample.tick.wrapping_sub(first)) / f64::from(h.rate_hz));
+            rows.sample(&sample, time)?;
+            summary.samples += 1;
+        }
+        Frame::Event(event) => {
+            rows.json_line(&event_json(&event).to_string())?;
+            summary.events.push(event);
+        }
+        Frame::Header(header) => {
+            rows.json_line(&header_json(&header).to_string())?;
+            if summary.header.is_none() {
+                summary.header = Some(header);
+            }
+        }
+        // In-the-loop traffic is not telemetry; a dump of a serial link may hold it.
+        Frame::SensorIn(_) | Frame::ActuatorOut(_) => {}
+    }
+    Ok(())
+}
+
+/// A Header as a JSON object.
+pub fn header_json(h: &Header) -> serde_json::Value {
+    serde_json::json!({
+        "type": "header",
+        "protocol": h.protocol.to_string(),
+        "firmware": h.firmware.to_string(),
+        "vehicle": h.vehicle.name(),
+        "rate_hz": h.rate_hz,
+        "test": serde_json::to_value(h.test).unwrap_or(serde_json::Value::Null),
+    })
+}
+
+/// An Event as a JSON object.
+pub fn event_json(event: &Event) -> serde_json::Value {
+    use serde_json::json;
+    match *event {
+        Event::PhaseChange { tick, from, to } => {
+            json!({"type": "event", "event": "phase_change", "tick": tick, "from": phase_name(from), "to": phase_name(to)})
+        }
+        Event::HoldEngaged { tick, axis } => {
+            json!({"type": "event", "event": "hold_engaged", "tick": tick, "axis": axis_name(axis)})
+        }
+        Event::HoldReleased { tick, axis } => {
+            json!({"type": "event", "event": "hold_released", "tick": tick, "axis": axis_name(axis)})
+        }
+        Event::TrimCaptured {
+            tick,
+            sticks,
+            phi,
+            theta,
+            psi,
+        } => json!({
+            "type": "event", "event": "trim_captured", "tick": tick,
+            "sticks": {"lat": sticks.lat, "lon": sticks.lon, "ped": sticks.ped, "col": sticks.col},
+            "phi": phi, "theta": theta, "psi": psi,
+        }),
+        Event::Abort { tick, reason } => {
+            json!({"type": "event", "event": "abort", "tick": tick, "reason": reason.name()})
+        }
+    }
+}
+
+/// A one-line human description of an event.
+pub fn event_text(event: &Event) -> String {
+    match *event {
+        Event::PhaseChange { tick, from, to } => {
+            format!("tick {tick}: phase {} -> {}", phase_name(from), phase_name(to))
+        }
+        Event::HoldEngaged { tick, axis } => format!("tick {tick}: hold engaged on {}", axis_name(axis)),
+        Event::HoldReleased { tick, axis } => format!("tick {tick}: hold released on {}", axis_name(axis)),
+        Event::TrimCaptured { tick, sticks, phi, theta, .. } => format!(
+            "tick {tick}: trim captured (lat {:.4}, lon {:.4}, ped {:.4}, col {:.4}; phi {:.2} deg, theta {:.2} deg)",
+            sticks.lat,
+            sticks.lon,
+            sticks.ped,
+            sticks.col,
+            phi.to_degrees(),
+            theta.to_degrees()
+        ),
+        Event::Abort { tick, reason } => format!("tick {tick}: ABORT ({})", reason.name()),
+    }
+}
+
+fn open(path: &Path) -> anyhow::Result<File> {
+    File::open(path).with_context(|| format!("cannot open {}", path.display()))
+}
+
+/// Run `sweephold decode`.
+pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
+    // Open every input before writing anything, so a typo loses no output.
+    let inputs = args
+        .dumps
+        .iter()
+        .map(|p| open(p).map(|f| (p, f)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let sink: Box<dyn Write> = match &args.output {
+        Some(path) => Box::new(
+            File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+        ),
+        None => Box::new(io::stdout().lock()),
+    };
+    let sink = BufWriter::with_capacity(CHUNK, sink);
+    let mut rows = match args.format {
+        Format::Csv => RowWriter::csv(sink),
+        Format::Jsonl => RowWriter::jsonl(sink),
+    };
+    rows.header()?;
+    let mut good_total = 0;
+    for (path, file) in inputs {
+        let summary =
+            decode_stream(file, &mut rows).with_context(|| format!("{}", path.display()))?;
+        good_total += summary.stats.good_frames;
+        if !args.quiet {
+            print_summary(path, &summary, args.format == Format::Csv);
+        }
+    }
+    rows.into_inner().context("cannot write output")?;
+    if good_total == 0 {
+        let names: Vec<String> = args.dumps.iter().map(|p| p.display().to_string()).collect();
+        bail!("no valid frame in {}", names.join(", "));
+    }
+    Ok(())
+}
+
+fn print_summary(path: &Path, s: &DumpSummary, list_events: bool) {
+    let st = &s.stats;
+    let (vehicle, protocol, firmware, rate) = match &s.header {
+        Some(h) => (
+            h.vehicle.name().to_string(),
+            h.protocol.to_string(),
+            h.firmware.to_string(),
+            format!("{} Hz", h.rate_hz),
+        ),
+        None => (
+            "unknown (no header)".into(),
+            "unknown".into(),
+            "unknown".into(),
+            "unknown".into(),
+        ),
+    };
+    let duration = s
+        .duration_s()
+        .map_or("unknown".to_string(), |d| format!("{d:.3} s"));
+    eprintln!("{}:", path.display());
+    eprintln!(
+        "  {} bytes, {} good frames ({} samples, {} events), {} corrupt frames skipped, {} tick gaps",
+        st.bytes,
+        st.good_frames,
+        s.samples,
+        s.events.len(),
+        st.corrupt_frames,
+        st.tick_gaps
+    );
+    eprintln!(
+        "  duration {duration}, vehicle {vehicle}, rate {rate}, protocol {protocol}, firmware {firmware}"
+    );
+    if list_events {
+        for event in &s.events {
+            eprintln!("  {}", event_text(event));
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Frequency-domain system identification in the manner of CIFER.

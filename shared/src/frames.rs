@@ -1,0 +1,479 @@
+//! The frame types that cross the wire.
+//!
+//! Every frame is one [`Frame`] value. The flight controller streams a [`Header`] when a
+//! test starts, one [`Sample`] per tick, and an [`Event`] whenever something discrete
+//! happens. When a flight controller runs in the loop with the host simulator, the host
+//! sends a [`SensorIn`] each tick and the flight controller answers with an
+//! [`ActuatorOut`].
+//!
+//! Units are SI throughout: rad, rad/s, m/s, m/s², s. Control commands are fractions of
+//! full stick travel in [−1, 1].
+
+use postcard::experimental::max_size::MaxSize;
+use serde::{Deserialize, Serialize};
+
+/// Version of the wire protocol. A host refuses a dump whose `major` differs from its
+/// own; `minor` bumps only add frame variants at the end of [`Frame`] or enum variants at
+/// the end of an enum, which an older host reports as corrupt frames and skips.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ProtocolVersion {
+    /// Incompatible layout changes.
+    pub major: u16,
+    /// Compatible additions.
+    pub minor: u16,
+}
+
+/// The protocol version this crate speaks.
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 0 };
+
+impl core::fmt::Display for ProtocolVersion {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}.{}", self.major, self.minor)
+    }
+}
+
+/// Semantic version of the firmware that produced a dump.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FirmwareVersion {
+    /// Major version.
+    pub major: u8,
+    /// Minor version.
+    pub minor: u8,
+    /// Patch version.
+    pub patch: u8,
+}
+
+impl core::fmt::Display for FirmwareVersion {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}.{}.{}", self.major, self.minor, self.patch)
+    }
+}
+
+/// Which aircraft the flight controller is configured for.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum VehicleId {
+    /// MBB Bo-105 (full scale; flown in simulation).
+    Bo105,
+    /// TREX 700L-class flybarless model helicopter.
+    Trex700l,
+}
+
+impl VehicleId {
+    /// Lower-case name used on the command line and in file names.
+    pub const fn name(self) -> &'static str {
+        match self {
+            VehicleId::Bo105 => "bo105",
+            VehicleId::Trex700l => "trex700l",
+        }
+    }
+}
+
+/// A control axis. Order everywhere: lateral, longitudinal, pedal, collective.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Axis {
+    /// Lateral cyclic (δ_lat), held on roll attitude φ.
+    Lat,
+    /// Longitudinal cyclic (δ_lon), held on pitch attitude θ.
+    Lon,
+    /// Pedal (δ_ped), held on heading error ψ − ψ_trim.
+    Ped,
+    /// Collective (δ_col); never held, never given off-axis noise.
+    Col,
+}
+
+impl Axis {
+    /// All four axes in wire order.
+    pub const ALL: [Axis; 4] = [Axis::Lat, Axis::Lon, Axis::Ped, Axis::Col];
+
+    /// Lower-case name used on the command line, in CSV columns and file names.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Axis::Lat => "lat",
+            Axis::Lon => "lon",
+            Axis::Ped => "ped",
+            Axis::Col => "col",
+        }
+    }
+
+    /// Position in [`Axis::ALL`] and in `[f32; 4]` control arrays.
+    pub const fn index(self) -> usize {
+        match self {
+            Axis::Lat => 0,
+            Axis::Lon => 1,
+            Axis::Ped => 2,
+            Axis::Col => 3,
+        }
+    }
+}
+
+/// How the non-primary axes are treated during an excitation (paper §IV.B).
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ExcitationMode {
+    /// Conditional attitude hold plus off-axis noise: the paper's method.
+    ConditionalAttitudeHold,
+    /// Attitude-hold controller always on, sweep added on the primary axis (paper Fig. 3).
+    Standard,
+    /// Controller always on plus off-axis noise (Tischler's method).
+    OffAxisNoise,
+}
+
+/// The excitation signal on the primary axis.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InputKind {
+    /// Tischler's exponential computer-generated frequency sweep.
+    Sweep,
+    /// Doublet: +A for one pulse width, −A for one pulse width.
+    Doublet,
+    /// 3-2-1-1 multistep: +A 3w, −A 2w, +A 1w, −A 1w.
+    ThreeTwoOneOne,
+}
+
+/// Phase of the test sequencer.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Phase {
+    /// Pilot has full authority; waiting for the test switch.
+    Idle,
+    /// Test switch on; the sequencer starts trim capture on the next tick.
+    Armed,
+    /// Averaging pilot sticks and attitude to define the trim.
+    TrimCapture,
+    /// Raised-cosine fade-in of the excitation (and the ω_min hold, if configured).
+    FadeIn,
+    /// The excitation proper (sweep, doublet or 3-2-1-1).
+    Sweep,
+    /// Raised-cosine fade-out of the excitation.
+    FadeOut,
+    /// Test complete; pilot pass-through until the switch is released.
+    Done,
+    /// Test aborted; pilot pass-through until the switch is cycled.
+    Aborted,
+}
+
+/// State of the conditional attitude hold on one axis.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum HoldState {
+    /// Controller released: the axis carries its excitation.
+    Released,
+    /// Controller engaged: the axis carries the attitude-hold command.
+    Engaged,
+    /// Inside the hysteresis band with the freeze option: last command held constant.
+    Frozen,
+}
+
+/// Why a test was aborted.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AbortReason {
+    /// |φ| or |θ| above the abort limit.
+    AttitudeLimit,
+    /// |p|, |q| or |r| above its limit.
+    RateLimit,
+    /// A sensor value was NaN or infinite.
+    SensorNotFinite,
+    /// The sensor sample did not change for more than the stale limit of ticks.
+    SensorStale,
+    /// A pilot stick moved more than the override threshold away from its trim.
+    PilotOverride,
+    /// The pilot's test switch left the test position.
+    SwitchReleased,
+}
+
+impl AbortReason {
+    /// Short snake_case name used in reports and JSON.
+    pub const fn name(self) -> &'static str {
+        match self {
+            AbortReason::AttitudeLimit => "attitude_limit",
+            AbortReason::RateLimit => "rate_limit",
+            AbortReason::SensorNotFinite => "sensor_not_finite",
+            AbortReason::SensorStale => "sensor_stale",
+            AbortReason::PilotOverride => "pilot_override",
+            AbortReason::SwitchReleased => "switch_released",
+        }
+    }
+}
+
+/// One value per control axis, in fractions of full stick travel ([−1, 1]).
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Controls {
+    /// Lateral cyclic.
+    pub lat: f32,
+    /// Longitudinal cyclic.
+    pub lon: f32,
+    /// Pedal.
+    pub ped: f32,
+    /// Collective.
+    pub col: f32,
+}
+
+impl Controls {
+    /// The four values in axis order (lat, lon, ped, col).
+    pub const fn to_array(self) -> [f32; 4] {
+        [self.lat, self.lon, self.ped, self.col]
+    }
+
+    /// Build from an array in axis order (lat, lon, ped, col).
+    pub const fn from_array(a: [f32; 4]) -> Self {
+        Controls {
+            lat: a[0],
+            lon: a[1],
+            ped: a[2],
+            col: a[3],
+        }
+    }
+
+    /// The value on one axis.
+    pub const fn get(&self, axis: Axis) -> f32 {
+        match axis {
+            Axis::Lat => self.lat,
+            Axis::Lon => self.lon,
+            Axis::Ped => self.ped,
+            Axis::Col => self.col,
+        }
+    }
+}
+
+/// What the flight controller's sensors report each tick, in body axes.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Measurements {
+    /// Roll rate [rad/s].
+    pub p: f32,
+    /// Pitch rate [rad/s].
+    pub q: f32,
+    /// Yaw rate [rad/s].
+    pub r: f32,
+    /// Roll attitude φ [rad].
+    pub phi: f32,
+    /// Pitch attitude θ [rad].
+    pub theta: f32,
+    /// Heading ψ [rad], in (−π, π].
+    pub psi: f32,
+    /// Body-axis velocity u [m/s].
+    pub u: f32,
+    /// Body-axis velocity v [m/s].
+    pub v: f32,
+    /// Body-axis velocity w [m/s].
+    pub w: f32,
+    /// Specific force along x as an accelerometer at the CG reads it [m/s²].
+    pub ax: f32,
+    /// Specific force along y [m/s²].
+    pub ay: f32,
+    /// Specific force along z [m/s²] (≈ −g in hover).
+    pub az: f32,
+}
+
+/// The pilot's inputs as the flight controller reads them from the receiver.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PilotInput {
+    /// Stick positions, fractions of full travel.
+    pub sticks: Controls,
+    /// The test switch: `true` in the test position (arms the sequencer).
+    pub test_switch: bool,
+}
+
+/// Sweep parameters of the active test (paper Eq. 19–23).
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SweepSettings {
+    /// Record length T_rec [s] (fades and the ω_min hold come on top).
+    pub t_rec_s: f32,
+    /// Amplitude A, fraction of full stick travel.
+    pub amplitude: f32,
+    /// Start frequency ω_min [rad/s].
+    pub omega_min: f32,
+    /// End frequency ω_max [rad/s].
+    pub omega_max: f32,
+    /// Raised-cosine fade-in and fade-out length [s]; 0 disables.
+    pub fade_s: f32,
+    /// Cycles at ω_min before the sweep proper; 0 disables.
+    pub start_hold_cycles: u8,
+}
+
+/// Pulse parameters of doublet and 3-2-1-1 inputs.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PulseSettings {
+    /// Pulse amplitude, fraction of full stick travel.
+    pub amplitude: f32,
+    /// Base pulse width [s].
+    pub width_s: f32,
+}
+
+/// Bit in [`TestConfig::warnings`]: T_rec is shorter than 4·T_max = 4·2π/ω_min.
+pub const WARN_RECORD_SHORT: u8 = 1 << 0;
+
+/// The test the flight controller is flying, as recorded in the [`Header`].
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TestConfig {
+    /// How the off-axis inputs are treated.
+    pub mode: ExcitationMode,
+    /// The excited axis.
+    pub primary: Axis,
+    /// The excitation signal.
+    pub input: InputKind,
+    /// Sweep parameters (used when `input` is [`InputKind::Sweep`]).
+    pub sweep: SweepSettings,
+    /// Pulse parameters (used for doublet and 3-2-1-1).
+    pub pulse: PulseSettings,
+    /// RMS of the off-axis noise, fraction of full stick travel.
+    pub noise_rms: f32,
+    /// Low-pass cutoff of the off-axis noise [rad/s].
+    pub noise_cutoff_rad_s: f32,
+    /// Seed of the noise generator.
+    pub seed: u32,
+    /// Attitude above which the hold controller engages [rad] (paper: 6°).
+    pub hold_engage_rad: f32,
+    /// Attitude below which the hold controller releases [rad] (paper: 4°).
+    pub hold_release_rad: f32,
+    /// Freeze the last command inside the hysteresis band instead of keeping the prior form.
+    pub freeze_in_band: bool,
+    /// Bit set of `WARN_*` flags raised when the configuration was built.
+    pub warnings: u8,
+}
+
+/// Sent once when a test starts: who is flying what.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Header {
+    /// Wire protocol version; must stay the first field (decoders peek at it).
+    pub protocol: ProtocolVersion,
+    /// Firmware version.
+    pub firmware: FirmwareVersion,
+    /// Configured vehicle.
+    pub vehicle: VehicleId,
+    /// Fixed tick rate of the control loop [Hz].
+    pub rate_hz: u16,
+    /// The active test.
+    pub test: TestConfig,
+}
+
+/// One firmware tick: what was commanded, why, and what the sensors saw.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sample {
+    /// Tick counter since boot; consecutive Samples differ by one.
+    pub tick: u32,
+    /// Sequencer phase during this tick.
+    pub phase: Phase,
+    /// Excited axis.
+    pub primary: Axis,
+    /// Instantaneous sweep frequency dθ/dt [rad/s]; 0 outside a sweep.
+    pub sweep_omega: f32,
+    /// Hold state of the lateral, longitudinal and pedal axes.
+    pub hold: [HoldState; 3],
+    /// Applied commands (trim + perturbation, or pilot pass-through).
+    pub command: Controls,
+    /// Sweep (or pulse) component of the commands.
+    pub sweep: Controls,
+    /// Off-axis noise component of the commands.
+    pub noise: Controls,
+    /// Pilot stick positions.
+    pub pilot: Controls,
+    /// Sensor measurements used in this tick.
+    pub meas: Measurements,
+}
+
+/// Something discrete that happened at a tick.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Event {
+    /// The sequencer changed phase.
+    PhaseChange {
+        /// Tick of the change.
+        tick: u32,
+        /// Phase before.
+        from: Phase,
+        /// Phase after.
+        to: Phase,
+    },
+    /// The attitude-hold controller engaged on an axis.
+    HoldEngaged {
+        /// Tick of the change.
+        tick: u32,
+        /// Axis (lat, lon or ped).
+        axis: Axis,
+    },
+    /// The attitude-hold controller released an axis.
+    HoldReleased {
+        /// Tick of the change.
+        tick: u32,
+        /// Axis (lat, lon or ped).
+        axis: Axis,
+    },
+    /// Trim capture finished: the trim every command is built on.
+    TrimCaptured {
+        /// Tick of the capture.
+        tick: u32,
+        /// Averaged pilot sticks.
+        sticks: Controls,
+        /// Averaged roll attitude [rad].
+        phi: f32,
+        /// Averaged pitch attitude [rad].
+        theta: f32,
+        /// Heading at capture [rad].
+        psi: f32,
+    },
+    /// The test was aborted; outputs fell back to pilot pass-through in this tick.
+    Abort {
+        /// Tick of the abort.
+        tick: u32,
+        /// Why.
+        reason: AbortReason,
+    },
+}
+
+/// Host → flight controller, each tick, when running in the loop: the simulated sensors
+/// and pilot.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorIn {
+    /// Sensor sample counter; a value that does not change marks a stale sample.
+    pub seq: u32,
+    /// The measurements.
+    pub meas: Measurements,
+    /// The pilot.
+    pub pilot: PilotInput,
+}
+
+/// Flight controller → host, each tick, when running in the loop: the outputs.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ActuatorOut {
+    /// Tick that produced these outputs.
+    pub tick: u32,
+    /// Seq of the [`SensorIn`] they answer.
+    pub seq: u32,
+    /// Commands, fractions of full stick travel.
+    pub command: Controls,
+    /// Servo pulse widths [µs]: swash servos 1–3, tail.
+    pub servo_us: [u16; 4],
+}
+
+/// Everything that crosses the wire. `Header` must stay variant 0: a decoder peeks at
+/// the protocol version of a Header it cannot fully decode.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(clippy::large_enum_variant)]
+pub enum Frame {
+    /// Test start.
+    Header(Header),
+    /// One tick.
+    Sample(Sample),
+    /// A discrete event.
+    Event(Event),
+    /// In-the-loop sensors (host → flight controller).
+    SensorIn(SensorIn),
+    /// In-the-loop outputs (flight controller → host).
+    ActuatorOut(ActuatorOut),
+}

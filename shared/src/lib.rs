@@ -1,0 +1,31 @@
+//! # sweephold-protocol
+//!
+//! The wire protocol between the sweephold flight-controller firmware and the host tool:
+//! frame types ([`frames`]), their encoding — postcard, CRC-32, COBS, 0x00 delimiter —
+//! ([`codec`]), and a streaming decoder that survives corrupt input ([`decoder`]).
+//!
+//! `no_std`, no allocation. Features: `std` (error trait impls for the host), `defmt`
+//! (derive `defmt::Format` on every wire type, for firmware logging).
+//!
+//! ```
+//! use sweephold_protocol::{codec, decoder::Decoder, frames::*};
+//!
+//! let event = Frame::Event(Event::Abort { tick: 7, reason: AbortReason::RateLimit });
+//! let mut wire = [0u8; codec::MAX_FRAME_LEN];
+//! let n = codec::encode(&event, &mut wire).unwrap();
+//!
+//! let mut decoder = Decoder::new();
+//! let frames: Vec<_> = decoder.feed(&wire[..n]).collect();
+//! assert_eq!(frames, vec![Ok(event)]);
+//! ```
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![deny(missing_docs)]
+
+pub mod cobs;
+pub mod codec;
+pub mod decoder;
+pub mod frames;
+
+pub use codec::{encode, MAX_FRAME_LEN};
+pub use decoder::{DecodeStats, Decoder, FrameError};
+pub use frames::*;
