@@ -1,1 +1,5 @@
-//! Frequency-domain system identification in the manner of CIFER.
+//! Frequency-domain system identification in the manner of CIFER: frequency responses
+//! (FRESPID, MISOSA, COMPOSITE) and state-space fits with accuracy metrics (DERIVID,
+//! VERIFY).
+
+pub mod document;
