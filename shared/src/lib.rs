@@ -25,6 +25,8 @@ pub mod cobs;
 pub mod codec;
 pub mod decoder;
 pub mod frames;
+#[cfg(feature = "synthetic")]
+pub mod synthetic;
 
 pub use codec::{encode, MAX_FRAME_LEN};
 pub use decoder::{DecodeStats, Decoder, FrameError};

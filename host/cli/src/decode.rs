@@ -219,19 +219,34 @@ pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
         Format::Jsonl => RowWriter::jsonl(sink),
     };
     rows.header()?;
-    let mut good_total = 0;
+    let mut empty = Vec::new();
+    let mut any_good = false;
     for (path, file) in inputs {
         let summary =
             decode_stream(file, &mut rows).with_context(|| format!("{}", path.display()))?;
-        good_total += summary.stats.good_frames;
+        let st = summary.stats;
+        if st.good_frames == 0 {
+            empty.push(format!(
+                "{} ({} bytes, {} corrupt frames)",
+                path.display(),
+                st.bytes,
+                st.corrupt_frames
+            ));
+            continue;
+        }
+        any_good = true;
         if !args.quiet {
             print_summary(path, &summary, args.format == Format::Csv);
         }
     }
     rows.into_inner().context("cannot write output")?;
-    if good_total == 0 {
-        let names: Vec<String> = args.dumps.iter().map(|p| p.display().to_string()).collect();
-        bail!("no valid frame in {}", names.join(", "));
+    if !any_good {
+        bail!("no valid frame in {}", empty.join(", "));
+    }
+    if !args.quiet {
+        for dump in &empty {
+            eprintln!("warning: no valid frame in {dump}");
+        }
     }
     Ok(())
 }

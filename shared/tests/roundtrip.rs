@@ -1,0 +1,66 @@
+//! Property round-trips of every frame type through encode → decode.
+
+mod strategies;
+
+use proptest::prelude::*;
+use strategies::*;
+use sweephold_protocol::{codec, Decoder, Frame};
+
+/// Frames compare by their wire bytes: postcard writes f32 bit-exactly, so equal bytes
+/// mean bit-identical values (NaN payloads included, which `PartialEq` cannot check).
+fn wire(frame: &Frame) -> Vec<u8> {
+    codec::encode_to_vec(frame)
+        .expect("every frame fits MAX_FRAME_LEN")
+        .to_vec()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn every_frame_round_trips(frame in frame()) {
+        let bytes = wire(&frame);
+        prop_assert!(bytes.len() <= codec::MAX_FRAME_LEN);
+        prop_assert_eq!(bytes.last(), Some(&0u8));
+        prop_assert!(!bytes[..bytes.len() - 1].contains(&0), "COBS leaves no zero inside");
+        let mut decoder = Decoder::new();
+        let decoded: Vec<_> = decoder.feed(&bytes).collect();
+        prop_assert_eq!(decoded.len(), 1);
+        let back = decoded[0].expect("an intact frame decodes");
+        prop_assert_eq!(wire(&back), bytes);
+        prop_assert_eq!(decoder.finish(), None);
+        prop_assert_eq!(decoder.stats().good_frames, 1);
+    }
+
+    /// A stream split into arbitrary chunks decodes to the same frames.
+    #[test]
+    fn chunking_does_not_matter(frames in proptest::collection::vec(frame(), 1..40),
+                                cuts in proptest::collection::vec(1usize..300, 1..50)) {
+        let stream: Vec<u8> = frames.iter().flat_map(wire).collect();
+        let mut decoder = Decoder::new();
+        let mut out = Vec::new();
+        let mut at = 0;
+        for cut in cuts.iter().cycle() {
+            if at >= stream.len() { break; }
+            let end = (at + cut).min(stream.len());
+            out.extend(decoder.feed(&stream[at..end]));
+            at = end;
+        }
+        prop_assert_eq!(decoder.finish(), None);
+        prop_assert_eq!(out.len(), frames.len());
+        for (got, want) in out.iter().zip(&frames) {
+            prop_assert_eq!(wire(got.as_ref().expect("intact")), wire(want));
+        }
+    }
+
+    /// Arbitrary bytes never panic the decoder, and every byte is accounted for.
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2000)) {
+        let mut decoder = Decoder::new();
+        let n = decoder.feed(&bytes).count();
+        decoder.finish();
+        let stats = decoder.stats();
+        prop_assert_eq!(stats.bytes, bytes.len() as u64);
+        prop_assert!(stats.good_frames + stats.corrupt_frames >= n as u64);
+    }
+}
