@@ -62,6 +62,8 @@ pub struct FrfDocument {
 impl FrfDocument {
     /// The conditioned response of one pair, if present.
     pub fn pair(&self, input: &str, output: &str) -> Option<&PairResponse> {
-        self.pairs.iter().find(|p| p.input == input && p.output == output)
+        self.pairs
+            .iter()
+            .find(|p| p.input == input && p.output == output)
     }
 }
