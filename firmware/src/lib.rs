@@ -1,2 +1,69 @@
-//! Flight logic of the sweephold flight controller (host-testable; `no_std` on the board).
-#![cfg_attr(not(test), no_std)]
+//! # sweephold-firmware — flight logic
+//!
+//! The host-testable, `no_std`, allocation-free flight logic of the sweephold flight
+//! controller: Tischler's exponential frequency sweep (and doublet / 3-2-1-1 inputs)
+//! flown under the *conditional attitude hold* of Jung, Shim & Kim, with off-axis noise,
+//! abort safety, CCPM-120 mixing and postcard telemetry.
+//!
+//! The entry point is [`FlightController`]: build it from a [`Config`] (presets
+//! [`Config::bo105_default`] and [`Config::trex700l_default`]), then call
+//! [`FlightController::step`] once per tick with the sensor frame; it returns the
+//! [`Output`] (commands and servo pulse widths) and writes the telemetry frames (Header,
+//! Events, one Sample per tick) into a [`FrameSink`].
+//!
+//! ```
+//! use sweephold_firmware::{Config, FlightController};
+//! use sweephold_protocol::{Axis, Phase, SensorIn};
+//!
+//! let mut fc = FlightController::new(Config::bo105_default(Axis::Lat)).unwrap();
+//! let mut telemetry: heapless::Vec<u8, 1024> = heapless::Vec::new();
+//! let mut sensor = SensorIn::default();
+//! sensor.pilot.test_switch = true;
+//! let out = fc.step(&sensor, &mut telemetry);
+//! assert_eq!(fc.phase(), Phase::Armed);
+//! assert!(out.command.lat.abs() <= 1.0);
+//! ```
+//!
+//! The tick path has no `unwrap`, `expect`, panicking index or `unsafe`, runs in bounded
+//! time and turns NaN or infinite inputs into an abort and finite, clamped outputs.
+//!
+//! Modules, one concept each: [`sweep`] (the sweep and its closed-form phase),
+//! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
+//! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
+//! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
+//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer).
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::indexing_slicing
+    )
+)]
+
+#[macro_use]
+mod fmt;
+
+pub mod attitude_hold;
+pub mod config;
+pub mod controller;
+pub mod excitation;
+pub mod hold;
+pub mod mixer;
+pub mod noise;
+pub mod pulse;
+pub mod safety;
+pub mod sink;
+pub mod sweep;
+pub mod trim;
+
+pub use attitude_hold::{AxisGains, Gains};
+pub use config::{paper_test, Config, ConfigError};
+pub use controller::{FlightController, Output, FIRMWARE_VERSION};
+pub use mixer::{mix, MixerConfig, ServoConfig};
+pub use safety::SafetyLimits;
+pub use sink::{FrameSink, IoSink};

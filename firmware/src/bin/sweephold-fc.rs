@@ -1,23 +1,71 @@
-//! The STM32F4 flight-controller image. Built with `cargo fw`; on the host it is an empty
-//! program so that `cargo build --workspace` works.
+//! `sweephold-fc`: the STM32F405 flight-controller image (`cargo fw`).
+//!
+//! Boots on the board and, unchanged, in `qemu-system-arm -M netduinoplus2`. The board
+//! support lives in `firmware/src/board/` (included below); the flight logic is the
+//! `sweephold_firmware` library. On the host this is an empty program so that
+//! `cargo build --workspace` works; the board's divider arithmetic is unit-tested there.
 #![cfg_attr(target_os = "none", no_std, no_main)]
+#![deny(unsafe_op_in_unsafe_fn)]
 
 #[cfg(target_os = "none")]
-mod board {
-    use cortex_m_rt::entry;
+#[path = "../board/mod.rs"]
+mod board;
+
+/// Host unit tests of the board's pure arithmetic.
+#[cfg(all(test, not(target_os = "none")))]
+#[path = "../board/dividers.rs"]
+mod dividers;
+
+#[cfg(target_os = "none")]
+mod image {
+    use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_rtt as _;
+
+    use crate::board;
+
+    // Log lines carry the loop tick they were written in.
+    defmt::timestamp!("{=u32}", board::ticker::elapsed());
 
     #[entry]
     fn main() -> ! {
-        defmt::info!("sweephold-fc boot");
-        loop {
-            cortex_m::asm::wfi();
+        defmt::info!(
+            "sweephold-fc {=str}, protocol {=u16}.{=u16}",
+            env!("CARGO_PKG_VERSION"),
+            sweephold_protocol::PROTOCOL_VERSION.major,
+            sweephold_protocol::PROTOCOL_VERSION.minor
+        );
+        board::runner::run()
+    }
+
+    /// Every device interrupt lands here (no PAC, so no named vectors): route it.
+    /// cortex-m-rt requires the `unsafe fn` signature; the body is safe code.
+    #[exception]
+    unsafe fn DefaultHandler(irqn: i16) {
+        if !board::nvic::dispatch(irqn) {
+            defmt::panic!("unexpected exception or interrupt {=i16}", irqn);
         }
     }
 
+    /// A fault: outputs to the safe state, then stop. cortex-m-rt requires the `unsafe
+    /// fn` signature; the body is safe code.
+    #[exception]
+    unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
+        board::safe_state();
+        defmt::error!("hard fault at pc {=u32:#010x}", frame.pc());
+        loop {
+            cortex_m::asm::nop();
+        }
+    }
+
+    /// A panic: outputs to the safe state (servos at their failsafe pulses, interrupts
+    /// off so nothing moves them again), say where, and stop.
     #[panic_handler]
-    fn panic(_info: &core::panic::PanicInfo) -> ! {
-        cortex_m::interrupt::disable();
+    fn panic(info: &core::panic::PanicInfo) -> ! {
+        board::safe_state();
+        match info.location() {
+            Some(at) => defmt::error!("panic at {=str}:{=u32}", at.file(), at.line()),
+            None => defmt::error!("panic"),
+        }
         loop {
             cortex_m::asm::nop();
         }

@@ -1,0 +1,374 @@
+//! The attitude-hold controller of one axis: PID on the attitude error with rate damping
+//! from the measured body rate, output and integrator limits, anti-windup, bumpless
+//! engagement and integrator reset on release.
+//!
+//! ```text
+//! s = −1 if reversed else +1        (sign convention below)
+//! u = −s·(Kp·e + Kd·ω) + I + B,     I[n+1] = clamp(I[n] − s·Ki·e·dt, ±I_max)
+//! B[n+1] = B[n]·e^{−dt/τ_b}          (bumpless-transfer term, see below)
+//! output = clamp(u, ±u_max)
+//! ```
+//!
+//! `e` is the attitude deviation from trim \[rad\] and `ω` the matching body rate (p, q or
+//! r) [rad/s], used instead of de/dt because it is measured directly and has no
+//! derivative kick. Sign convention: a positive command produces a positive moment about
+//! the held axis (lat → +roll, lon → +pitch (nose up), ped → +yaw (nose right)); set
+//! `reversed` for an axis wired the other way.
+//!
+//! Anti-windup is conditional integration: the integrator does not grow while the output
+//! is saturated in the direction it would grow.
+//!
+//! Bumpless engagement sets the transfer term B so that the first output equals the
+//! perturbation the axis carried in the previous tick; B then decays with time constant
+//! τ_b (`bumpless_time_s`), handing the axis over to the PID within a few τ_b. Loading
+//! the offset into the integrator instead (the textbook bumpless transfer) would cancel
+//! the proportional action at the very moment the attitude has crossed the engage
+//! threshold, and with the small Ki of an attitude hold it would take tens of seconds to
+//! bleed off. The integrator starts empty at each engagement.
+
+/// Gains and limits of one axis. Units: stick fraction per rad, per rad/s, per rad·s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisGains {
+    /// Proportional gain on the attitude error [stick/rad].
+    pub kp: f32,
+    /// Integral gain [stick/(rad·s)].
+    pub ki: f32,
+    /// Rate-damping gain on the body rate [stick/(rad/s)].
+    pub kd: f32,
+    /// Output limit, fraction of stick travel (the controller's authority around trim).
+    pub output_limit: f32,
+    /// Integrator limit, fraction of stick travel.
+    pub integrator_limit: f32,
+    /// The axis' positive command produces a negative moment.
+    pub reversed: bool,
+    /// Time constant τ_b of the bumpless-transfer decay \[s\]; 0 hands over at once.
+    pub bumpless_time_s: f32,
+    /// Time constant τ_r \[s\] with which the controller's last output fades out after a
+    /// release, while the excitation resumes at once; 0 drops it in one tick (the
+    /// paper's rule taken literally). See `controller` for why a fade is the default.
+    pub release_time_s: f32,
+}
+
+impl AxisGains {
+    /// Whether every field is finite and in range: gains ≥ 0, output limit in (0, 1],
+    /// integrator limit in [0, output limit], bumpless time ≥ 0.
+    pub fn is_valid(&self) -> bool {
+        let finite = [
+            self.kp,
+            self.ki,
+            self.kd,
+            self.output_limit,
+            self.integrator_limit,
+            self.bumpless_time_s,
+            self.release_time_s,
+        ]
+        .iter()
+        .all(|v| v.is_finite());
+        finite
+            && self.kp >= 0.0
+            && self.ki >= 0.0
+            && self.kd >= 0.0
+            && self.output_limit > 0.0
+            && self.output_limit <= 1.0
+            && self.integrator_limit >= 0.0
+            && self.integrator_limit <= self.output_limit
+            && self.bumpless_time_s >= 0.0
+            && self.release_time_s >= 0.0
+    }
+}
+
+/// Gains of the three held axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gains {
+    /// Lateral cyclic on roll φ, damped by p.
+    pub lat: AxisGains,
+    /// Longitudinal cyclic on pitch θ, damped by q.
+    pub lon: AxisGains,
+    /// Pedal on heading error ψ − ψ_trim, damped by r.
+    pub ped: AxisGains,
+}
+
+impl Gains {
+    /// Starting values for the Bo-105 simulator, to be tuned against it (integration).
+    ///
+    /// Sizing, hover, quasi-static, with the simulator's gearing (lat ±8° θ1c, lon ±10°
+    /// θ1s, ped ±16.5° tail pitch per unit stick; positive stick → positive moment):
+    /// roll: L_θ1c ≈ −170 /s² per rad → ~24 rad/s² per stick, L_p ≈ −14 /s. Kp 2.0,
+    /// Kd 0.3: φ̈ + 21φ̇ + 47φ = 0 → poles ≈ −2.6, −18.5 /s.
+    /// pitch: M_θ1s ≈ 45 → ~7.9 rad/s² per stick, M_q ≈ −3.7 /s. Kp 3.0, Kd 1.0:
+    /// θ̈ + 11.6θ̇ + 23.6θ = 0 → poles ≈ −2.6, −9.0 /s.
+    /// yaw: N_θ0tr ≈ −15.5 per rad → ~4.5 rad/s² per stick, N_r ≈ −0.3 /s. Kp 3.0,
+    /// Kd 1.5: ω_n ≈ 3.7 rad/s, ζ ≈ 0.96.
+    /// Small integral gains trim out offsets over tens of seconds; authority ±0.3 of
+    /// stick around trim; bumpless hand-over in τ_b = 0.1 s.
+    ///
+    /// Flown once against `host/bo105` in hover (perfect sensors, pilot sticks fixed at
+    /// trim, paper test on each axis in CAH mode): every test completed without an abort,
+    /// attitude deviations peaked near 8°, and the hold was engaged about a quarter to a
+    /// third of the time; softer gains (Kp 0.6/1.0/1.0) also completed but deviated to
+    /// ~10° and stayed engaged ~60 % of the time.
+    pub const fn bo105() -> Self {
+        Gains {
+            lat: AxisGains {
+                kp: 2.0,
+                ki: 0.05,
+                kd: 0.3,
+                output_limit: 0.3,
+                integrator_limit: 0.3,
+                reversed: false,
+                bumpless_time_s: 0.1,
+                release_time_s: 0.5,
+            },
+            lon: AxisGains {
+                kp: 3.0,
+                ki: 0.1,
+                kd: 1.0,
+                output_limit: 0.3,
+                integrator_limit: 0.3,
+                reversed: false,
+                bumpless_time_s: 0.1,
+                release_time_s: 0.5,
+            },
+            ped: AxisGains {
+                kp: 3.0,
+                ki: 0.05,
+                kd: 1.5,
+                output_limit: 0.3,
+                integrator_limit: 0.3,
+                reversed: false,
+                bumpless_time_s: 0.1,
+                release_time_s: 0.5,
+            },
+        }
+    }
+
+    /// Starting values for a TREX 700L-class flybarless helicopter, to be tuned in flight.
+    ///
+    /// The model's control power is an order of magnitude above the Bo-105's (700-size
+    /// hybrid: L_β1s ≈ 3600, M_β1c ≈ 620 /s²), so the gains are lower and the authority
+    /// smaller; the rate damping dominates, as on a flybarless rate controller.
+    pub const fn trex700l() -> Self {
+        Gains {
+            lat: AxisGains {
+                kp: 0.25,
+                ki: 0.05,
+                kd: 0.05,
+                output_limit: 0.2,
+                integrator_limit: 0.2,
+                reversed: false,
+                bumpless_time_s: 0.3,
+                release_time_s: 0.5,
+            },
+            lon: AxisGains {
+                kp: 0.3,
+                ki: 0.05,
+                kd: 0.06,
+                output_limit: 0.2,
+                integrator_limit: 0.2,
+                reversed: false,
+                bumpless_time_s: 0.3,
+                release_time_s: 0.5,
+            },
+            ped: AxisGains {
+                kp: 0.5,
+                ki: 0.05,
+                kd: 0.1,
+                output_limit: 0.3,
+                integrator_limit: 0.3,
+                reversed: false,
+                bumpless_time_s: 0.3,
+                release_time_s: 0.5,
+            },
+        }
+    }
+
+    /// The three axes in order lat, lon, ped.
+    pub const fn to_array(&self) -> [AxisGains; 3] {
+        [self.lat, self.lon, self.ped]
+    }
+}
+
+/// Largest bumpless-transfer offset \[stick\]: commands and trims lie in [−1, 1].
+const MAX_TRANSFER: f32 = 2.0;
+
+/// State of one axis' attitude-hold controller: the integrator and the decaying
+/// bumpless-transfer term, both in stick units.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AttitudeController {
+    integral: f32,
+    transfer: f32,
+}
+
+impl AttitudeController {
+    /// A controller with an empty integrator.
+    pub const ZERO: AttitudeController = AttitudeController {
+        integral: 0.0,
+        transfer: 0.0,
+    };
+
+    fn sign(gains: &AxisGains) -> f32 {
+        if gains.reversed {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
+    /// The proportional and rate terms −s·(Kp·e + Kd·ω).
+    fn proportional_and_damping(gains: &AxisGains, error: f32, rate: f32) -> f32 {
+        -Self::sign(gains) * (gains.kp * error + gains.kd * rate)
+    }
+
+    /// Bumpless engagement: empty the integrator and set the transfer term so that the
+    /// output for (`error`, `rate`) equals `previous_output` (the perturbation the axis
+    /// carried last tick).
+    pub fn engage(&mut self, gains: &AxisGains, error: f32, rate: f32, previous_output: f32) {
+        self.integral = 0.0;
+        let needed = previous_output - Self::proportional_and_damping(gains, error, rate);
+        self.transfer = if gains.bumpless_time_s > 0.0 {
+            clamp_finite(needed, MAX_TRANSFER)
+        } else {
+            0.0
+        };
+    }
+
+    /// Forget the integrator and the transfer term (on release).
+    pub fn reset(&mut self) {
+        *self = Self::ZERO;
+    }
+
+    /// The remaining bumpless-transfer offset \[stick\].
+    pub fn transfer(&self) -> f32 {
+        self.transfer
+    }
+
+    /// The integrator's current contribution \[stick\].
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+
+    /// One control step: the output for this tick, then the integrator update.
+    pub fn update(&mut self, gains: &AxisGains, error: f32, rate: f32, dt: f32) -> f32 {
+        let unsaturated =
+            Self::proportional_and_damping(gains, error, rate) + self.integral + self.transfer;
+        let output = clamp_finite(unsaturated, gains.output_limit);
+        // B ← B·e^{−dt/τ_b}: continuous at engagement, gone after a few τ_b. A decay rate
+        // needs no libm precision: micromath's fast exp (≈1e-3 relative) does.
+        self.transfer = if gains.bumpless_time_s > 0.0 {
+            let decay = micromath::F32Ext::exp(-dt / gains.bumpless_time_s);
+            clamp_finite(self.transfer * decay, MAX_TRANSFER)
+        } else {
+            0.0
+        };
+        let increment = -Self::sign(gains) * gains.ki * error * dt;
+        // Conditional integration: no growth further into a saturated output.
+        let winding_up = (unsaturated >= gains.output_limit && increment > 0.0)
+            || (unsaturated <= -gains.output_limit && increment < 0.0);
+        if !winding_up {
+            self.integral = clamp_finite(self.integral + increment, gains.integrator_limit);
+        }
+        output
+    }
+}
+
+/// `value` clamped to ±|`limit`|; NaN maps to 0 (a NaN limit counts as 0).
+///
+/// Not `f32::clamp`, which panics when its bounds are NaN or reversed: gains reach this
+/// through public functions that cannot assume a validated configuration.
+pub(crate) fn clamp_finite(value: f32, limit: f32) -> f32 {
+    let limit = if limit.is_nan() { 0.0 } else { limit.abs() };
+    if value.is_nan() {
+        0.0
+    } else {
+        value.max(-limit).min(limit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f32 = 0.005;
+
+    #[test]
+    fn presets_are_valid() {
+        for gains in [Gains::bo105(), Gains::trex700l()] {
+            assert!(gains.to_array().iter().all(AxisGains::is_valid));
+        }
+    }
+
+    #[test]
+    fn opposes_a_positive_error_and_a_positive_rate() {
+        let gains = Gains::bo105().lat;
+        let mut controller = AttitudeController::default();
+        assert!(controller.update(&gains, 0.1, 0.0, DT) < 0.0);
+        controller.reset();
+        assert!(controller.update(&gains, 0.0, 0.5, DT) < 0.0);
+        let reversed = AxisGains {
+            reversed: true,
+            ..gains
+        };
+        controller.reset();
+        assert!(controller.update(&reversed, 0.1, 0.0, DT) > 0.0);
+    }
+
+    #[test]
+    fn output_is_limited_and_the_integrator_does_not_wind_up() {
+        let gains = Gains::bo105().lat;
+        let mut controller = AttitudeController::default();
+        for _ in 0..100_000 {
+            let out = controller.update(&gains, 1.0, 0.0, DT);
+            assert!(out.abs() <= gains.output_limit);
+        }
+        // Saturated by the P term alone: the integrator must not have grown.
+        assert_eq!(controller.integral(), 0.0);
+        // Not saturated: the integrator grows but stays within its limit.
+        for _ in 0..100_000 {
+            controller.update(&gains, 0.01, 0.0, DT);
+        }
+        assert!(controller.integral() < 0.0);
+        assert!(controller.integral() >= -gains.integrator_limit);
+    }
+
+    #[test]
+    fn engagement_is_bumpless_and_release_resets() {
+        let gains = Gains::bo105().lon;
+        let mut controller = AttitudeController::default();
+        controller.engage(&gains, 0.11, 0.02, 0.04);
+        let initial_transfer = controller.transfer();
+        assert!(initial_transfer > 0.0);
+        let first = controller.update(&gains, 0.11, 0.02, DT);
+        assert!((first - 0.04).abs() < 1e-6, "first output {first}");
+        // After 5 τ_b the transfer has bled off and the PID acts against the error.
+        let ticks = (5.0 * gains.bumpless_time_s / DT) as usize;
+        let mut last = first;
+        for _ in 0..ticks {
+            last = controller.update(&gains, 0.11, 0.02, DT);
+        }
+        // e^{−5} ≈ 0.7 %: the transfer term is practically gone.
+        assert!(controller.transfer().abs() < 0.01 * initial_transfer);
+        assert!(last < -0.1, "output after hand-over {last}");
+        controller.reset();
+        assert_eq!(controller.integral(), 0.0);
+        assert_eq!(controller.transfer(), 0.0);
+    }
+
+    #[test]
+    fn invalid_limits_do_not_panic() {
+        let mut gains = Gains::bo105().lat;
+        gains.output_limit = f32::NAN;
+        gains.integrator_limit = -1.0;
+        let mut controller = AttitudeController::default();
+        assert_eq!(controller.update(&gains, 0.1, 0.1, DT), 0.0);
+        assert_eq!(clamp_finite(5.0, -2.0), 2.0);
+    }
+
+    #[test]
+    fn nan_inputs_give_a_finite_output() {
+        let gains = Gains::bo105().ped;
+        let mut controller = AttitudeController::default();
+        let out = controller.update(&gains, f32::NAN, f32::INFINITY, DT);
+        assert!(out.is_finite());
+        assert!(controller.integral().is_finite());
+    }
+}

@@ -1,0 +1,143 @@
+//! Divider arithmetic for the tick timer, the servo PWM timer and the USART, from the
+//! clock frequencies the clock tree actually runs at. Pure functions, tested on the host.
+
+/// Servo PWM counter frequency [Hz]: one count per microsecond, so a compare value is
+/// the pulse width in µs.
+pub const SERVO_COUNTER_HZ: u32 = 1_000_000;
+
+/// Why a divider cannot be programmed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum DividerError {
+    /// A requested rate of zero.
+    ZeroRate,
+    /// The input clock is too slow for the requested rate.
+    ClockTooSlow,
+    /// The result does not fit the register.
+    OutOfRange,
+}
+
+/// Auto-reload value of a 32-bit timer counting at `timer_hz` with prescaler 0 so that
+/// it overflows at `rate_hz`: f_update = f_timer / (ARR + 1), ARR = round(f_timer/f) − 1.
+/// Prescaler 0 keeps the full timer resolution (and QEMU's timer model mishandles a
+/// non-zero prescaler on the update interrupt).
+pub fn tick_reload(timer_hz: u32, rate_hz: u32) -> Result<u32, DividerError> {
+    if rate_hz == 0 {
+        return Err(DividerError::ZeroRate);
+    }
+    let counts = (timer_hz + rate_hz / 2) / rate_hz;
+    if counts < 2 {
+        return Err(DividerError::ClockTooSlow);
+    }
+    Ok(counts - 1)
+}
+
+/// The update rate a reload value really gives [mHz], for the boot log: f_timer /(ARR+1).
+pub fn achieved_rate_millihz(timer_hz: u32, reload: u32) -> u64 {
+    u64::from(timer_hz) * 1000 / (u64::from(reload) + 1)
+}
+
+/// Prescaler and auto-reload of a 16-bit timer at `timer_hz` counting microseconds with
+/// a PWM frame of `frame_hz`: PSC = f_timer / 1 MHz − 1, ARR = 1 MHz / f_frame − 1.
+pub fn servo_dividers(timer_hz: u32, frame_hz: u32) -> Result<(u16, u16), DividerError> {
+    if frame_hz == 0 {
+        return Err(DividerError::ZeroRate);
+    }
+    if timer_hz < SERVO_COUNTER_HZ {
+        return Err(DividerError::ClockTooSlow);
+    }
+    let prescaler =
+        u16::try_from(timer_hz / SERVO_COUNTER_HZ - 1).map_err(|_| DividerError::OutOfRange)?;
+    let period = SERVO_COUNTER_HZ / frame_hz;
+    if period < 2 {
+        return Err(DividerError::ClockTooSlow);
+    }
+    let reload = u16::try_from(period - 1).map_err(|_| DividerError::OutOfRange)?;
+    Ok((prescaler, reload))
+}
+
+/// USART baud-rate register with 16× oversampling (OVER8 = 0, RM0090 §30.3.4):
+/// USARTDIV = f_pclk / (16·baud), BRR = mantissa·16 + fraction = round(f_pclk / baud).
+pub fn usart_brr(pclk_hz: u32, baud: u32) -> Result<u32, DividerError> {
+    if baud == 0 {
+        return Err(DividerError::ZeroRate);
+    }
+    let brr = (pclk_hz + baud / 2) / baud;
+    // USARTDIV ≥ 1 (mantissa ≥ 1); the mantissa has 12 bits.
+    if brr < 16 {
+        return Err(DividerError::ClockTooSlow);
+    }
+    if brr > 0xFFFF {
+        return Err(DividerError::OutOfRange);
+    }
+    Ok(brr)
+}
+
+/// Baud rate error of a BRR value [parts per million]: |f_pclk/BRR − baud| / baud.
+pub fn baud_error_ppm(pclk_hz: u32, baud: u32, brr: u32) -> u32 {
+    let actual = u64::from(pclk_hz) * 1_000_000 / u64::from(brr.max(1));
+    let wanted = u64::from(baud) * 1_000_000;
+    let error = actual.abs_diff(wanted) * 1_000_000 / wanted.max(1);
+    u32::try_from(error).unwrap_or(u32::MAX)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_reload_gives_the_rate_on_every_clock_tree() {
+        // PLL tree: TIM2 at 84 MHz; HSI fallback: 16 MHz; QEMU: 1 GHz.
+        assert_eq!(tick_reload(84_000_000, 200), Ok(419_999));
+        assert_eq!(tick_reload(16_000_000, 200), Ok(79_999));
+        assert_eq!(tick_reload(1_000_000_000, 200), Ok(4_999_999));
+        for (clock, rate) in [(84_000_000, 200), (16_000_000, 333), (1_000_000_000, 1000)] {
+            let reload = tick_reload(clock, rate).unwrap();
+            let achieved = achieved_rate_millihz(clock, reload);
+            let wanted = u64::from(rate) * 1000;
+            // Rounding the count to the nearest integer bounds the error by half a count.
+            assert!(
+                achieved.abs_diff(wanted) * u64::from(reload + 1) <= wanted,
+                "{clock} {rate}"
+            );
+        }
+    }
+
+    #[test]
+    fn tick_reload_rejects_impossible_rates() {
+        assert_eq!(tick_reload(16_000_000, 0), Err(DividerError::ZeroRate));
+        assert_eq!(tick_reload(1000, 1000), Err(DividerError::ClockTooSlow));
+    }
+
+    #[test]
+    fn servo_timer_counts_microseconds() {
+        assert_eq!(servo_dividers(84_000_000, 50), Ok((83, 19_999)));
+        assert_eq!(servo_dividers(16_000_000, 333), Ok((15, 3002)));
+        assert_eq!(servo_dividers(1_000_000_000, 50), Ok((999, 19_999)));
+        assert_eq!(servo_dividers(500_000, 50), Err(DividerError::ClockTooSlow));
+        // 10 Hz needs a 100 000-count period: more than 16 bits.
+        assert_eq!(
+            servo_dividers(84_000_000, 10),
+            Err(DividerError::OutOfRange)
+        );
+        assert_eq!(servo_dividers(84_000_000, 0), Err(DividerError::ZeroRate));
+    }
+
+    #[test]
+    fn brr_matches_the_reference_manual_and_stays_accurate() {
+        // f_PCLK = 84 MHz, OVER8 = 0, 460.8 kBd: USARTDIV = 84e6 / (16 · 460800) = 11.39
+        // → mantissa 11, fraction round(0.39 · 16) = 6 → BRR = 11·16 + 6 = 0xB6.
+        assert_eq!(usart_brr(84_000_000, 460_800), Ok(0xB6));
+        for pclk in [16_000_000, 84_000_000] {
+            let brr = usart_brr(pclk, 460_800).unwrap();
+            // A UART receiver tolerates a few percent; stay under 1 %.
+            assert!(baud_error_ppm(pclk, 460_800, brr) < 10_000, "{pclk}");
+        }
+        assert_eq!(
+            usart_brr(1_000_000, 460_800),
+            Err(DividerError::ClockTooSlow)
+        );
+        assert_eq!(usart_brr(84_000_000, 0), Err(DividerError::ZeroRate));
+        assert_eq!(usart_brr(84_000_000, 1), Err(DividerError::OutOfRange));
+    }
+}

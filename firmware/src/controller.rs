@@ -1,0 +1,652 @@
+//! The flight controller: test sequencer, conditional attitude hold, excitation, safety
+//! and telemetry, advanced one fixed-rate tick at a time by [`FlightController::step`].
+//!
+//! # Sequencer
+//!
+//! ```text
+//! Idle ──switch off→on──▶ Armed ──next tick──▶ TrimCapture ──trim_capture_s──▶ FadeIn
+//!   ▲                                                                        │
+//!   │ switch off                                       Sweep ◀───────────────┘
+//!   │                                                    │
+//! Done / Aborted ◀── excitation over (Done) ── FadeOut ◀─┘      any check fails → Aborted
+//! ```
+//!
+//! * Arming needs a rising edge of the test switch. At boot the switch counts as off, so
+//!   a switch already on at the first tick arms; after Done or Aborted the switch must go
+//!   off (→ Idle) and on again.
+//! * The Header frame goes out on the Armed → TrimCapture tick, just before that
+//!   PhaseChange: the test starts there, and a test aborted in its Armed tick has none.
+//! * The `phase` of a Sample is the phase after the tick's transitions, i.e. the one whose
+//!   logic produced the command. Phases of zero length (no fade) are skipped.
+//! * Armed, TrimCapture and the excitation phases are guarded by the safety checks; in
+//!   Idle, Armed, TrimCapture, Done and Aborted the outputs are pilot pass-through.
+//! * The excitation phases FadeIn / Sweep / FadeOut follow the excitation's segments (see
+//!   [`SweepSignal`](crate::sweep::SweepSignal) and
+//!   [`PulseSignal`](crate::pulse::PulseSignal)); every command there is
+//!   `trim + perturbation`, clamped to [−1, 1].
+//!
+//! # Sample fields
+//!
+//! `sweep_omega` is the instantaneous frequency dθ/dt of the sweep signal: ω(t) in the
+//! Sweep phase, ω_min in FadeIn (the fade and the ω_min hold run at ω_min) and ω_max in
+//! FadeOut; 0 in every other phase and for pulse inputs. `sweep` and `noise` are the
+//! parts actually applied (0 on an axis whose hold is Engaged or Frozen in conditional
+//! attitude hold), so `command − trim − sweep − noise` is the hold controller's share.
+//! `pilot` and `meas` are the raw inputs of the tick (a NaN that caused an abort is
+//! logged as such).
+//!
+//! # Pilot override during trim capture
+//!
+//! During TrimCapture the sticks are compared with the running average of the capture so
+//! far (from its second tick on): a pilot who moves more than the override threshold
+//! while the trim is being taken aborts the test instead of corrupting the trim.
+//!
+//! # Frames per tick
+//!
+//! In order: the Header (test start only), Events as they happen, then exactly one Sample
+//! — in every phase, so a missing tick shows up as a gap in `Sample::tick`.
+
+use sweephold_protocol::{
+    encode, AbortReason, ActuatorOut, Axis, Controls, Event, ExcitationMode, FirmwareVersion,
+    Frame, Header, HoldState, Measurements, Phase, Sample, SensorIn, MAX_FRAME_LEN,
+    PROTOCOL_VERSION,
+};
+
+use crate::attitude_hold::{AttitudeController, AxisGains};
+use crate::config::{Config, ConfigError};
+use crate::excitation::{Excitation, ExcitationSample};
+use crate::hold::{next_hold_state, HoldThresholds};
+use crate::mixer::mix;
+use crate::noise::OffAxisNoise;
+use crate::safety::{self, SafetyInput, StaleTracker};
+use crate::sink::FrameSink;
+use crate::trim::{Trim, TrimAccumulator};
+
+/// What the flight controller commands in one tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Output {
+    /// Commands, fractions of full stick travel, each in [−1, 1] and finite.
+    pub command: Controls,
+    /// Servo pulse widths \[µs\]: swash servos 1 (front), 2 (right-rear), 3 (left-rear),
+    /// tail.
+    pub servo_us: [u16; 4],
+}
+
+impl Output {
+    /// The in-the-loop answer to the [`SensorIn`] with sequence number `seq`, produced at
+    /// `tick` (the value of [`FlightController::tick`] before the `step`).
+    pub const fn actuator_out(&self, tick: u32, seq: u32) -> ActuatorOut {
+        ActuatorOut {
+            tick,
+            seq,
+            command: self.command,
+            servo_us: self.servo_us,
+        }
+    }
+}
+
+/// This crate's version, as recorded in the Header.
+pub const FIRMWARE_VERSION: FirmwareVersion = FirmwareVersion {
+    major: parse_version_part(env!("CARGO_PKG_VERSION_MAJOR")),
+    minor: parse_version_part(env!("CARGO_PKG_VERSION_MINOR")),
+    patch: parse_version_part(env!("CARGO_PKG_VERSION_PATCH")),
+};
+
+/// Decimal digits to u8 at compile time (saturating; non-digits ignored).
+const fn parse_version_part(text: &str) -> u8 {
+    let mut rest = text.as_bytes();
+    let mut value: u8 = 0;
+    while let [digit, tail @ ..] = rest {
+        if digit.is_ascii_digit() {
+            value = value.saturating_mul(10).saturating_add(*digit - b'0');
+        }
+        rest = tail;
+    }
+    value
+}
+
+/// The held axes, in the order of `Sample::hold`.
+const HELD_AXES: [Axis; 3] = [Axis::Lat, Axis::Lon, Axis::Ped];
+
+/// Hold state and controller of one held axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct HeldAxis {
+    state: HoldState,
+    controller: AttitudeController,
+    /// The perturbation (command − trim) actually applied last tick: the bumpless
+    /// starting point of an engagement and the value a Frozen axis keeps.
+    last_perturbation: f32,
+    /// What is left of the controller's output after a release, fading with τ_r.
+    release_carry: f32,
+}
+
+impl HeldAxis {
+    const RELEASED: HeldAxis = HeldAxis {
+        state: HoldState::Released,
+        controller: AttitudeController::ZERO,
+        last_perturbation: 0.0,
+        release_carry: 0.0,
+    };
+}
+
+/// Everything one held axis needs from this tick's measurements.
+#[derive(Clone, Copy, Debug)]
+struct AxisInput {
+    axis: Axis,
+    gains: AxisGains,
+    /// Attitude deviation from trim \[rad\].
+    deviation: f32,
+    /// Matching body rate [rad/s].
+    rate: f32,
+    /// Filtered noise sample for this axis.
+    noise: f32,
+}
+
+/// The parts of one tick's command, for the Sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct TickParts {
+    command: [f32; 4],
+    sweep: [f32; 4],
+    noise: [f32; 4],
+    sweep_omega: f32,
+}
+
+impl TickParts {
+    fn pass_through(pilot: [f32; 4]) -> Self {
+        TickParts {
+            command: pilot.map(clamp_unit),
+            sweep: [0.0; 4],
+            noise: [0.0; 4],
+            sweep_omega: 0.0,
+        }
+    }
+}
+
+/// The flight controller. See the [module documentation](self) for the sequencer.
+#[derive(Clone, Debug)]
+pub struct FlightController {
+    config: Config,
+    header: Header,
+    excitation: Excitation,
+    /// The noise generator as configured; copied at each test start so that every test
+    /// with the same seed gets the same noise.
+    noise_at_start: OffAxisNoise,
+    noise: OffAxisNoise,
+    thresholds: HoldThresholds,
+    rate_hz: f64,
+    dt_s: f32,
+    trim_capture_ticks: u32,
+    phase: Phase,
+    tick: u32,
+    /// Ticks since the excitation started (time base of the sweep: t = n / rate).
+    excitation_tick: u32,
+    trim_accumulator: TrimAccumulator,
+    trim: Trim,
+    stale: StaleTracker,
+    axes: [HeldAxis; 3],
+    switch_was_on: bool,
+    /// Last finite stick values, for pass-through of a non-finite stick.
+    last_finite_pilot: [f32; 4],
+}
+
+impl FlightController {
+    /// Validate `config` and build a controller in Idle at tick 0.
+    pub fn new(config: Config) -> Result<FlightController, ConfigError> {
+        let warnings = config.validate()?;
+        let mut config = config;
+        config.test.warnings = warnings;
+        if warnings != 0 {
+            warn!("test configuration warnings: {=u8:#x}", warnings);
+        }
+        let dt_s = config.dt_s();
+        let noise = OffAxisNoise::new(
+            config.test.seed,
+            config.test.noise_rms,
+            config.test.noise_cutoff_rad_s,
+            dt_s,
+        );
+        let rate = f32::from(config.rate_hz);
+        // Validation bounds trim_capture_s·rate to [1, 10 000].
+        let trim_capture_ticks = libm::roundf(config.trim_capture_s * rate).max(1.0) as u32;
+        Ok(FlightController {
+            header: Header {
+                protocol: PROTOCOL_VERSION,
+                firmware: FIRMWARE_VERSION,
+                vehicle: config.vehicle,
+                rate_hz: config.rate_hz,
+                test: config.test,
+            },
+            excitation: Excitation::from_test(&config.test),
+            noise_at_start: noise,
+            noise,
+            thresholds: config.hold_thresholds(),
+            rate_hz: f64::from(config.rate_hz),
+            dt_s,
+            trim_capture_ticks,
+            phase: Phase::Idle,
+            tick: 0,
+            excitation_tick: 0,
+            trim_accumulator: TrimAccumulator::default(),
+            trim: Trim::default(),
+            stale: StaleTracker::default(),
+            axes: [HeldAxis::RELEASED; 3],
+            switch_was_on: false,
+            last_finite_pilot: [0.0; 4],
+            config,
+        })
+    }
+
+    /// The Header sent at test start (vehicle, rate, test, warnings).
+    pub fn header(&self) -> Header {
+        self.header
+    }
+
+    /// The current sequencer phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// Number of ticks stepped so far (the tick number the next `step` will carry).
+    pub fn tick(&self) -> u32 {
+        self.tick
+    }
+
+    /// The validated configuration (with `test.warnings` filled in).
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The trim of the current or last test (zero before the first capture).
+    pub fn trim(&self) -> Trim {
+        self.trim
+    }
+
+    /// Hold states of lat, lon and ped.
+    pub fn hold_states(&self) -> [HoldState; 3] {
+        self.axes.map(|axis| axis.state)
+    }
+
+    /// Run one tick: sequencer, safety, excitation and hold, telemetry into `sink`.
+    /// Bounded time, no allocation, no panic for any input.
+    pub fn step(&mut self, input: &SensorIn, sink: &mut impl FrameSink) -> Output {
+        let tick = self.tick;
+        let unchanged_seq_ticks = self.stale.observe(input.seq);
+        let pilot = self.sanitize_pilot(&input.pilot.sticks);
+        let switch_on = input.pilot.test_switch;
+        let switch_rising = switch_on && !self.switch_was_on;
+        self.switch_was_on = switch_on;
+        let phase_at_start = self.phase;
+
+        match self.phase {
+            Phase::Idle if switch_rising => self.set_phase(Phase::Armed, tick, sink),
+            Phase::Done | Phase::Aborted if !switch_on => self.set_phase(Phase::Idle, tick, sink),
+            _ => {}
+        }
+
+        if is_guarded(self.phase) {
+            let stick_reference = match self.phase {
+                Phase::TrimCapture => self.trim_accumulator.mean_sticks(),
+                Phase::FadeIn | Phase::Sweep | Phase::FadeOut => Some(self.trim.sticks),
+                _ => None,
+            };
+            let verdict = safety::check(
+                &self.config.safety,
+                &SafetyInput {
+                    sensor: input,
+                    unchanged_seq_ticks,
+                    stick_reference,
+                },
+            );
+            if let Some(reason) = verdict {
+                self.abort(reason, tick, sink);
+            }
+        }
+
+        // Armed lasts exactly one tick: the test starts on the next one.
+        if self.phase == Phase::Armed && phase_at_start == Phase::Armed {
+            emit(sink, &Frame::Header(self.header));
+            self.trim_accumulator = TrimAccumulator::default();
+            self.set_phase(Phase::TrimCapture, tick, sink);
+        }
+
+        let excite = match self.phase {
+            Phase::TrimCapture => {
+                self.trim_accumulator.add(&input.pilot.sticks, &input.meas);
+                if self.trim_accumulator.count() >= self.trim_capture_ticks {
+                    self.start_excitation(tick, sink);
+                    true
+                } else {
+                    false
+                }
+            }
+            Phase::FadeIn | Phase::Sweep | Phase::FadeOut => true,
+            _ => false,
+        };
+        let parts = if excite {
+            self.excite(&input.meas, pilot, tick, sink)
+        } else {
+            TickParts::pass_through(pilot)
+        };
+
+        let command = Controls::from_array(parts.command);
+        let sample = Sample {
+            tick,
+            phase: self.phase,
+            primary: self.config.test.primary,
+            sweep_omega: parts.sweep_omega,
+            hold: self.hold_states(),
+            command,
+            sweep: Controls::from_array(parts.sweep),
+            noise: Controls::from_array(parts.noise),
+            pilot: input.pilot.sticks,
+            meas: input.meas,
+        };
+        emit(sink, &Frame::Sample(sample));
+        self.tick = tick.wrapping_add(1);
+        Output {
+            command,
+            servo_us: mix(&self.config.mixer, &command),
+        }
+    }
+
+    /// Sticks with each non-finite value replaced by the last finite one.
+    fn sanitize_pilot(&mut self, sticks: &Controls) -> [f32; 4] {
+        for (kept, value) in self.last_finite_pilot.iter_mut().zip(sticks.to_array()) {
+            if value.is_finite() {
+                *kept = value;
+            }
+        }
+        self.last_finite_pilot
+    }
+
+    fn set_phase(&mut self, to: Phase, tick: u32, sink: &mut impl FrameSink) {
+        if self.phase != to {
+            let from = self.phase;
+            info!("tick {=u32}: phase {} -> {}", tick, from, to);
+            emit(sink, &Frame::Event(Event::PhaseChange { tick, from, to }));
+            self.phase = to;
+        }
+    }
+
+    fn abort(&mut self, reason: AbortReason, tick: u32, sink: &mut impl FrameSink) {
+        warn!("tick {=u32}: abort: {}", tick, reason);
+        emit(sink, &Frame::Event(Event::Abort { tick, reason }));
+        self.release_all(tick, sink);
+        self.set_phase(Phase::Aborted, tick, sink);
+    }
+
+    /// Release every held axis (end of the excitation or abort).
+    fn release_all(&mut self, tick: u32, sink: &mut impl FrameSink) {
+        for (held, axis) in self.axes.iter_mut().zip(HELD_AXES) {
+            if held.state != HoldState::Released {
+                emit(sink, &Frame::Event(Event::HoldReleased { tick, axis }));
+            }
+            *held = HeldAxis::RELEASED;
+        }
+    }
+
+    /// Trim capture complete: fix the trim and reset the excitation's state.
+    fn start_excitation(&mut self, tick: u32, sink: &mut impl FrameSink) {
+        self.trim = self.trim_accumulator.trim();
+        let trim = self.trim;
+        info!("tick {=u32}: trim captured", tick);
+        emit(
+            sink,
+            &Frame::Event(Event::TrimCaptured {
+                tick,
+                sticks: Controls::from_array(trim.sticks),
+                phi: trim.phi,
+                theta: trim.theta,
+                psi: trim.psi,
+            }),
+        );
+        self.excitation_tick = 0;
+        self.noise = self.noise_at_start;
+        self.axes = [HeldAxis::RELEASED; 3];
+    }
+
+    /// One tick of the excitation phases.
+    fn excite(
+        &mut self,
+        meas: &Measurements,
+        pilot: [f32; 4],
+        tick: u32,
+        sink: &mut impl FrameSink,
+    ) -> TickParts {
+        // t = n / rate from an integer count: no accumulated rounding over a long record.
+        let t = f64::from(self.excitation_tick) / self.rate_hz;
+        let sample = self.excitation.sample(t);
+        let Some(phase) = sample.segment.phase() else {
+            self.release_all(tick, sink);
+            self.set_phase(Phase::Done, tick, sink);
+            return TickParts::pass_through(pilot);
+        };
+        self.set_phase(phase, tick, sink);
+        self.excitation_tick = self.excitation_tick.saturating_add(1);
+
+        let trim = self.trim;
+        let [noise_lat, noise_lon, noise_ped] = self.noise.next_sample();
+        let gains = &self.config.gains;
+        // lat ↔ φ (damped by p), lon ↔ θ (q), ped ↔ heading error ψ − ψ_trim wrapped to
+        // ±π (r); all as deviations from the captured trim.
+        let inputs = [
+            AxisInput {
+                axis: Axis::Lat,
+                gains: gains.lat,
+                deviation: meas.phi - trim.phi,
+                rate: meas.p,
+                noise: noise_lat,
+            },
+            AxisInput {
+                axis: Axis::Lon,
+                gains: gains.lon,
+                deviation: meas.theta - trim.theta,
+                rate: meas.q,
+                noise: noise_lon,
+            },
+            AxisInput {
+                axis: Axis::Ped,
+                gains: gains.ped,
+                deviation: wrap_pi(meas.psi - trim.psi),
+                rate: meas.r,
+                noise: noise_ped,
+            },
+        ];
+
+        let primary = self.config.test.primary;
+        let mode = self.config.test.mode;
+        let mut parts = TickParts {
+            command: [0.0; 4],
+            sweep: [0.0; 4],
+            noise: [0.0; 4],
+            sweep_omega: sample.omega,
+        };
+        let held_parts = parts
+            .command
+            .iter_mut()
+            .zip(parts.sweep.iter_mut())
+            .zip(parts.noise.iter_mut())
+            .zip(trim.sticks);
+        for ((((command, sweep_part), noise_part), trim_stick), (held, input)) in
+            held_parts.zip(self.axes.iter_mut().zip(inputs))
+        {
+            let step = step_axis(
+                held,
+                &input,
+                &sample,
+                primary,
+                mode,
+                &self.thresholds,
+                self.dt_s,
+            );
+            *command = clamp_unit(trim_stick + step.perturbation);
+            held.last_perturbation = *command - trim_stick;
+            *sweep_part = step.sweep;
+            *noise_part = step.noise;
+            if step.previous != held.state {
+                let axis = input.axis;
+                match held.state {
+                    HoldState::Engaged => {
+                        debug!("tick {=u32}: hold engaged on {}", tick, axis);
+                        emit(sink, &Frame::Event(Event::HoldEngaged { tick, axis }));
+                    }
+                    HoldState::Released => {
+                        debug!("tick {=u32}: hold released on {}", tick, axis);
+                        emit(sink, &Frame::Event(Event::HoldReleased { tick, axis }));
+                    }
+                    HoldState::Frozen => {}
+                }
+            }
+        }
+
+        // The collective is never held and never gets noise: trim, plus the excitation
+        // when it is the primary axis.
+        let collective_sweep = if primary == Axis::Col {
+            sample.value
+        } else {
+            0.0
+        };
+        let [lat, lon, ped, _] = parts.command;
+        let [sweep_lat, sweep_lon, sweep_ped, _] = parts.sweep;
+        let [_, _, _, trim_col] = trim.sticks;
+        parts.command = [lat, lon, ped, clamp_unit(trim_col + collective_sweep)];
+        parts.sweep = [sweep_lat, sweep_lon, sweep_ped, collective_sweep];
+        parts
+    }
+}
+
+/// Result of one held axis' tick.
+struct AxisStep {
+    previous: HoldState,
+    perturbation: f32,
+    sweep: f32,
+    noise: f32,
+}
+
+/// Hold logic and controller of one held axis for one tick; updates `held.state` and
+/// the controller, returns the perturbation and its sweep and noise parts.
+fn step_axis(
+    held: &mut HeldAxis,
+    input: &AxisInput,
+    sample: &ExcitationSample,
+    primary: Axis,
+    mode: ExcitationMode,
+    thresholds: &HoldThresholds,
+    dt_s: f32,
+) -> AxisStep {
+    let is_primary = input.axis == primary;
+    let with_noise = matches!(
+        mode,
+        ExcitationMode::ConditionalAttitudeHold | ExcitationMode::OffAxisNoise
+    );
+    let sweep = if is_primary { sample.value } else { 0.0 };
+    let noise = if !is_primary && with_noise {
+        input.noise * sample.envelope
+    } else {
+        0.0
+    };
+    let previous = held.state;
+    let gains = &input.gains;
+    let (state, perturbation, sweep, noise) = match mode {
+        ExcitationMode::ConditionalAttitudeHold => {
+            match next_hold_state(previous, input.deviation, thresholds) {
+                HoldState::Released => {
+                    if previous != HoldState::Released {
+                        held.controller.reset();
+                        // Bumpless release: the controller was holding the aircraft
+                        // against moments (sideslip, speed) that do not vanish at 4°;
+                        // dropping its output in one tick kicks the aircraft straight
+                        // back through 6° and injects a broadband step into every held
+                        // axis at once, i.e. cross-control coherence.
+                        held.release_carry = held.last_perturbation - sweep - noise;
+                    }
+                    held.release_carry *= fade_factor(gains.release_time_s, dt_s);
+                    let carry = held.release_carry;
+                    (HoldState::Released, sweep + noise + carry, sweep, noise)
+                }
+                HoldState::Engaged => {
+                    if previous != HoldState::Engaged {
+                        let last = held.last_perturbation;
+                        held.controller
+                            .engage(gains, input.deviation, input.rate, last);
+                    }
+                    let output = held
+                        .controller
+                        .update(gains, input.deviation, input.rate, dt_s);
+                    (HoldState::Engaged, output, 0.0, 0.0)
+                }
+                HoldState::Frozen => (HoldState::Frozen, held.last_perturbation, 0.0, 0.0),
+            }
+        }
+        // Standard and off-axis-noise methods: the controller always drives the axis and
+        // the excitation is added on top.
+        ExcitationMode::Standard | ExcitationMode::OffAxisNoise => {
+            if previous != HoldState::Engaged {
+                let last = held.last_perturbation;
+                held.controller
+                    .engage(gains, input.deviation, input.rate, last);
+            }
+            let output = held
+                .controller
+                .update(gains, input.deviation, input.rate, dt_s);
+            (HoldState::Engaged, output + sweep + noise, sweep, noise)
+        }
+    };
+    held.state = state;
+    AxisStep {
+        previous,
+        perturbation,
+        sweep,
+        noise,
+    }
+}
+
+/// exp(−dt/τ): the per-tick factor of a first-order fade with time constant τ (0: gone
+/// at once). micromath's exp is plenty for a fade.
+fn fade_factor(tau_s: f32, dt_s: f32) -> f32 {
+    if tau_s > 0.0 {
+        micromath::F32Ext::exp(-dt_s / tau_s)
+    } else {
+        0.0
+    }
+}
+
+/// Phases the safety checks guard.
+fn is_guarded(phase: Phase) -> bool {
+    matches!(
+        phase,
+        Phase::Armed | Phase::TrimCapture | Phase::FadeIn | Phase::Sweep | Phase::FadeOut
+    )
+}
+
+/// Encode `frame` and hand it to `sink`. Encoding cannot fail for the protocol's types
+/// with a `MAX_FRAME_LEN` buffer; if it ever did, the frame is dropped (and shows up as
+/// a gap) rather than stopping the control loop.
+fn emit(sink: &mut impl FrameSink, frame: &Frame) {
+    let mut buffer = [0u8; MAX_FRAME_LEN];
+    match encode(frame, &mut buffer) {
+        Ok(length) => sink.write_frame(buffer.get(..length).unwrap_or(&[])),
+        Err(_) => error!("telemetry frame encoding failed"),
+    }
+}
+
+/// `value` clamped to [−1, 1]; NaN maps to 0.
+fn clamp_unit(value: f32) -> f32 {
+    crate::attitude_hold::clamp_finite(value, 1.0)
+}
+
+/// Angle wrapped to [−π, π]; non-finite maps to 0.
+///
+/// x − 2π·round(x/2π) lies in [−π, π] in exact arithmetic; the final clamp keeps it
+/// there after rounding, even for huge |x| where the subtraction loses every digit.
+pub fn wrap_pi(angle: f32) -> f32 {
+    use core::f32::consts::{PI, TAU};
+    if !angle.is_finite() {
+        return 0.0;
+    }
+    (angle - TAU * libm::roundf(angle / TAU)).clamp(-PI, PI)
+}
+
+#[cfg(test)]
+#[path = "controller_tests.rs"]
+mod tests;

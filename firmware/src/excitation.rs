@@ -1,0 +1,110 @@
+//! The primary-axis excitation: a sweep or a multistep, behind one interface the
+//! sequencer drives with the time since the excitation started.
+
+use sweephold_protocol::{InputKind, Phase, TestConfig};
+
+use crate::pulse::{PulsePattern, PulseSignal};
+use crate::sweep::SweepSignal;
+
+/// Which part of the excitation a time falls in; maps one to one onto the sequencer's
+/// FadeIn / Sweep / FadeOut phases.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Segment {
+    /// Fade-in and ω_min hold (sweep) or quiet lead-in (pulses).
+    LeadIn,
+    /// The sweep record or the pulses.
+    Main,
+    /// Fade-out (sweep) or quiet tail (pulses).
+    Tail,
+    /// Past the end.
+    Finished,
+}
+
+impl Segment {
+    /// The sequencer phase of this segment; `None` once finished.
+    pub const fn phase(self) -> Option<Phase> {
+        match self {
+            Segment::LeadIn => Some(Phase::FadeIn),
+            Segment::Main => Some(Phase::Sweep),
+            Segment::Tail => Some(Phase::FadeOut),
+            Segment::Finished => None,
+        }
+    }
+}
+
+/// One excitation sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExcitationSample {
+    /// Where in the excitation.
+    pub segment: Segment,
+    /// Primary-axis perturbation, fraction of stick travel.
+    pub value: f32,
+    /// Instantaneous frequency dθ/dt [rad/s] of a sweep; 0 for pulses and when finished.
+    pub omega: f32,
+    /// Envelope in [0, 1] applied to the excitation and to the off-axis noise.
+    pub envelope: f32,
+}
+
+impl ExcitationSample {
+    /// The sample past the end of the excitation.
+    pub const FINISHED: ExcitationSample = ExcitationSample {
+        segment: Segment::Finished,
+        value: 0.0,
+        omega: 0.0,
+        envelope: 0.0,
+    };
+}
+
+/// The configured primary-axis excitation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Excitation {
+    /// Exponential sweep with fades and ω_min hold.
+    Sweep(SweepSignal),
+    /// Doublet or 3-2-1-1.
+    Pulse(PulseSignal),
+}
+
+impl Excitation {
+    /// Build from a validated test configuration.
+    pub fn from_test(test: &TestConfig) -> Self {
+        let fade_s = f64::from(test.sweep.fade_s);
+        match test.input {
+            InputKind::Sweep => Excitation::Sweep(SweepSignal::new(
+                test.sweep.amplitude,
+                f64::from(test.sweep.omega_min),
+                f64::from(test.sweep.omega_max),
+                f64::from(test.sweep.t_rec_s),
+                fade_s,
+                test.sweep.start_hold_cycles,
+            )),
+            InputKind::Doublet => Excitation::Pulse(PulseSignal::new(
+                PulsePattern::Doublet,
+                test.pulse.amplitude,
+                f64::from(test.pulse.width_s),
+                fade_s,
+            )),
+            InputKind::ThreeTwoOneOne => Excitation::Pulse(PulseSignal::new(
+                PulsePattern::ThreeTwoOneOne,
+                test.pulse.amplitude,
+                f64::from(test.pulse.width_s),
+                fade_s,
+            )),
+        }
+    }
+
+    /// The excitation at time `t` \[s\] since it started.
+    pub fn sample(&self, t: f64) -> ExcitationSample {
+        match self {
+            Excitation::Sweep(sweep) => sweep.sample(t),
+            Excitation::Pulse(pulse) => pulse.sample(t),
+        }
+    }
+
+    /// Total length \[s\] (lead-in, main part and tail).
+    pub fn duration_s(&self) -> f64 {
+        match self {
+            Excitation::Sweep(sweep) => sweep.duration_s(),
+            Excitation::Pulse(pulse) => pulse.duration_s(),
+        }
+    }
+}
