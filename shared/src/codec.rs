@@ -36,12 +36,54 @@ pub enum EncodeError {
     Serialize,
 }
 
-/// CRC-32 (IEEE) of `bytes`.
+/// CRC-32 (IEEE) of `bytes`: reflected, polynomial 0xEDB88320, init and xorout
+/// 0xFFFFFFFF. On the host this is crc32fast (carry-less multiply: decoding is CRC-bound);
+/// on the flight controller it is [`crc32_small`], whose table costs 1 KiB of flash
+/// instead of crc32fast's 16 KiB.
+#[cfg(not(target_os = "none"))]
 pub fn crc32(bytes: &[u8]) -> u32 {
     let mut hasher = crc32fast::Hasher::new();
     hasher.update(bytes);
     hasher.finalize()
 }
+
+/// CRC-32 (IEEE) of `bytes`; see the host variant.
+#[cfg(target_os = "none")]
+pub fn crc32(bytes: &[u8]) -> u32 {
+    crc32_small(bytes)
+}
+
+/// CRC-32 (IEEE), byte at a time with one 256-entry table built at compile time:
+/// crc ← T[(crc ⊕ b) & 0xFF] ⊕ (crc ≫ 8).
+pub fn crc32_small(bytes: &[u8]) -> u32 {
+    let mut crc = 0xFFFF_FFFFu32;
+    for &byte in bytes {
+        crc = CRC_TABLE[usize::from((crc as u8) ^ byte)] ^ (crc >> 8);
+    }
+    !crc
+}
+
+/// T[n] = the CRC register after shifting the byte n through eight rounds of the
+/// reflected polynomial.
+const CRC_TABLE: [u32; 256] = {
+    let mut table = [0u32; 256];
+    let mut n = 0;
+    while n < 256 {
+        let mut c = n as u32;
+        let mut k = 0;
+        while k < 8 {
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+            k += 1;
+        }
+        table[n] = c;
+        n += 1;
+    }
+    table
+};
 
 /// Encode `frame` into `out` as it goes on the wire, delimiter included; returns the
 /// number of bytes written. No allocation; bounded time.
@@ -90,5 +132,44 @@ impl core::ops::Deref for FrameBytes {
     type Target = [u8];
     fn deref(&self) -> &[u8] {
         self.as_bytes()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{crc32, crc32_small};
+
+    /// The standard check value of CRC-32/ISO-HDLC and a known string, both variants.
+    #[test]
+    fn reference_values() {
+        for crc in [crc32, crc32_small] {
+            assert_eq!(crc(b"123456789"), 0xCBF4_3926);
+            assert_eq!(crc(b""), 0);
+            assert_eq!(
+                crc(b"The quick brown fox jumps over the lazy dog"),
+                0x414F_A339
+            );
+        }
+    }
+
+    /// The board's table CRC and the host's agree on every length and content.
+    #[test]
+    fn board_and_host_variants_agree() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let bytes: Vec<u8> = (0..4096)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                x as u8
+            })
+            .collect();
+        for len in 0..bytes.len() {
+            assert_eq!(
+                crc32(&bytes[..len]),
+                crc32_small(&bytes[..len]),
+                "length {len}"
+            );
+        }
     }
 }
