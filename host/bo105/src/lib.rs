@@ -1,1 +1,25 @@
 //! Nonlinear helicopter simulation (Bo-105, TREX 700L class) with trim and linearization.
+//!
+//! A minimum-complexity model after Heffley & Mnich (NASA CR-177476) with Padfield's Bo-105
+//! data: six-degree-of-freedom rigid body with Euler angles and position, first-order
+//! tip-path-plane flapping (β1c, β1s) whose time constant follows from the blade data,
+//! blade-element thrust with iterated Glauert momentum inflow (optionally Pitt–Peters
+//! dynamic inflow), hub spring and thrust-offset moments, tail rotor, fuselage drag, fin
+//! and tailplane. See `README.md` for the validation against Padfield's Helisim.
+
+#![warn(missing_docs)]
+
+pub mod linearize;
+pub mod model;
+mod rng;
+mod rotor;
+pub mod sim;
+mod trig;
+pub mod trim;
+pub mod vehicle;
+
+pub use linearize::{linearize, linearize_with, Linearization};
+pub use model::State;
+pub use sim::{ActuatorModel, SensorNoise, SensorReading, Sim, SimOptions};
+pub use trim::{trim, Trim, TrimError, KNOT};
+pub use vehicle::{BladePitch, Gearing, Helicopter, Rotor, Surface, UnknownVehicle, Vehicle};

@@ -1,0 +1,460 @@
+//! Vehicle parameter sets: the Bo-105 (Padfield, *Helicopter Flight Dynamics*, Helisim
+//! data) and an approximate TREX 700L-class radio-controlled helicopter.
+//!
+//! Axes: body x forward, y right, z down, origin at the centre of gravity (CG). Positions
+//! below are from the CG in metres. Both main rotors turn anticlockwise seen from above
+//! (Padfield's convention for the Bo-105), so the tail rotor pushes to the right (+y) and
+//! a positive tail-rotor collective yaws the nose left.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// Which aircraft to simulate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Vehicle {
+    /// MBB Bo-105, 2200 kg, hingeless rotor (Padfield's Helisim data).
+    #[default]
+    Bo105,
+    /// TREX 700L-class RC helicopter (approximate, see [`Helicopter::trex700l`]).
+    Trex700l,
+}
+
+impl Vehicle {
+    /// The parameter set of this vehicle.
+    pub fn helicopter(self) -> Helicopter {
+        match self {
+            Vehicle::Bo105 => Helicopter::bo105(),
+            Vehicle::Trex700l => Helicopter::trex700l(),
+        }
+    }
+
+    /// The lower-case name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Vehicle::Bo105 => "bo105",
+            Vehicle::Trex700l => "trex700l",
+        }
+    }
+}
+
+impl fmt::Display for Vehicle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A vehicle name that is neither `bo105` nor `trex700l`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownVehicle(pub String);
+
+impl fmt::Display for UnknownVehicle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "unknown vehicle `{}` (expected bo105 or trex700l)",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for UnknownVehicle {}
+
+impl FromStr for Vehicle {
+    type Err = UnknownVehicle;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "bo105" | "bo-105" => Ok(Vehicle::Bo105),
+            "trex700l" | "trex700" | "trex-700l" => Ok(Vehicle::Trex700l),
+            _ => Err(UnknownVehicle(s.to_string())),
+        }
+    }
+}
+
+/// Blade and hub data of one rotor. The flap time constant is derived from these (Lock
+/// number, rotor speed, hub stiffness), never typed in: see [`Rotor::flap_time_constant`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotor {
+    /// Radius R [m].
+    pub radius: f64,
+    /// Rotor speed Ω [rad/s].
+    pub omega: f64,
+    /// Number of blades N_b.
+    pub blades: f64,
+    /// Blade chord c [m].
+    pub chord: f64,
+    /// Linear twist θ_tw [rad] (root to tip; negative = washout). Blade pitch at radius
+    /// fraction x is θ0 + x·θ_tw.
+    pub twist: f64,
+    /// Blade lift-curve slope a [1/rad].
+    pub lift_slope: f64,
+    /// Blade flap moment of inertia about the hub I_β [kg·m²].
+    pub flap_inertia: f64,
+    /// Equivalent centre-spring hub stiffness K_β [N·m/rad] per blade.
+    pub hub_stiffness: f64,
+    /// Profile drag δ = δ0 + δ2·C_T².
+    pub profile_drag: [f64; 2],
+    /// Hub position from the CG, body axes [m].
+    pub hub: [f64; 3],
+}
+
+impl Rotor {
+    /// Solidity σ = N_b·c/(πR).
+    pub fn solidity(&self) -> f64 {
+        self.blades * self.chord / (std::f64::consts::PI * self.radius)
+    }
+
+    /// Disc area πR² [m²].
+    pub fn disc_area(&self) -> f64 {
+        std::f64::consts::PI * self.radius * self.radius
+    }
+
+    /// Tip speed ΩR [m/s].
+    pub fn tip_speed(&self) -> f64 {
+        self.omega * self.radius
+    }
+
+    /// Lock number γ = ρ·a·c·R⁴ / I_β.
+    pub fn lock_number(&self, air_density: f64) -> f64 {
+        air_density * self.lift_slope * self.chord * self.radius.powi(4) / self.flap_inertia
+    }
+
+    /// Flap-frequency ratio excess λ_β² − 1 = K_β / (I_β Ω²).
+    pub fn stiffness_excess(&self) -> f64 {
+        self.hub_stiffness / (self.flap_inertia * self.omega * self.omega)
+    }
+
+    /// Stiffness number S_β = 8(λ_β² − 1)/γ.
+    pub fn stiffness_number(&self, air_density: f64) -> f64 {
+        8.0 * self.stiffness_excess() / self.lock_number(air_density)
+    }
+
+    /// Tip-path-plane flap time constant τ_f [s] in hover, from the blade data.
+    ///
+    /// The first-order multiblade flap equations (second derivatives dropped, see
+    /// `rotor.rs`) in hover are `M·β' = N·β + forcing`, with g = γ/8, s = λ_β² − 1,
+    /// `M = [[g, 2], [−2, g]]`, `N = [[−s, −g], [g, −s]]` (′ = d/dψ). Their eigenvalues are
+    /// `Ω·(−g(2+s) ± i(2s − g²)) / (g² + 4)`, so
+    ///
+    /// ```text
+    /// τ_f = (g² + 4) / (Ω·g·(2 + s))   ≈ 16/(γΩ) for small g and s.
+    /// ```
+    pub fn flap_time_constant(&self, air_density: f64) -> f64 {
+        let g = self.lock_number(air_density) / 8.0;
+        let s = self.stiffness_excess();
+        (g * g + 4.0) / (self.omega * g * (2.0 + s))
+    }
+}
+
+/// A lifting surface (vertical fin or horizontal tailplane).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    /// Area [m²].
+    pub area: f64,
+    /// Incidence [rad] (fin: toward +y side force in forward flight; tailplane: leading
+    /// edge up).
+    pub incidence: f64,
+    /// Lift-curve slope [1/rad].
+    pub lift_slope: f64,
+    /// Position from the CG, body axes [m].
+    pub position: [f64; 3],
+    /// Angle of attack where the linear lift stops growing (crude stall) [rad].
+    pub stall_angle: f64,
+}
+
+/// Linear gearing of one control channel: `blade pitch = centre + gain·stick`, stick
+/// fraction in [−1, 1].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gearing {
+    /// Blade pitch at centred stick [rad].
+    pub centre: f64,
+    /// Blade pitch per unit stick fraction [rad].
+    pub gain: f64,
+}
+
+impl Gearing {
+    /// Blade pitch for a stick fraction.
+    pub fn pitch(&self, stick: f64) -> f64 {
+        self.centre + self.gain * stick
+    }
+
+    /// Stick fraction for a blade pitch.
+    pub fn stick(&self, pitch: f64) -> f64 {
+        (pitch - self.centre) / self.gain
+    }
+}
+
+/// The full parameter set of a helicopter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Helicopter {
+    /// Display name.
+    pub name: &'static str,
+    /// Mass [kg].
+    pub mass: f64,
+    /// Roll inertia I_xx [kg·m²].
+    pub ixx: f64,
+    /// Pitch inertia I_yy [kg·m²].
+    pub iyy: f64,
+    /// Yaw inertia I_zz [kg·m²].
+    pub izz: f64,
+    /// Product of inertia I_xz [kg·m²] (positive: principal axis nose-down of x).
+    pub ixz: f64,
+    /// Air density ρ [kg/m³].
+    pub air_density: f64,
+    /// Gravity g [m/s²].
+    pub gravity: f64,
+    /// Main rotor (hub position = rotor hub).
+    pub main_rotor: Rotor,
+    /// Forward tilt of the main-rotor shaft [rad] (Padfield's γ_s; top of the shaft
+    /// leans forward).
+    pub shaft_tilt: f64,
+    /// Tail rotor (thrust along +y for positive pitch; flap data unused).
+    pub tail_rotor: Rotor,
+    /// Fuselage equivalent flat-plate drag areas along x, y, z [m²].
+    pub fuselage_drag_area: [f64; 3],
+    /// Vertical fin.
+    pub fin: Surface,
+    /// Horizontal tailplane.
+    pub tailplane: Surface,
+    /// Stick → blade pitch gearing, in control order [lat → θ1c, lon → θ1s,
+    /// ped → θ0_TR, col → θ0].
+    pub gearing: [Gearing; 4],
+}
+
+impl Helicopter {
+    /// The MBB Bo-105 from Padfield's Helisim data (DESIGN.md §5).
+    ///
+    /// Gearing (positive stick produces a positive moment: lat → roll right, lon → nose up,
+    /// ped → nose right, col → up):
+    /// θ1c = −8°·lat (±8°), θ1s = +10°·lon (±10°), θ0_TR = 8.5° − 16.5°·ped (−8°…25°),
+    /// θ0 = 11° + 9°·col (2°…20°).
+    pub fn bo105() -> Helicopter {
+        let deg = std::f64::consts::PI / 180.0;
+        Helicopter {
+            name: "Bo-105",
+            mass: 2200.0,
+            ixx: 1433.0,
+            iyy: 4973.0,
+            izz: 4099.0,
+            ixz: 660.0,
+            air_density: 1.225,
+            gravity: 9.80665,
+            main_rotor: Rotor {
+                radius: 4.91,
+                omega: 44.4,
+                blades: 4.0,
+                chord: 0.27,
+                twist: -0.14,
+                lift_slope: 6.113,
+                flap_inertia: 231.7,
+                hub_stiffness: 113_330.0,
+                profile_drag: [0.0074, 38.66],
+                // CG 0.0163 R forward of the shaft, hub 1.48 m above the CG.
+                hub: [-0.0163 * 4.91, 0.0, -1.48],
+            },
+            shaft_tilt: 0.0524,
+            tail_rotor: Rotor {
+                radius: 0.95,
+                omega: 2220.0 * 2.0 * std::f64::consts::PI / 60.0,
+                blades: 2.0,
+                chord: 0.18,
+                twist: 0.0,
+                lift_slope: 5.7,
+                flap_inertia: 1.0,
+                hub_stiffness: 0.0,
+                profile_drag: [0.008, 9.5],
+                hub: [-6.0, 0.0, -1.72],
+            },
+            fuselage_drag_area: [1.4, 8.0, 10.0],
+            fin: Surface {
+                area: 0.805,
+                incidence: 0.0812,
+                lift_slope: 2.704,
+                position: [-5.4, 0.0, -0.9],
+                stall_angle: 0.35,
+            },
+            tailplane: Surface {
+                area: 0.803,
+                incidence: 0.0698,
+                lift_slope: 3.262,
+                position: [-4.56, 0.0, -0.2],
+                stall_angle: 0.35,
+            },
+            gearing: [
+                Gearing {
+                    centre: 0.0,
+                    gain: -8.0 * deg,
+                },
+                Gearing {
+                    centre: 0.0,
+                    gain: 10.0 * deg,
+                },
+                Gearing {
+                    centre: 8.5 * deg,
+                    gain: -16.5 * deg,
+                },
+                Gearing {
+                    centre: 11.0 * deg,
+                    gain: 9.0 * deg,
+                },
+            ],
+        }
+    }
+
+    /// A TREX 700L-class RC helicopter. **Approximate**: no published identified model
+    /// exists; the numbers are typical of the class (1.56 m rotor, 5 kg, 1900 rpm,
+    /// flybarless, two blades of ~0.2 kg with 62 mm chord).
+    ///
+    /// The flybarless head is modelled as a stiff hub with an equivalent centre-spring
+    /// stiffness of 350 N·m/rad per blade (head dampers), chosen so the roll flap-moment
+    /// derivative L_β1s = (N_b K_β/2 + T h)/I_xx ≈ 3 000 s⁻², of the order of the 700-size
+    /// approximation in DESIGN.md (3 588.6). The flap time constant follows from the blade
+    /// data (γ ≈ 3.4, Ω = 199 rad/s): τ_f ≈ 0.023 s. A hub spring can only shorten τ_f, so
+    /// DESIGN.md's 0.068 s (at 1500 rpm) cannot be reached with 1900 rpm and real blades.
+    /// CCPM-120 mixing is a firmware concern: here the controls are the same four stick
+    /// fractions as for the Bo-105. Gearing: θ1c = −8°·lat, θ1s = +8°·lon,
+    /// θ0_TR = 5° − 25°·ped, θ0 = 2° + 12°·col.
+    pub fn trex700l() -> Helicopter {
+        let deg = std::f64::consts::PI / 180.0;
+        Helicopter {
+            name: "TREX 700L class (approximate)",
+            mass: 5.0,
+            ixx: 0.12,
+            iyy: 0.40,
+            izz: 0.35,
+            ixz: 0.0,
+            air_density: 1.225,
+            gravity: 9.80665,
+            main_rotor: Rotor {
+                radius: 0.78,
+                omega: 1900.0 * 2.0 * std::f64::consts::PI / 60.0,
+                blades: 2.0,
+                chord: 0.062,
+                twist: 0.0,
+                lift_slope: 5.5,
+                flap_inertia: 0.046,
+                hub_stiffness: 350.0,
+                profile_drag: [0.012, 0.0],
+                hub: [0.0, 0.0, -0.25],
+            },
+            shaft_tilt: 0.0,
+            tail_rotor: Rotor {
+                radius: 0.135,
+                omega: 1900.0 * 4.7 * 2.0 * std::f64::consts::PI / 60.0,
+                blades: 2.0,
+                chord: 0.032,
+                twist: 0.0,
+                lift_slope: 5.0,
+                flap_inertia: 1.0,
+                hub_stiffness: 0.0,
+                profile_drag: [0.012, 0.0],
+                hub: [-0.95, 0.0, -0.12],
+            },
+            fuselage_drag_area: [0.03, 0.10, 0.12],
+            fin: Surface {
+                area: 0.012,
+                incidence: 0.0,
+                lift_slope: 3.0,
+                position: [-0.90, 0.0, -0.05],
+                stall_angle: 0.35,
+            },
+            tailplane: Surface {
+                area: 0.010,
+                incidence: 0.0,
+                lift_slope: 3.0,
+                position: [-0.70, 0.0, 0.0],
+                stall_angle: 0.35,
+            },
+            gearing: [
+                Gearing {
+                    centre: 0.0,
+                    gain: -8.0 * deg,
+                },
+                Gearing {
+                    centre: 0.0,
+                    gain: 8.0 * deg,
+                },
+                Gearing {
+                    centre: 5.0 * deg,
+                    gain: -25.0 * deg,
+                },
+                Gearing {
+                    centre: 2.0 * deg,
+                    gain: 12.0 * deg,
+                },
+            ],
+        }
+    }
+
+    /// Main-rotor flap time constant τ_f [s] in hover, from blade data.
+    pub fn flap_time_constant(&self) -> f64 {
+        self.main_rotor.flap_time_constant(self.air_density)
+    }
+
+    /// Blade pitches for stick fractions `[lat, lon, ped, col]`.
+    pub fn blade_pitch(&self, controls: [f64; 4]) -> BladePitch {
+        BladePitch {
+            theta1c: self.gearing[0].pitch(controls[0]),
+            theta1s: self.gearing[1].pitch(controls[1]),
+            theta0_tr: self.gearing[2].pitch(controls[2]),
+            theta0: self.gearing[3].pitch(controls[3]),
+        }
+    }
+
+    /// Stick fractions `[lat, lon, ped, col]` for blade pitches.
+    pub fn controls_for(&self, pitch: &BladePitch) -> [f64; 4] {
+        [
+            self.gearing[0].stick(pitch.theta1c),
+            self.gearing[1].stick(pitch.theta1s),
+            self.gearing[2].stick(pitch.theta0_tr),
+            self.gearing[3].stick(pitch.theta0),
+        ]
+    }
+}
+
+/// Blade pitch angles [rad] (Padfield's conventions: θ = θ0 + θ1s sin ψ + θ1c cos ψ,
+/// ψ from the tail, anticlockwise; positive θ1s tilts the disc aft → nose up; positive θ1c
+/// tilts it left → roll left).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct BladePitch {
+    /// Main-rotor collective θ0 (at the blade root).
+    pub theta0: f64,
+    /// Longitudinal cyclic θ1s.
+    pub theta1s: f64,
+    /// Lateral cyclic θ1c.
+    pub theta1c: f64,
+    /// Tail-rotor collective θ0_TR.
+    pub theta0_tr: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bo105_derived_blade_data_match_design() {
+        let heli = Helicopter::bo105();
+        let gamma = heli.main_rotor.lock_number(heli.air_density);
+        assert!((gamma - 5.1).abs() < 0.1, "Lock number {gamma}");
+        let sigma = heli.main_rotor.solidity();
+        assert!((sigma - 0.070).abs() < 0.002, "solidity {sigma}");
+        let tau = heli.flap_time_constant();
+        assert!((0.06..0.08).contains(&tau), "tau_f {tau}");
+        // The small-g approximation 16/(γΩ) is within a few percent.
+        let approx = 16.0 / (gamma * heli.main_rotor.omega);
+        assert!((tau / approx - 1.0).abs() < 0.05, "{tau} vs {approx}");
+    }
+
+    #[test]
+    fn gearing_round_trips_and_vehicle_names_parse() {
+        let heli = Helicopter::bo105();
+        let sticks = [0.1, -0.3, 0.25, 0.4];
+        let back = heli.controls_for(&heli.blade_pitch(sticks));
+        for (a, b) in sticks.iter().zip(back) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert_eq!("bo105".parse::<Vehicle>(), Ok(Vehicle::Bo105));
+        assert_eq!("TREX700L".parse::<Vehicle>(), Ok(Vehicle::Trex700l));
+        assert!("ec135".parse::<Vehicle>().is_err());
+    }
+}
