@@ -48,12 +48,31 @@ pub struct Config {
     pub test: TestConfig,
     /// Length of the trim capture \[s\] (paper-free choice: 1 s).
     pub trim_capture_s: f32,
+    /// What the hold thresholds are measured from (the paper: the attitude itself).
+    pub hold_reference: HoldReference,
     /// Attitude-hold gains.
     pub gains: Gains,
     /// Abort limits.
     pub safety: SafetyLimits,
     /// Swashplate mixer.
     pub mixer: MixerConfig,
+}
+
+/// What the conditional-hold thresholds (engage 6°, release 4°) apply to on the roll and
+/// pitch axes. The heading axis always uses the heading error ψ − ψ_trim. Either way the
+/// controller, once engaged, regulates the attitude back to the captured trim.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum HoldReference {
+    /// The paper's rule: the feedback angles φ and θ themselves. A hover trim a few
+    /// degrees off level (the Bo-105 rolls about −2.4° against its tail rotor) then
+    /// engages earlier on that side, which bounds the absolute attitude at about the
+    /// engage angle plus the overshoot. A trim attitude beyond the release angle keeps
+    /// the controller engaged (standard feedback), which is safe but excites nothing.
+    Level,
+    /// Deviations from the captured trim attitude, for trims far from level (e.g.
+    /// forward flight nose-down).
+    Trim,
 }
 
 /// Why a configuration was refused.
@@ -149,7 +168,7 @@ pub const fn paper_test(primary: Axis) -> TestConfig {
             amplitude: 0.05,
             width_s: 1.0,
         },
-        noise_rms: 0.02,
+        noise_rms: 0.03,
         noise_cutoff_rad_s: 31.4,
         seed: 1,
         hold_engage_rad: 6.0 * DEG,
@@ -169,6 +188,7 @@ impl Config {
             rate_hz: 200,
             test: paper_test(primary),
             trim_capture_s: 1.0,
+            hold_reference: HoldReference::Level,
             gains: Gains::bo105(),
             safety: SafetyLimits::bo105(),
             mixer: MixerConfig::trex700l(),
@@ -185,6 +205,9 @@ impl Config {
             rate_hz: 200,
             test,
             trim_capture_s: 1.0,
+            // Its hover trim rolls about −5° (tail-rotor thrust), beyond the
+            // 4° release angle: thresholds from trim.
+            hold_reference: HoldReference::Trim,
             gains: Gains::trex700l(),
             safety: SafetyLimits::trex700l(),
             mixer: MixerConfig::trex700l(),

@@ -53,7 +53,7 @@ use sweephold_protocol::{
 };
 
 use crate::attitude_hold::{AttitudeController, AxisGains};
-use crate::config::{Config, ConfigError};
+use crate::config::{Config, ConfigError, HoldReference};
 use crate::excitation::{Excitation, ExcitationSample};
 use crate::hold::{next_hold_state, HoldThresholds};
 use crate::mixer::mix;
@@ -134,7 +134,9 @@ impl HeldAxis {
 struct AxisInput {
     axis: Axis,
     gains: AxisGains,
-    /// Attitude deviation from trim \[rad\].
+    /// The angle the hold thresholds apply to \[rad\] (see [`HoldReference`]).
+    hold_angle: f32,
+    /// Attitude deviation from trim, the controller's error \[rad\].
     deviation: f32,
     /// Matching body rate [rad/s].
     rate: f32,
@@ -429,10 +431,17 @@ impl FlightController {
         let gains = &self.config.gains;
         // lat ↔ φ (damped by p), lon ↔ θ (q), ped ↔ heading error ψ − ψ_trim wrapped to
         // ±π (r); all as deviations from the captured trim.
+        // The hold thresholds apply to φ and θ themselves (paper) or to their deviations
+        // from trim; the controller always regulates to the trim attitude.
+        let (phi_ref, theta_ref) = match self.config.hold_reference {
+            HoldReference::Level => (0.0, 0.0),
+            HoldReference::Trim => (trim.phi, trim.theta),
+        };
         let inputs = [
             AxisInput {
                 axis: Axis::Lat,
                 gains: gains.lat,
+                hold_angle: meas.phi - phi_ref,
                 deviation: meas.phi - trim.phi,
                 rate: meas.p,
                 noise: noise_lat,
@@ -440,6 +449,7 @@ impl FlightController {
             AxisInput {
                 axis: Axis::Lon,
                 gains: gains.lon,
+                hold_angle: meas.theta - theta_ref,
                 deviation: meas.theta - trim.theta,
                 rate: meas.q,
                 noise: noise_lon,
@@ -447,6 +457,7 @@ impl FlightController {
             AxisInput {
                 axis: Axis::Ped,
                 gains: gains.ped,
+                hold_angle: wrap_pi(meas.psi - trim.psi),
                 deviation: wrap_pi(meas.psi - trim.psi),
                 rate: meas.r,
                 noise: noise_ped,
@@ -549,7 +560,7 @@ fn step_axis(
     let gains = &input.gains;
     let (state, perturbation, sweep, noise) = match mode {
         ExcitationMode::ConditionalAttitudeHold => {
-            match next_hold_state(previous, input.deviation, thresholds) {
+            match next_hold_state(previous, input.hold_angle, thresholds) {
                 HoldState::Released => {
                     if previous != HoldState::Released {
                         held.controller.reset();

@@ -284,7 +284,13 @@ fn a_release_without_fade_hands_the_axis_straight_back_to_the_sweep() {
 
 #[test]
 fn conditional_hold_follows_the_three_rules_at_the_controller() {
-    let mut rig = Rig::into_sweep(short_config());
+    // Angles below are written as trim + deviation: measure from trim so they read as
+    // the paper's thresholds whatever the rig's trim attitude; a short release fade so
+    // the checks fit inside the short record.
+    let mut config = short_config();
+    config.hold_reference = HoldReference::Trim;
+    config.gains.lat.release_time_s = 0.2;
+    let mut rig = Rig::into_sweep(config);
     let trim_phi = rig.fc.trim().phi;
     let previous_command = rig.sample().command.lat;
     // Rule 1: above 6° the controller takes the axis, bumplessly.
@@ -360,9 +366,30 @@ fn conditional_hold_follows_the_three_rules_at_the_controller() {
 }
 
 #[test]
+fn level_reference_applies_the_thresholds_to_the_attitude_itself() {
+    // The rig trims at θ = 0.04 rad (2.3°). With the paper's Level reference, θ = 6.5°
+    // (4.2° from trim) is past the 6° engage angle; measured from trim it is in the band.
+    for (reference, engaged) in [(HoldReference::Level, true), (HoldReference::Trim, false)] {
+        let mut config = short_config();
+        config.hold_reference = reference;
+        let mut rig = Rig::into_sweep(config);
+        assert!((rig.fc.trim().theta - 0.04).abs() < 1e-3);
+        rig.input.meas.theta = 6.5 * DEG;
+        rig.step();
+        let state = rig.sample().hold[1];
+        assert_eq!(
+            state == HoldState::Engaged,
+            engaged,
+            "{reference:?}: {state:?}"
+        );
+    }
+}
+
+#[test]
 fn freeze_in_band_holds_the_last_command() {
     let mut config = short_config();
     config.test.freeze_in_band = true;
+    config.hold_reference = HoldReference::Trim;
     let mut rig = Rig::into_sweep(config);
     let trim_theta = rig.fc.trim().theta;
     rig.input.meas.theta = trim_theta + 5.0 * DEG;

@@ -62,7 +62,7 @@ pub mod sweep;
 pub mod trim;
 
 pub use attitude_hold::{AxisGains, Gains};
-pub use config::{paper_test, Config, ConfigError};
+pub use config::{paper_test, Config, ConfigError, HoldReference};
 pub use controller::{FlightController, Output, FIRMWARE_VERSION};
 pub use mixer::{mix, MixerConfig, ServoConfig};
 pub use safety::SafetyLimits;
