@@ -4,6 +4,10 @@
 use clap::{Parser, Subcommand};
 
 pub mod decode;
+pub mod fit;
+pub mod fly;
+pub mod frf;
+pub mod sim;
 pub mod table;
 
 /// Identify helicopter dynamics from automated frequency sweeps flown under conditional
@@ -21,11 +25,23 @@ pub struct Cli {
 pub enum Command {
     /// Decode telemetry dumps into CSV or JSON lines (one row per Sample).
     Decode(decode::DecodeArgs),
+    /// Fit a state-space model structure to frequency responses (CIFER DERIVID-like).
+    Fit(fit::FitArgs),
+    /// Fly sweep records with the flight controller in the loop and the simulator as the aircraft.
+    Fly(fly::FlyArgs),
+    /// Frequency responses (Chirp-Z, multi-window, MISO, composite) from dumps or CSV.
+    Frf(frf::FrfArgs),
+    /// Trim and linearize the simulated helicopters (bo105, trex700l).
+    Sim(sim::SimArgs),
 }
 
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Decode(args) => decode::run(&args),
+        Command::Fit(args) => fit::run(&args),
+        Command::Fly(args) => fly::run(&args),
+        Command::Frf(args) => frf::run(&args),
+        Command::Sim(args) => sim::run(&args),
     }
 }

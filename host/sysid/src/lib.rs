@@ -3,3 +3,5 @@
 //! VERIFY).
 
 pub mod document;
+pub mod fit;
+pub mod frf;

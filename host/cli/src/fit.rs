@@ -1,0 +1,236 @@
+//! `sweephold fit`: fit a state-space model structure to frequency responses (CIFER
+//! DERIVID-like), print the parameter table (value, Cramér–Rao bound, insensitivity,
+//! flags) and the cost per pair, and optionally write `model.json`.
+
+use std::fmt::Write as _;
+use std::fs;
+use std::io::{self, Write};
+use std::path::PathBuf;
+
+use anyhow::{bail, Context};
+use clap::Args;
+use sysid::document::FrfDocument;
+use sysid::fit::report::{cost_table, parameter_table, reduction_table};
+use sysid::fit::{fit, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure};
+
+/// Arguments of `sweephold fit`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Structure files and the model.json layout are described in \
+host/sysid/models/README.md. Shipped structures: host/sysid/models/bo105-6dof.toml and \
+bo105-9dof-hybrid.toml.\n\nGuidelines (paper, Tischler & Remple): J_ave <= 100 acceptable, \
+<= 50 excellent; Cramér–Rao bound <= 20 %, insensitivity <= 10 %, |correlation| <= 0.9."
+)]
+pub struct FitArgs {
+    /// Frequency responses to fit (`frf.json` as `sweephold frf` writes it).
+    #[arg(long, value_name = "FILE")]
+    pub frf: PathBuf,
+    /// Model structure file (TOML).
+    #[arg(long, value_name = "STRUCTURE.toml")]
+    pub model: PathBuf,
+    /// Write the fitted model here (`model.json`).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Drop poorly identified parameters one at a time while the cost allows it.
+    #[arg(long)]
+    pub reduce: bool,
+    /// Seed of the perturbed restarts (same seed, same result).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Take start values from a quasi-steady 6-DOF `model.json` (paper Eq. 26–27).
+    #[arg(long, value_name = "model6.json")]
+    pub start_from: Option<PathBuf>,
+    /// Most optimizer starts (stops earlier once a minimum is found twice).
+    #[arg(long, default_value_t = 8)]
+    pub max_starts: usize,
+    /// Fit frequencies per pair (n_ω).
+    #[arg(long, default_value_t = 20)]
+    pub points: usize,
+}
+
+/// Run `sweephold fit`.
+pub fn run(args: &FitArgs) -> anyhow::Result<()> {
+    let frf_text = fs::read_to_string(&args.frf)
+        .with_context(|| format!("cannot read {}", args.frf.display()))?;
+    let data: FrfDocument = serde_json::from_str(&frf_text).with_context(|| {
+        format!(
+            "{} is not a frequency-response document",
+            args.frf.display()
+        )
+    })?;
+    let mut structure = ModelStructure::from_path(&args.model)?;
+    if args.points < 2 {
+        bail!("--points must be at least 2");
+    }
+
+    // Everything goes to one report printed at the end (see `emit`).
+    let mut report = String::new();
+    if let Some(path) = &args.start_from {
+        let text =
+            fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+        let previous: ModelDocument = serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a model.json", path.display()))?;
+        let (started, notes) = start_from_quasi_steady(&structure, &previous)?;
+        let _ = writeln!(
+            report,
+            "start values from {} ({}):",
+            path.display(),
+            previous.structure
+        );
+        for note in &notes {
+            let _ = writeln!(
+                report,
+                "  {:<10} {:>14.6}  {}",
+                note.parameter, note.value, note.source
+            );
+        }
+        let _ = writeln!(report);
+        structure = started;
+    }
+
+    let options = FitOptions {
+        points_per_pair: args.points,
+        max_starts: args.max_starts.max(1),
+        seed: args.seed,
+        reduce: args.reduce,
+        ..FitOptions::default()
+    };
+    let result = fit(&structure, &data, &options)?;
+
+    write_report(&mut report, &result).expect("writing to a String cannot fail");
+    if let Some(path) = &args.out {
+        let json = serde_json::to_string_pretty(&result.to_document())?;
+        fs::write(path, json + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+        let _ = writeln!(report, "\nwrote {}", path.display());
+    }
+    emit(&report)
+}
+
+/// Print the report; a closed pipe (`| head`) is not an error of the fit.
+fn emit(report: &str) -> anyhow::Result<()> {
+    let mut stdout = io::stdout().lock();
+    match stdout
+        .write_all(report.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(error) if error.kind() != io::ErrorKind::BrokenPipe => Err(error.into()),
+        _ => Ok(()),
+    }
+}
+
+/// The text report: starts, reduction steps, parameter table, cost table.
+fn write_report(out: &mut String, result: &sysid::fit::FitResult) -> std::fmt::Result {
+    writeln!(
+        out,
+        "structure {} ({} states, {} controls, {} outputs), {} pairs, {} free parameters",
+        result.structure.name,
+        result.structure.states.len(),
+        result.structure.controls.len(),
+        result.structure.outputs.len(),
+        result.pairs.len(),
+        result.correlation_names.len()
+    )?;
+    for (number, start) in result.starts.iter().enumerate() {
+        match start.average_cost {
+            Some(cost) => writeln!(
+                out,
+                "  start {}: J_ave {:.4} after {} iterations ({})",
+                number + 1,
+                cost,
+                start.iterations,
+                start.stop
+            )?,
+            None => writeln!(out, "  start {}: {}", number + 1, start.stop)?,
+        }
+    }
+    writeln!(
+        out,
+        "  minimum {}",
+        if result.minimum_confirmed {
+            "found twice (taken as global)"
+        } else {
+            "NOT confirmed by a second start"
+        }
+    )?;
+    if !result.reduction.is_empty() {
+        writeln!(out, "\nreduction:")?;
+        write!(out, "{}", reduction_table(&result.reduction))?;
+    }
+    writeln!(out)?;
+    write!(out, "{}", parameter_table(result))?;
+    if result.hessian_singular {
+        writeln!(
+            out,
+            "warning: the Hessian is singular — some parameter combination does not affect \
+             the cost (Cramér–Rao bounds infinite)"
+        )?;
+    }
+    writeln!(out)?;
+    write!(out, "{}", cost_table(result))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sysid::fit::cost::PairBand;
+    use sysid::fit::synthetic::{exact_frf_document, SyntheticGrid};
+
+    const LAG: &str = r#"
+name = "lag"
+states = ["x"]
+controls = ["lat"]
+outputs = ["x"]
+pairs = [{ output = "x", input = "lat" }]
+[parameters]
+a = -2.0
+b = 3.0
+[F.x]
+x = "a"
+[G.x]
+lat = "b"
+"#;
+
+    #[test]
+    fn fits_and_writes_model_json() {
+        let directory = std::env::temp_dir().join(format!("sweephold-fit-{}", std::process::id()));
+        fs::create_dir_all(&directory).unwrap();
+        let structure_path = directory.join("lag.toml");
+        fs::write(&structure_path, LAG).unwrap();
+        let structure = ModelStructure::parse(LAG, "lag").unwrap();
+        let truth = structure.model(&[-1.5, 2.0]).unwrap();
+        let band = PairBand {
+            input: "lat".into(),
+            output: "x".into(),
+            range: [0.2, 20.0],
+        };
+        let frf = exact_frf_document(&truth, &[band], SyntheticGrid::FitPoints(20));
+        let frf_path = directory.join("frf.json");
+        fs::write(&frf_path, serde_json::to_string(&frf).unwrap()).unwrap();
+        let out = directory.join("model.json");
+        let args = FitArgs {
+            frf: frf_path,
+            model: structure_path.clone(),
+            out: Some(out.clone()),
+            reduce: false,
+            seed: 3,
+            start_from: None,
+            max_starts: 4,
+            points: 20,
+        };
+        run(&args).unwrap();
+        let document: ModelDocument =
+            serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();
+        assert!((document.parameter("a").unwrap() + 1.5).abs() < 1e-6);
+        assert!((document.parameter("b").unwrap() - 2.0).abs() < 1e-6);
+
+        // A malformed structure file is reported with its line.
+        fs::write(&structure_path, LAG.replace("lat = \"b\"", "lat = \"Zq\"")).unwrap();
+        let error = run(&args).unwrap_err().to_string();
+        assert!(
+            error.contains("line 13") && error.contains("undefined parameter `Zq`"),
+            "{error}"
+        );
+        fs::remove_dir_all(&directory).ok();
+    }
+}

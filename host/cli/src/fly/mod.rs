@@ -1,0 +1,432 @@
+//! `sweephold fly`: the paper's test campaign, flown on the host with the flight
+//! controller in the loop and the nonlinear simulator as the aircraft.
+
+pub mod link;
+pub mod plan;
+pub mod record;
+pub mod summary;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use anyhow::{bail, Context};
+use clap::{Args, ValueEnum};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sweephold_firmware::Config;
+use sweephold_protocol::{Axis, ExcitationMode, InputKind};
+
+use link::{FlightControllerLink, InProcessLink};
+use plan::{plan_records, RecordPlan};
+use record::{fly_record, Disturbances};
+use summary::{FlySummary, RunSummary};
+
+/// Excitation mode on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Conditional attitude hold plus off-axis noise (the paper's method).
+    Cah,
+    /// Attitude-hold controller always on, sweep added (the paper's Fig. 3 case).
+    Standard,
+    /// Controller always on plus off-axis noise (Tischler's method).
+    Noise,
+}
+
+impl ModeArg {
+    /// The firmware's mode.
+    pub fn mode(self) -> ExcitationMode {
+        match self {
+            ModeArg::Cah => ExcitationMode::ConditionalAttitudeHold,
+            ModeArg::Standard => ExcitationMode::Standard,
+            ModeArg::Noise => ExcitationMode::OffAxisNoise,
+        }
+    }
+
+    /// Name in files and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModeArg::Cah => "cah",
+            ModeArg::Standard => "standard",
+            ModeArg::Noise => "noise",
+        }
+    }
+}
+
+/// Primary input on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum InputArg {
+    /// Tischler's exponential sweep (two records per axis, the paper's bands).
+    Sweep,
+    /// A doublet (one record per axis).
+    Doublet,
+    /// A 3-2-1-1 multistep (one record per axis).
+    #[value(name = "3211")]
+    ThreeTwoOneOne,
+}
+
+impl InputArg {
+    fn kind(self) -> InputKind {
+        match self {
+            InputArg::Sweep => InputKind::Sweep,
+            InputArg::Doublet => InputKind::Doublet,
+            InputArg::ThreeTwoOneOne => InputKind::ThreeTwoOneOne,
+        }
+    }
+}
+
+/// Vehicle on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VehicleArg {
+    /// MBB Bo-105 (full scale).
+    Bo105,
+    /// TREX 700L-class model helicopter (approximate).
+    Trex700l,
+}
+
+impl VehicleArg {
+    /// The simulator's vehicle.
+    pub fn sim(self) -> bo105::Vehicle {
+        match self {
+            VehicleArg::Bo105 => bo105::Vehicle::Bo105,
+            VehicleArg::Trex700l => bo105::Vehicle::Trex700l,
+        }
+    }
+
+    /// Name in files and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            VehicleArg::Bo105 => "bo105",
+            VehicleArg::Trex700l => "trex700l",
+        }
+    }
+
+    /// The firmware's preset for this vehicle, exciting `axis`.
+    pub fn firmware_config(self, axis: Axis) -> Config {
+        match self {
+            VehicleArg::Bo105 => Config::bo105_default(axis),
+            VehicleArg::Trex700l => Config::trex700l_default(axis),
+        }
+    }
+}
+
+/// Arguments of `sweephold fly`.
+#[derive(Args, Debug, Clone)]
+#[command(
+    after_help = "Each record is written as DIR/<axis>-<n>.bin (the telemetry exactly as the \
+flight controller streamed it: read it with `sweephold decode` or `sweephold frf`), plus \
+DIR/summary.json (layout in the README). The same seed gives byte-identical dumps."
+)]
+pub struct FlyArgs {
+    /// Aircraft simulated.
+    #[arg(long, value_enum, default_value_t = VehicleArg::Bo105)]
+    pub vehicle: VehicleArg,
+    /// How the off-axis inputs are treated.
+    #[arg(long, value_enum, default_value_t = ModeArg::Cah)]
+    pub mode: ModeArg,
+    /// Axes to excite, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "lat,lon,ped,col", value_parser = parse_axis)]
+    pub axes: Vec<Axis>,
+    /// Primary input signal.
+    #[arg(long, value_enum, default_value_t = InputArg::Sweep)]
+    pub input: InputArg,
+    /// Campaign seed (firmware noise, sensor noise, gusts).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Sweep record length T_rec [s] (the paper: 90).
+    #[arg(long = "t-rec", value_name = "SECONDS", default_value_t = plan::PAPER_T_REC_S)]
+    pub t_rec_s: f64,
+    /// Control loop rate [Hz] (50–1000).
+    #[arg(long = "rate", value_name = "HZ", default_value_t = 200)]
+    pub rate_hz: u16,
+    /// Output folder.
+    #[arg(long, value_name = "DIR", default_value = "out/fly")]
+    pub out: PathBuf,
+    /// Turbulence level [m/s RMS of the body-axis gust].
+    #[arg(long, value_name = "LEVEL", default_value_t = 0.0)]
+    pub gust: f64,
+    /// Per-tick probability that the sensor sample is not refreshed.
+    #[arg(long = "sensor-dropout", value_name = "P", default_value_t = 0.0)]
+    pub sensor_dropout: f64,
+    /// Per-tick probability of a sensor spike.
+    #[arg(long = "sensor-spike", value_name = "P", default_value_t = 0.0)]
+    pub sensor_spike: f64,
+    /// Seconds after arming at which the pilot moves the lateral stick 20 % off trim.
+    #[arg(long = "pilot-override", value_name = "AT_S")]
+    pub pilot_override_at_s: Option<f64>,
+    /// RMS of the pilot's stick motion around trim, fraction of travel.
+    #[arg(long = "pilot-noise", value_name = "RMS", default_value_t = 0.0)]
+    pub pilot_noise: f64,
+    /// Perfect sensors (no noise, bias or latency).
+    #[arg(long = "perfect-sensors")]
+    pub perfect_sensors: bool,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_axis(text: &str) -> Result<Axis, String> {
+    Axis::ALL
+        .into_iter()
+        .find(|a| a.name() == text)
+        .ok_or_else(|| format!("unknown axis `{text}` (expected lat, lon, ped or col)"))
+}
+
+impl FlyArgs {
+    fn check(&self) -> anyhow::Result<()> {
+        if self.axes.is_empty() {
+            bail!("--axes names no axis");
+        }
+        for (name, p) in [
+            ("--sensor-dropout", self.sensor_dropout),
+            ("--sensor-spike", self.sensor_spike),
+        ] {
+            if !(0.0..=1.0).contains(&p) {
+                bail!("{name} {p}: a probability must be in [0, 1]");
+            }
+        }
+        if !(self.gust >= 0.0 && self.gust.is_finite()) {
+            bail!("--gust {}: must be a finite level >= 0", self.gust);
+        }
+        if !(self.pilot_noise >= 0.0 && self.pilot_noise < 0.5) {
+            bail!("--pilot-noise {}: must be in [0, 0.5)", self.pilot_noise);
+        }
+        if !(self.t_rec_s > 0.0 && self.t_rec_s.is_finite()) {
+            bail!(
+                "--t-rec {}: must be a positive number of seconds",
+                self.t_rec_s
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The firmware configuration of one record.
+pub fn record_config(vehicle: VehicleArg, plan: &RecordPlan, rate_hz: u16) -> Config {
+    let mut config = vehicle.firmware_config(plan.axis);
+    config.rate_hz = rate_hz;
+    config.test.mode = plan.mode;
+    config.test.input = plan.input;
+    config.test.primary = plan.axis;
+    config.test.seed = plan.seed;
+    config.test.sweep.omega_min = plan.omega_min as f32;
+    config.test.sweep.omega_max = plan.omega_max as f32;
+    config.test.sweep.t_rec_s = plan.t_rec_s as f32;
+    config.test.sweep.amplitude = plan.amplitude as f32;
+    config.test.pulse.amplitude = plan.amplitude as f32;
+    config
+}
+
+/// Result of a whole `fly` run.
+pub struct FlyOutcome {
+    /// The summary written to `summary.json`.
+    pub summary: FlySummary,
+    /// Dump paths, in flying order.
+    pub dumps: Vec<PathBuf>,
+}
+
+/// Run `sweephold fly`.
+pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
+    let outcome = fly(args, &|| Box::new(InProcessLink::new()))?;
+    if !args.quiet {
+        for run in &outcome.summary.runs {
+            let coherence: Vec<String> = run
+                .cross_coherence
+                .iter()
+                .map(|(k, v)| format!("{k} {v:.2}"))
+                .collect();
+            eprintln!(
+                "{:>9}  {:6.1} s  {}  max |phi| {:4.1} deg, |theta| {:4.1} deg  cross-coherence: {}",
+                run.file,
+                run.duration_s,
+                run.abort_reason.as_deref().map_or("ok     ".to_string(), |r| format!("ABORT {r}")),
+                run.max_abs_deg.phi,
+                run.max_abs_deg.theta,
+                if coherence.is_empty() { "-".to_string() } else { coherence.join(", ") }
+            );
+        }
+        eprintln!(
+            "wrote {} records and summary.json to {}",
+            outcome.dumps.len(),
+            args.out.display()
+        );
+    }
+    Ok(())
+}
+
+/// Fly every record of `args` with links made by `make_link` (one per worker thread),
+/// write the dumps and `summary.json`, and return the summary.
+pub fn fly(
+    args: &FlyArgs,
+    make_link: &(dyn Fn() -> Box<dyn FlightControllerLink> + Sync),
+) -> anyhow::Result<FlyOutcome> {
+    args.check()?;
+    let heli = args.vehicle.sim().helicopter();
+    let trim = bo105::trim(&heli, 0.0)
+        .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
+    let plans = plan_records(
+        &args.axes,
+        args.mode.mode(),
+        args.input.kind(),
+        args.t_rec_s,
+        args.seed,
+    );
+    // Refuse a bad configuration before anything is flown or written.
+    for plan in &plans {
+        let config = record_config(args.vehicle, plan, args.rate_hz);
+        sweephold_firmware::FlightController::new(config).map_err(|e| {
+            anyhow::anyhow!(
+                "record {}: the firmware refuses this configuration: {}",
+                plan.file_name(),
+                e.message()
+            )
+        })?;
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
+
+    let sim_options = if args.perfect_sensors {
+        bo105::SimOptions::perfect()
+    } else {
+        bo105::SimOptions::default()
+    };
+    let disturbances = Disturbances {
+        gust_level: args.gust,
+        sensor_dropout: args.sensor_dropout,
+        sensor_spike: args.sensor_spike,
+        pilot_override_at_s: args.pilot_override_at_s,
+        pilot_stick_noise: args.pilot_noise,
+    };
+
+    let bars = MultiProgress::with_draw_target(if args.quiet {
+        ProgressDrawTarget::hidden()
+    } else {
+        ProgressDrawTarget::stderr()
+    });
+    let style = ProgressStyle::with_template("{prefix:>9} [{bar:30}] {pos:>4}/{len} s {msg}")
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ");
+
+    let next = Mutex::new(0usize);
+    let results: Mutex<Vec<Option<anyhow::Result<RunSummary>>>> =
+        Mutex::new(plans.iter().map(|_| None).collect());
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(plans.len())
+        .max(1);
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| {
+                let mut link = make_link();
+                loop {
+                    let i = {
+                        let mut next = next.lock().unwrap_or_else(|e| e.into_inner());
+                        let i = *next;
+                        *next += 1;
+                        i
+                    };
+                    let Some(plan) = plans.get(i) else { break };
+                    let config = record_config(args.vehicle, plan, args.rate_hz);
+                    let max_s = expected_duration_s(&config) + 10.0;
+                    let bar = bars.add(ProgressBar::new(max_s as u64));
+                    bar.set_style(style.clone());
+                    bar.set_prefix(plan.file_name());
+                    let mut options = sim_options;
+                    options.seed = args.seed ^ u64::from(plan.seed).rotate_left(17);
+                    let aircraft = record::Aircraft {
+                        heli: &heli,
+                        trim: &trim,
+                        options,
+                    };
+                    let result = fly_record(
+                        link.as_mut(),
+                        &config,
+                        aircraft,
+                        &disturbances,
+                        max_s,
+                        |t| bar.set_position(t as u64),
+                    )
+                    .and_then(|flown| finish_record(args, plan, &config, flown));
+                    bar.finish_and_clear();
+                    results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(result);
+                }
+            });
+        }
+    });
+
+    let mut runs = Vec::new();
+    for (plan, result) in plans
+        .iter()
+        .zip(results.into_inner().unwrap_or_else(|e| e.into_inner()))
+    {
+        let run = result.unwrap_or_else(|| Err(anyhow::anyhow!("not flown")));
+        runs.push(run.with_context(|| format!("record {}", plan.file_name()))?);
+    }
+    let link = make_link().describe();
+    let summary = FlySummary {
+        vehicle: args.vehicle.name().to_string(),
+        mode: args.mode.name().to_string(),
+        rate_hz: u32::from(args.rate_hz),
+        seed: args.seed,
+        link,
+        runs,
+    };
+    let path = args.out.join("summary.json");
+    write_json(&path, &summary)?;
+    let dumps = plans.iter().map(|p| args.out.join(p.file_name())).collect();
+    Ok(FlyOutcome { summary, dumps })
+}
+
+/// Seconds from arming to the end of the excitation for `config` (trim capture, fades,
+/// the ω_min hold and the record).
+pub fn expected_duration_s(config: &Config) -> f64 {
+    let excitation = sweephold_firmware::excitation::Excitation::from_test(&config.test);
+    f64::from(config.trim_capture_s) + excitation.duration_s()
+}
+
+fn finish_record(
+    args: &FlyArgs,
+    plan: &RecordPlan,
+    config: &Config,
+    flown: record::FlownRecord,
+) -> anyhow::Result<RunSummary> {
+    let path = args.out.join(plan.file_name());
+    std::fs::write(&path, &flown.dump)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    let cross_coherence = if plan.input == InputKind::Sweep && flown.abort.is_none() {
+        record_cross_coherence(&flown.dump, &plan.file_name())?
+    } else {
+        BTreeMap::new()
+    };
+    Ok(RunSummary {
+        axis: plan.axis.name().to_string(),
+        index: plan.index,
+        file: plan.file_name(),
+        omega_min: plan.omega_min,
+        omega_max: plan.omega_max,
+        duration_s: flown.ticks as f64 / f64::from(config.rate_hz),
+        frames: flown.frames,
+        aborted: flown.abort.is_some(),
+        abort_reason: flown.abort.map(|r| r.name().to_string()),
+        max_abs_deg: flown.max_abs_deg,
+        hold_fraction: flown.hold_fraction,
+        cross_coherence,
+    })
+}
+
+/// Mean coherence between the primary control and each other excited control over the
+/// sweep band of one record (sysid's cross-control coherence).
+pub fn record_cross_coherence(dump: &[u8], name: &str) -> anyhow::Result<BTreeMap<String, f64>> {
+    let record = sysid::frf::load_dump_bytes(dump, name)?;
+    let primary = record.primary.clone();
+    let pairs = sysid::frf::cross_control_coherence(&record, &sysid::frf::FrfOptions::default())?;
+    Ok(pairs
+        .into_iter()
+        .map(|c| (if c.a == primary { c.b } else { c.a }, c.mean))
+        .collect())
+}
+
+/// Write `value` as pretty JSON to `path`.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,240 @@
+//! Flying one record: the simulator and a flight-controller link in lockstep.
+
+use bo105::{Helicopter, Sim, SimOptions, Trim};
+use sweephold_firmware::Config;
+use sweephold_protocol::{
+    Controls, Decoder, Event, Frame, HoldState, Measurements, Phase, PilotInput, Sample, SensorIn,
+};
+
+use super::link::FlightControllerLink;
+use super::summary::{HoldFraction, MaxAbsDeg};
+
+/// Disturbances and faults injected into one record.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Disturbances {
+    /// Turbulence level handed to the simulator's gust model [m/s RMS].
+    pub gust_level: f64,
+    /// Per-tick probability that the sensor sample is not refreshed.
+    pub sensor_dropout: f64,
+    /// Per-tick probability of a sensor spike.
+    pub sensor_spike: f64,
+    /// Time [s] after arming at which the pilot moves the lateral stick 20 % off trim.
+    pub pilot_override_at_s: Option<f64>,
+    /// RMS of random pilot stick motion around trim, fraction of travel (0: hands still).
+    pub pilot_stick_noise: f64,
+}
+
+/// What one record produced.
+#[derive(Clone, Debug)]
+pub struct FlownRecord {
+    /// The telemetry exactly as the flight controller streamed it.
+    pub dump: Vec<u8>,
+    /// Good frames in the dump.
+    pub frames: u64,
+    /// Ticks flown (arming to the end).
+    pub ticks: u64,
+    /// Abort reason, if the firmware aborted.
+    pub abort: Option<sweephold_protocol::AbortReason>,
+    /// Peak attitude excursions over the excitation.
+    pub max_abs_deg: MaxAbsDeg,
+    /// Share of excitation ticks with the hold engaged.
+    pub hold_fraction: HoldFraction,
+    /// The final sequencer phase.
+    pub final_phase: Phase,
+}
+
+/// Watches the telemetry as it streams, as a ground station would.
+#[derive(Default)]
+struct TelemetryMonitor {
+    decoder: Decoder,
+    phase: Option<Phase>,
+    abort: Option<sweephold_protocol::AbortReason>,
+    start_psi: Option<f32>,
+    max_abs: MaxAbsDeg,
+    excitation_ticks: u64,
+    engaged_ticks: [u64; 3],
+}
+
+impl TelemetryMonitor {
+    fn observe(&mut self, bytes: &[u8]) {
+        let decoder = &mut self.decoder;
+        for frame in decoder.feed(bytes).flatten() {
+            match frame {
+                Frame::Sample(sample) => Self::sample(
+                    &sample,
+                    &mut self.phase,
+                    &mut self.start_psi,
+                    &mut self.max_abs,
+                    &mut self.excitation_ticks,
+                    &mut self.engaged_ticks,
+                ),
+                Frame::Event(Event::Abort { reason, .. }) => self.abort = Some(reason),
+                _ => {}
+            }
+        }
+    }
+
+    fn sample(
+        sample: &Sample,
+        phase: &mut Option<Phase>,
+        start_psi: &mut Option<f32>,
+        max_abs: &mut MaxAbsDeg,
+        excitation_ticks: &mut u64,
+        engaged_ticks: &mut [u64; 3],
+    ) {
+        *phase = Some(sample.phase);
+        if !matches!(sample.phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut) {
+            return;
+        }
+        let m = &sample.meas;
+        let psi0 = *start_psi.get_or_insert(m.psi);
+        let dpsi = bo105::sim::wrap_angle(f64::from(m.psi) - f64::from(psi0));
+        max_abs.phi = max_abs.phi.max(f64::from(m.phi).abs().to_degrees());
+        max_abs.theta = max_abs.theta.max(f64::from(m.theta).abs().to_degrees());
+        max_abs.psi = max_abs.psi.max(dpsi.abs().to_degrees());
+        *excitation_ticks += 1;
+        for (count, hold) in engaged_ticks.iter_mut().zip(sample.hold) {
+            *count += u64::from(hold == HoldState::Engaged);
+        }
+    }
+
+    fn hold_fraction(&self) -> HoldFraction {
+        let share = |n: u64| {
+            if self.excitation_ticks == 0 {
+                0.0
+            } else {
+                n as f64 / self.excitation_ticks as f64
+            }
+        };
+        HoldFraction {
+            lat: share(self.engaged_ticks[0]),
+            lon: share(self.engaged_ticks[1]),
+            ped: share(self.engaged_ticks[2]),
+        }
+    }
+}
+
+/// Ticks flown in Idle before the pilot flips the test switch.
+const IDLE_TICKS: u64 = 10;
+
+/// The simulated aircraft a record is flown on.
+#[derive(Clone, Copy)]
+pub struct Aircraft<'a> {
+    /// Its parameters.
+    pub heli: &'a Helicopter,
+    /// The trim it starts from (hover).
+    pub trim: &'a Trim,
+    /// Sensors, actuators, integration step and seed.
+    pub options: SimOptions,
+}
+
+/// Fly one record: start the simulator at trim, arm the flight controller, and run the
+/// lockstep loop until the test is done or aborted (or `max_s` of flight time passed).
+pub fn fly_record(
+    link: &mut dyn FlightControllerLink,
+    config: &Config,
+    aircraft: Aircraft<'_>,
+    disturbances: &Disturbances,
+    max_s: f64,
+    mut progress: impl FnMut(f64),
+) -> anyhow::Result<FlownRecord> {
+    let rate = f64::from(config.rate_hz);
+    let dt = 1.0 / rate;
+    let trim = aircraft.trim;
+    let mut options = aircraft.options;
+    options.gust_level = disturbances.gust_level;
+    options.dropout_probability = disturbances.sensor_dropout;
+    options.spike_probability = disturbances.sensor_spike;
+    let mut sim = Sim::at_trim(aircraft.heli.clone(), trim, options);
+    let trim_sticks = trim.controls.map(|c| c as f32);
+    let mut pilot_rng = SplitMix(u64::from(config.test.seed) ^ 0x9170_7D15_7A2B);
+
+    link.begin_record(config)?;
+    let mut dump = Vec::with_capacity((max_s * rate) as usize * 140);
+    let mut monitor = TelemetryMonitor::default();
+    let mut reading = sim.step(dt, trim.controls);
+    let max_ticks = (max_s * rate).ceil() as u64;
+    let mut ticks = 0;
+    while ticks < max_ticks {
+        let armed_s = ticks.saturating_sub(IDLE_TICKS) as f64 * dt;
+        let mut sticks = trim_sticks;
+        if disturbances.pilot_stick_noise > 0.0 {
+            for s in &mut sticks {
+                *s += (disturbances.pilot_stick_noise * pilot_rng.gaussian()) as f32;
+            }
+        }
+        if let Some(at) = disturbances.pilot_override_at_s {
+            if ticks >= IDLE_TICKS && armed_s >= at {
+                sticks[0] += 0.2;
+            }
+        }
+        let input = SensorIn {
+            seq: reading.seq,
+            meas: measurements(&reading),
+            pilot: PilotInput {
+                sticks: Controls::from_array(sticks),
+                test_switch: ticks >= IDLE_TICKS,
+            },
+        };
+        let start = dump.len();
+        let out = link.exchange(&input, &mut dump)?;
+        monitor.observe(&dump[start..]);
+        let command = out.command.to_array().map(f64::from);
+        reading = sim.step(dt, command);
+        ticks += 1;
+        if ticks % 200 == 0 {
+            progress(ticks as f64 * dt);
+        }
+        if ticks > IDLE_TICKS && matches!(monitor.phase, Some(Phase::Done | Phase::Aborted)) {
+            break;
+        }
+    }
+    monitor.decoder.finish();
+    Ok(FlownRecord {
+        frames: monitor.decoder.stats().good_frames,
+        ticks,
+        abort: monitor.abort,
+        max_abs_deg: monitor.max_abs,
+        hold_fraction: monitor.hold_fraction(),
+        final_phase: monitor.phase.unwrap_or(Phase::Idle),
+        dump,
+    })
+}
+
+/// The simulator's sensor reading as the firmware receives it.
+pub fn measurements(r: &bo105::SensorReading) -> Measurements {
+    Measurements {
+        p: r.p as f32,
+        q: r.q as f32,
+        r: r.r as f32,
+        phi: r.phi as f32,
+        theta: r.theta as f32,
+        psi: r.psi as f32,
+        u: r.u as f32,
+        v: r.v as f32,
+        w: r.w as f32,
+        ax: r.ax as f32,
+        ay: r.ay as f32,
+        az: r.az as f32,
+    }
+}
+
+/// splitmix64 with a Box–Muller Gaussian, for the simulated pilot's hands.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn unit(&mut self) -> f64 {
+        ((self.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    fn gaussian(&mut self) -> f64 {
+        let (a, b) = (self.unit(), self.unit());
+        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    }
+}

@@ -1,0 +1,88 @@
+//! `summary.json` of `sweephold fly` (layout documented in the README; later checks read
+//! these names).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+/// Peak absolute attitude excursions over a record [deg].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MaxAbsDeg {
+    /// Peak |φ| [deg] (absolute attitude, trim included).
+    pub phi: f64,
+    /// Peak |θ| [deg] (absolute attitude, trim included).
+    pub theta: f64,
+    /// Peak |ψ − ψ_start| wrapped to ±180° [deg].
+    pub psi: f64,
+}
+
+/// Share of the excitation ticks with the hold controller engaged, per held axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HoldFraction {
+    /// Lateral.
+    pub lat: f64,
+    /// Longitudinal.
+    pub lon: f64,
+    /// Pedal.
+    pub ped: f64,
+}
+
+/// One flown record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Primary axis name.
+    pub axis: String,
+    /// 1-based record index for this axis.
+    pub index: u32,
+    /// Dump file name, relative to the summary.
+    pub file: String,
+    /// Sweep start frequency [rad/s].
+    pub omega_min: f64,
+    /// Sweep end frequency [rad/s].
+    pub omega_max: f64,
+    /// Flown duration, arming to the end of the record [s].
+    pub duration_s: f64,
+    /// Frames in the dump.
+    pub frames: u64,
+    /// Whether the firmware aborted the test.
+    pub aborted: bool,
+    /// Abort reason (`attitude_limit`, …) or null.
+    pub abort_reason: Option<String>,
+    /// Peak attitude excursions during the excitation.
+    pub max_abs_deg: MaxAbsDeg,
+    /// Share of excitation ticks with the hold engaged, per axis.
+    pub hold_fraction: HoldFraction,
+    /// Average coherence between the primary control and each other control over the
+    /// sweep band, keyed by control name.
+    pub cross_coherence: BTreeMap<String, f64>,
+}
+
+/// The whole `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FlySummary {
+    /// Vehicle name (`bo105`, `trex700l`).
+    pub vehicle: String,
+    /// Excitation mode (`cah`, `standard`, `noise`).
+    pub mode: String,
+    /// Tick rate [Hz].
+    pub rate_hz: u32,
+    /// Campaign seed.
+    pub seed: u64,
+    /// Flight-controller link (`in-process`, `qemu`, `serial:PATH`).
+    pub link: String,
+    /// The records, in flying order.
+    pub runs: Vec<RunSummary>,
+}
+
+impl FlySummary {
+    /// Mean over the records of `axis` of their cross-control coherence with `other`.
+    pub fn mean_cross_coherence(&self, axis: &str, other: &str) -> Option<f64> {
+        let values: Vec<f64> = self
+            .runs
+            .iter()
+            .filter(|r| r.axis == axis)
+            .filter_map(|r| r.cross_coherence.get(other).copied())
+            .collect();
+        (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+    }
+}

@@ -1,0 +1,389 @@
+//! `sweephold frf`: telemetry dumps or CSV logs → composite, MISO-conditioned frequency
+//! responses (`frf.json`) and, optionally, SVG Bode and cross-control coherence plots.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use clap::Args;
+use sysid::frf::{
+    analyse, group_by_primary, load_csv, load_dump, write_plots, CsvColumns, FrfAnalysis,
+    FrfOptions, Record,
+};
+
+/// Arguments of `sweephold frf`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Records of the same swept axis are joined (each detrended, tapered \
+to zero at the joins). The response of output y to control x comes from the records in \
+which x is swept, conditioned on the other controls excited there. Files ending in .csv \
+are read as CSV with a header row (columns chosen with --time, --inputs, --outputs); \
+anything else as a telemetry dump.\n\nExit status: 0 when frf.json was written; 1 on an \
+unreadable file, a dump without a sweep, a record too short for the band, a swept input \
+without excitation, or a bad option."
+)]
+pub struct FrfArgs {
+    /// Telemetry dumps or CSV files.
+    #[arg(required = true, value_name = "DUMP|CSV")]
+    pub files: Vec<PathBuf>,
+    /// Where to write the frequency-response document.
+    #[arg(long, value_name = "FILE", default_value = "frf.json")]
+    pub out: PathBuf,
+    /// Also write SVG plots (one Bode plot per pair, one cross-control coherence plot per
+    /// swept axis) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    /// Frequency band [rad/s] of the grid; default: the sweep band of the dump Header
+    /// (required for CSV).
+    #[arg(long, value_name = "WMIN,WMAX", value_parser = parse_band)]
+    pub band: Option<Band>,
+    /// Coherence γ² at or above which a frequency is valid.
+    #[arg(long, value_name = "G2", default_value_t = 0.6)]
+    pub coherence_threshold: f64,
+    /// Number of window lengths (from 20π/ω_max to half the record).
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub windows: usize,
+    /// Overlap of consecutive windows, 0..0.95.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.8)]
+    pub overlap: f64,
+    /// Number of log-spaced frequencies.
+    #[arg(long, value_name = "N", default_value_t = 200)]
+    pub points: usize,
+    /// CSV: the time column [s].
+    #[arg(long, value_name = "COLUMN", default_value = "time_s")]
+    pub time: String,
+    /// CSV: input columns, `NAME=COLUMN` or `COLUMN`, comma-separated.
+    #[arg(
+        long = "inputs",
+        value_name = "LIST",
+        default_value = "lat=cmd_lat,lon=cmd_lon,ped=cmd_ped,col=cmd_col"
+    )]
+    pub input_columns: String,
+    /// CSV: output columns, `NAME=COLUMN` or `COLUMN`, comma-separated.
+    #[arg(
+        long = "outputs",
+        value_name = "LIST",
+        default_value = "u,v,w,p,q,r,ax,ay,az,phi,theta"
+    )]
+    pub output_columns: String,
+    /// CSV: the swept input (a name from --inputs); default: the most active input.
+    #[arg(long, value_name = "NAME")]
+    pub primary: Option<String>,
+    /// CSV: column whose value keeps a row only in the fade_in, sweep and fade_out
+    /// phases (ignored when the file has no such column).
+    #[arg(long, value_name = "COLUMN", default_value = "phase")]
+    pub phase_column: String,
+    /// No summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// A frequency band [rad/s] as given on the command line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Band(pub [f64; 2]);
+
+fn parse_band(text: &str) -> Result<Band, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [lo, hi] = parts.as_slice() else {
+        return Err(format!("`{text}`: expected WMIN,WMAX"));
+    };
+    let number = |s: &str| {
+        s.parse::<f64>()
+            .map_err(|_| format!("`{s}` is not a number"))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+        return Err(format!("`{text}`: need 0 < WMIN < WMAX"));
+    }
+    Ok(Band([lo, hi]))
+}
+
+/// `NAME=COLUMN` or `COLUMN` (name = column), comma-separated.
+fn parse_columns(list: &str, option: &str) -> anyhow::Result<Vec<(String, String)>> {
+    let columns: Vec<(String, String)> = list
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|item| match item.split_once('=') {
+            Some((name, column)) => (name.trim().to_string(), column.trim().to_string()),
+            None => (item.to_string(), item.to_string()),
+        })
+        .collect();
+    if columns.is_empty() || columns.iter().any(|(n, c)| n.is_empty() || c.is_empty()) {
+        bail!("{option} `{list}`: expected NAME=COLUMN or COLUMN, comma-separated");
+    }
+    Ok(columns)
+}
+
+impl FrfArgs {
+    fn options(&self) -> FrfOptions {
+        FrfOptions {
+            band: self.band.map(|b| b.0),
+            points: self.points,
+            windows: self.windows,
+            overlap: self.overlap,
+            coherence_threshold: self.coherence_threshold,
+            ..FrfOptions::default()
+        }
+    }
+
+    fn csv_columns(&self) -> anyhow::Result<CsvColumns> {
+        Ok(CsvColumns {
+            time: self.time.clone(),
+            inputs: parse_columns(&self.input_columns, "--inputs")?,
+            outputs: parse_columns(&self.output_columns, "--outputs")?,
+            primary: self.primary.clone(),
+            phase_column: Some(self.phase_column.clone()),
+            sweep_band: self.band.map(|b| b.0),
+        })
+    }
+}
+
+fn is_csv(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+}
+
+/// Run `sweephold frf`.
+pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
+    let opts = args.options();
+    opts.validate()?;
+    let columns = args.csv_columns()?;
+    let records: Vec<Record> = args
+        .files
+        .iter()
+        .map(|path| {
+            if is_csv(path) {
+                load_csv(path, &columns)
+            } else {
+                load_dump(path)
+            }
+        })
+        .collect::<Result<_, _>>()?;
+    let groups = group_by_primary(records)?;
+    let analysis = analyse(&groups, &opts)?;
+
+    let file =
+        File::create(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut writer = BufWriter::new(file);
+    serde_json::to_writer_pretty(&mut writer, &analysis.document)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    writeln!(writer)?;
+    writer
+        .flush()
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+
+    let plots = match &args.plots {
+        Some(dir) => write_plots(&analysis, dir)?.len(),
+        None => 0,
+    };
+    if !args.quiet {
+        eprint!("{}", summary(&analysis, &args.out, plots));
+    }
+    Ok(())
+}
+
+/// The stderr summary: groups, valid ranges, cross-control coherence, notes.
+fn summary(analysis: &FrfAnalysis, out: &Path, plots: usize) -> String {
+    let mut text = String::new();
+    let document = &analysis.document;
+    for group in &analysis.groups {
+        let windows: Vec<String> = group.windows.iter().map(|w| format!("{w:.1}")).collect();
+        text += &format!(
+            "{} sweep: {} record(s), {:.1} s, {:.3}–{:.2} rad/s, windows {} s, conditioned on {}\n",
+            group.axis,
+            group.records,
+            group.seconds,
+            group.band[0],
+            group.band[1],
+            windows.join(" "),
+            group.conditioned_on.join(", ")
+        );
+    }
+    for pair in &document.pairs {
+        let range = match pair.valid_range {
+            Some([lo, hi]) => format!("{lo:.2}–{hi:.2} rad/s"),
+            None => "none".to_string(),
+        };
+        text += &format!(
+            "  {:>4} → {:<5} valid (γ² ≥ {}): {range}\n",
+            pair.input, pair.output, document.coherence_threshold
+        );
+    }
+    for cc in &document.cross_coherence {
+        let verdict = if cc.mean <= 0.5 {
+            "ok"
+        } else {
+            "above the 0.5 guideline"
+        };
+        text += &format!(
+            "  cross-control coherence ({} sweep) {}–{}: {:.2} ({verdict})\n",
+            cc.axis, cc.a, cc.b, cc.mean
+        );
+    }
+    for note in &document.notes {
+        text += &format!("note: {note}\n");
+    }
+    text += &format!("wrote {}", out.display());
+    if plots > 0 {
+        text += &format!(" and {plots} plots");
+    }
+    text += "\n";
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use sweephold_protocol::{
+        encode, Axis, Controls, ExcitationMode, FirmwareVersion, Frame, Header, HoldState,
+        InputKind, Measurements, Phase, PulseSettings, Sample, SweepSettings, TestConfig,
+        VehicleId, MAX_FRAME_LEN, PROTOCOL_VERSION,
+    };
+
+    #[derive(Parser)]
+    struct Harness {
+        #[command(flatten)]
+        args: FrfArgs,
+    }
+
+    fn parse(argv: &[&str]) -> FrfArgs {
+        Harness::try_parse_from(std::iter::once("frf").chain(argv.iter().copied()))
+            .expect("arguments parse")
+            .args
+    }
+
+    fn scratch_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("sweephold-frf-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// A dump of a lateral sweep (ω 0.5–12 rad/s, 50 Hz, `seconds` long) where the roll
+    /// rate is a discrete first-order lag of the lateral command; `sweep` false gives a
+    /// dump that never leaves the idle phase.
+    fn dump(seconds: f64, sweep: bool) -> Vec<u8> {
+        let rate = 50u16;
+        let header = Header {
+            protocol: PROTOCOL_VERSION,
+            firmware: FirmwareVersion {
+                major: 0,
+                minor: 1,
+                patch: 0,
+            },
+            vehicle: VehicleId::Trex700l,
+            rate_hz: rate,
+            test: TestConfig {
+                mode: ExcitationMode::ConditionalAttitudeHold,
+                primary: Axis::Lat,
+                input: InputKind::Sweep,
+                sweep: SweepSettings {
+                    t_rec_s: seconds as f32,
+                    amplitude: 0.05,
+                    omega_min: 0.5,
+                    omega_max: 12.0,
+                    fade_s: 0.0,
+                    start_hold_cycles: 0,
+                },
+                pulse: PulseSettings {
+                    amplitude: 0.05,
+                    width_s: 0.5,
+                },
+                noise_rms: 0.0,
+                noise_cutoff_rad_s: 10.0,
+                seed: 0,
+                hold_engage_rad: 0.105,
+                hold_release_rad: 0.07,
+                freeze_in_band: false,
+                warnings: 0,
+            },
+        };
+        let mut bytes = Vec::new();
+        let mut push = |frame: Frame| {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            let n = encode(&frame, &mut buf).unwrap();
+            bytes.extend_from_slice(&buf[..n]);
+        };
+        push(Frame::Header(header));
+        let len = (seconds * f64::from(rate)) as usize;
+        let (c1, t) = (4.0f64, seconds);
+        let c2 = 1.0 / (c1.exp() - 1.0);
+        let mut p = 0.0f64;
+        for k in 0..len {
+            let time = k as f64 / f64::from(rate);
+            let theta = 0.5 * time + 11.5 * c2 * ((t / c1) * ((c1 * time / t).exp() - 1.0) - time);
+            let lat = if sweep { 0.05 * theta.sin() } else { 0.0 };
+            p = 0.9 * p + 0.1 * 2.0 * lat;
+            push(Frame::Sample(Sample {
+                tick: k as u32,
+                phase: if sweep { Phase::Sweep } else { Phase::Idle },
+                primary: Axis::Lat,
+                sweep_omega: 0.0,
+                hold: [HoldState::Released; 3],
+                command: Controls {
+                    lat: lat as f32,
+                    ..Controls::default()
+                },
+                sweep: Controls::default(),
+                noise: Controls::default(),
+                pilot: Controls::default(),
+                meas: Measurements {
+                    p: p as f32,
+                    ..Measurements::default()
+                },
+            }));
+        }
+        bytes
+    }
+
+    #[test]
+    fn writes_the_document_and_plots() {
+        let dir = scratch_dir("ok");
+        let dump_path = dir.join("lat.dump");
+        std::fs::write(&dump_path, dump(60.0, true)).unwrap();
+        let out = dir.join("frf.json");
+        let plots = dir.join("plots");
+        let args = parse(&[
+            dump_path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--plots",
+            plots.to_str().unwrap(),
+            "--points",
+            "60",
+            "-q",
+        ]);
+        run(&args).unwrap();
+        let document: sysid::document::FrfDocument =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let pair = document.pair("lat", "p").expect("lat → p");
+        assert_eq!(pair.omega.len(), 60);
+        // p/lat = 0.2/(1 − 0.9 z⁻¹): 6 dB (gain 2) at low frequency.
+        assert!((pair.mag_db[0] - 6.02).abs() < 0.5, "{}", pair.mag_db[0]);
+        assert!(plots.join("frf_lat_p.svg").exists());
+        let svg = std::fs::read_to_string(plots.join("frf_lat_p.svg")).unwrap();
+        assert!(svg.starts_with("<svg") || svg.contains("<svg"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn one_line_errors() {
+        let dir = scratch_dir("err");
+        let idle = dir.join("idle.dump");
+        std::fs::write(&idle, dump(10.0, false)).unwrap();
+        let short = dir.join("short.dump");
+        std::fs::write(&short, dump(3.0, true)).unwrap();
+        let out = dir.join("frf.json");
+        for (file, expected) in [(&idle, "no sweep"), (&short, "too short")] {
+            let args = parse(&[file.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q"]);
+            let message = format!("{:#}", run(&args).unwrap_err());
+            assert!(message.contains(expected), "{message}");
+            assert!(!message.contains('\n'), "{message}");
+        }
+        assert!(!out.exists());
+        assert!(parse_band("3,1").is_err() && parse_band("0.5,20").is_ok());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,578 @@
+//! State-space model fitting to frequency responses, as CIFER's DERIVID does it.
+//!
+//! A [`ModelStructure`] (TOML file, see `host/sysid/models/README.md`) says which entries
+//! of `M ẋ = F x + G u(t − τ)`, `y = H0 x + H1 ẋ` are free, fixed, zero or constrained.
+//! [`fit`] interpolates each pair's response at n_ω = 20 log-spaced frequencies of its
+//! range, minimises the DERIVID cost ([`cost`]) with Levenberg–Marquardt from several
+//! seeded starts until the same minimum is found twice ([`optimizer`]), and reports
+//! Cramér–Rao bounds, insensitivities and correlations ([`accuracy`]); optionally it drops
+//! poorly identified parameters one at a time ([`reduce`]).
+
+pub mod accuracy;
+pub mod cost;
+pub mod error;
+pub mod expression;
+pub mod model;
+pub mod optimizer;
+pub mod reduce;
+pub mod report;
+pub mod start;
+pub mod structure;
+pub mod synthetic;
+
+#[cfg(test)]
+pub(crate) mod test_support;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::document::FrfDocument;
+
+pub use accuracy::{AccuracyAnalysis, ParameterAccuracy};
+pub use cost::{cost_between_models, ModelComparison, PairBand, PairGrid};
+pub use error::{FitError, StructureError, StructureProblem};
+pub use model::Model;
+pub use optimizer::StopReason;
+pub use reduce::ReductionStep;
+pub use report::ModelDocument;
+pub use start::{start_from_quasi_steady, StartValueNote};
+pub use structure::{ModelStructure, ParameterKind};
+
+/// Settings of a fit. `Default` gives CIFER-like values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Fit frequencies per pair, log-spaced over its range (n_ω, usually 20).
+    pub points_per_pair: usize,
+    /// Levenberg–Marquardt iteration limit per start.
+    pub max_iterations: usize,
+    /// Most starts (the first from the structure's start values, the rest perturbed).
+    pub max_starts: usize,
+    /// Perturbation of restarts: each free value × (1 + spread·U(−1, 1)).
+    pub start_spread: f64,
+    /// Seed of the restart perturbations.
+    pub seed: u64,
+    /// Two starts found the same minimum when their J_ave differ by at most
+    /// `same_minimum_tolerance · max(1, J_ave)`.
+    pub same_minimum_tolerance: f64,
+    /// Run the parameter reduction after the fit ([`reduce`]).
+    pub reduce: bool,
+    /// Reduction keeps dropping parameters while J_ave rises by less than this per step.
+    pub reduce_max_cost_rise: f64,
+    /// Flag a Cramér–Rao bound above this percentage of the value.
+    pub cramer_rao_limit_percent: f64,
+    /// Flag an insensitivity above this percentage of the value.
+    pub insensitivity_limit_percent: f64,
+    /// Flag a parameter pair correlated beyond this |ρ|.
+    pub correlation_limit: f64,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            points_per_pair: cost::DEFAULT_POINTS_PER_PAIR,
+            max_iterations: 200,
+            max_starts: 8,
+            start_spread: 0.3,
+            seed: 1,
+            same_minimum_tolerance: 1e-4,
+            reduce: false,
+            reduce_max_cost_rise: 2.0,
+            cramer_rao_limit_percent: 20.0,
+            insensitivity_limit_percent: 10.0,
+            correlation_limit: 0.9,
+        }
+    }
+}
+
+/// How a parameter entered the fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ParameterStatus {
+    /// Identified.
+    Free,
+    /// Held at its value (by the file, or dropped by the reduction at zero).
+    Fixed,
+    /// A linear expression of other parameters.
+    Constrained,
+}
+
+/// A warning on an identified parameter (guidelines of the paper and Tischler & Remple).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "flag", rename_all = "snake_case")]
+pub enum AccuracyFlag {
+    /// Cramér–Rao bound above the limit (20 %).
+    CramerRao,
+    /// Insensitivity above the limit (10 %).
+    Insensitive,
+    /// |correlation| with another parameter above the limit (0.9).
+    Correlated {
+        /// The other parameter.
+        with: String,
+        /// The correlation coefficient.
+        correlation: f64,
+    },
+}
+
+/// One parameter of the fitted model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterReport {
+    /// Engineering name.
+    pub name: String,
+    /// Value.
+    pub value: f64,
+    /// Free, fixed or constrained.
+    pub status: ParameterStatus,
+    /// Cramér–Rao bound in % of |value| (free parameters only).
+    pub cramer_rao_percent: Option<f64>,
+    /// Insensitivity in % of |value| (free parameters only).
+    pub insensitivity_percent: Option<f64>,
+    /// Guideline violations.
+    pub flags: Vec<AccuracyFlag>,
+}
+
+/// The cost of one pair at the fitted model.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PairFit {
+    /// Control name.
+    pub input: String,
+    /// Output name.
+    pub output: String,
+    /// Range fitted [rad/s].
+    pub range: [f64; 2],
+    /// J of the pair.
+    pub cost: f64,
+}
+
+/// What one start of the optimizer reached.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StartOutcome {
+    /// J_ave at the end of the run (None when the start could not be evaluated).
+    pub average_cost: Option<f64>,
+    /// Iterations used.
+    pub iterations: usize,
+    /// Why it stopped (debug form of [`StopReason`]), or the error.
+    pub stop: String,
+}
+
+/// Everything a fit produces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitResult {
+    /// The structure with the fitted values as its values (and, after a reduction, the
+    /// dropped parameters fixed at zero).
+    pub structure: ModelStructure,
+    /// Base-parameter values (free and fixed), in structure order.
+    pub values: Vec<f64>,
+    /// The fitted numeric model.
+    pub model: Model,
+    /// Base parameters in structure order, then the constrained ones.
+    pub parameters: Vec<ParameterReport>,
+    /// J per pair.
+    pub pairs: Vec<PairFit>,
+    /// J_ave: mean J over the pairs.
+    pub average_cost: f64,
+    /// Free-parameter names: the rows/columns of `correlation`.
+    pub correlation_names: Vec<String>,
+    /// Correlation matrix of the free parameters (NaN when the Hessian is singular).
+    pub correlation: DMatrix<f64>,
+    /// True when the Hessian could not be inverted.
+    pub hessian_singular: bool,
+    /// Every start tried, in order.
+    pub starts: Vec<StartOutcome>,
+    /// True when two starts reached the best minimum.
+    pub minimum_confirmed: bool,
+    /// Reduction steps (empty without `reduce`).
+    pub reduction: Vec<ReductionStep>,
+}
+
+impl FitResult {
+    /// Value of a parameter (base or constrained) by name.
+    pub fn parameter(&self, name: &str) -> Option<f64> {
+        self.parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.value)
+    }
+
+    /// The pairs and ranges fitted, e.g. to score the model against a truth model with
+    /// [`cost_between_models`].
+    pub fn bands(&self) -> Vec<PairBand> {
+        self.pairs
+            .iter()
+            .map(|pair| PairBand {
+                input: pair.input.clone(),
+                output: pair.output.clone(),
+                range: pair.range,
+            })
+            .collect()
+    }
+
+    /// The `model.json` form.
+    pub fn to_document(&self) -> ModelDocument {
+        ModelDocument::from_result(self)
+    }
+}
+
+/// Fit `structure` to the responses in `data`.
+pub fn fit(
+    structure: &ModelStructure,
+    data: &FrfDocument,
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let grids = cost::build_pair_grids(structure, data, options.points_per_pair)?;
+    let result = fit_on_grids(structure, &grids, options)?;
+    if options.reduce {
+        reduce::reduce(result, &grids, options)
+    } else {
+        Ok(result)
+    }
+}
+
+/// Base-parameter vector with the free entries replaced by `free_values`.
+fn merge(base: &[f64], free: &[usize], free_values: &DVector<f64>) -> Vec<f64> {
+    let mut values = base.to_vec();
+    for (k, &index) in free.iter().enumerate() {
+        values[index] = free_values[k];
+    }
+    values
+}
+
+/// Multi-start fit on prepared grids, then the accuracy analysis.
+pub(crate) fn fit_on_grids(
+    structure: &ModelStructure,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let base = structure.values();
+    let free = structure.free_indices();
+    let n_pairs = grids.len() as f64;
+    let bounds = optimizer::Bounds {
+        lower: free
+            .iter()
+            .map(|&i| structure.parameters[i].lower)
+            .collect(),
+        upper: free
+            .iter()
+            .map(|&i| structure.parameters[i].upper)
+            .collect(),
+    };
+    let rules = optimizer::StoppingRules {
+        max_iterations: options.max_iterations,
+        ..optimizer::StoppingRules::default()
+    };
+    let evaluate = |x: &DVector<f64>, with_jacobian: bool| {
+        let values = merge(&base, &free, x);
+        if with_jacobian {
+            let (r, j) = cost::residuals_and_jacobian(structure, &values, &free, grids)?;
+            Ok((r, Some(j)))
+        } else {
+            let model = structure.model(&values)?;
+            Ok((DVector::from_vec(cost::residuals(&model, grids)?), None))
+        }
+    };
+
+    let first_start = DVector::from_iterator(free.len(), free.iter().map(|&i| base[i]));
+    let mut random = optimizer::SplitMix64::new(options.seed);
+    let mut starts = Vec::new();
+    let mut finals: Vec<(DVector<f64>, f64)> = Vec::new();
+    let mut minimum_confirmed = false;
+    let mut last_error = None;
+    let tolerance = |a: f64, b: f64| {
+        (a - b).abs() <= options.same_minimum_tolerance * a.abs().max(b.abs()).max(1.0)
+    };
+    for start_number in 0..options.max_starts.max(1) {
+        let start = if start_number == 0 {
+            let mut x = first_start.clone();
+            bounds.project(&mut x);
+            x
+        } else {
+            optimizer::perturbed_start(
+                &first_start,
+                options.start_spread,
+                0.1,
+                &bounds,
+                &mut random,
+            )
+        };
+        if free.is_empty() {
+            finals.push((start, f64::NAN));
+            break;
+        }
+        match optimizer::levenberg_marquardt(evaluate, start, &bounds, &rules) {
+            Ok(outcome) => {
+                let average_cost = outcome.cost / n_pairs;
+                starts.push(StartOutcome {
+                    average_cost: Some(average_cost),
+                    iterations: outcome.iterations,
+                    stop: format!("{:?}", outcome.reason),
+                });
+                finals.push((outcome.x, average_cost));
+            }
+            Err(FitError::SingularSystem { omega }) => {
+                starts.push(StartOutcome {
+                    average_cost: None,
+                    iterations: 0,
+                    stop: format!("start not evaluable (singular at ω = {omega})"),
+                });
+                last_error = Some(FitError::SingularSystem { omega });
+                continue;
+            }
+            Err(other) => return Err(other),
+        }
+        let best = finals.iter().map(|(_, j)| *j).fold(f64::INFINITY, f64::min);
+        let hits = finals.iter().filter(|(_, j)| tolerance(*j, best)).count();
+        if hits >= 2 {
+            minimum_confirmed = true;
+            break;
+        }
+    }
+    let best = finals
+        .iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(x, _)| x.clone());
+    let Some(best) = best else {
+        return Err(last_error.unwrap_or(FitError::NoPairs));
+    };
+    let values = merge(&base, &free, &best);
+    let (residual, jacobian) = cost::residuals_and_jacobian(structure, &values, &free, grids)?;
+    let costs = cost::pair_costs_from_residuals(grids, residual.as_slice());
+    let analysis = accuracy::analyse(&jacobian);
+    let fitted_structure = structure.with_values(&values)?;
+    let model = structure.model(&values)?;
+    let parameters = parameter_reports(&fitted_structure, &values, &free, &analysis, options);
+    Ok(FitResult {
+        pairs: grids
+            .iter()
+            .zip(&costs)
+            .map(|(grid, &cost)| PairFit {
+                input: grid.input.clone(),
+                output: grid.output.clone(),
+                range: grid.range,
+                cost,
+            })
+            .collect(),
+        average_cost: cost::average(&costs),
+        correlation_names: free
+            .iter()
+            .map(|&i| structure.parameters[i].name.clone())
+            .collect(),
+        correlation: analysis.correlation.clone(),
+        hessian_singular: analysis.singular,
+        structure: fitted_structure,
+        values,
+        model,
+        parameters,
+        starts,
+        minimum_confirmed,
+        reduction: Vec::new(),
+    })
+}
+
+fn parameter_reports(
+    structure: &ModelStructure,
+    values: &[f64],
+    free: &[usize],
+    analysis: &AccuracyAnalysis,
+    options: &FitOptions,
+) -> Vec<ParameterReport> {
+    let mut reports: Vec<ParameterReport> = structure
+        .parameters
+        .iter()
+        .enumerate()
+        .map(|(index, parameter)| {
+            let value = values[index];
+            match free.iter().position(|&i| i == index) {
+                Some(k) => {
+                    let accuracy = analysis.parameters[k];
+                    let cramer_rao = accuracy::percent_of(accuracy.cramer_rao, value);
+                    let insensitivity = accuracy::percent_of(accuracy.insensitivity, value);
+                    let mut flags = Vec::new();
+                    if cramer_rao.is_nan() || cramer_rao > options.cramer_rao_limit_percent {
+                        flags.push(AccuracyFlag::CramerRao);
+                    }
+                    if insensitivity.is_nan() || insensitivity > options.insensitivity_limit_percent
+                    {
+                        flags.push(AccuracyFlag::Insensitive);
+                    }
+                    for (other, &other_index) in free.iter().enumerate() {
+                        let rho = analysis.correlation[(k, other)];
+                        if other != k && rho.abs() > options.correlation_limit {
+                            flags.push(AccuracyFlag::Correlated {
+                                with: structure.parameters[other_index].name.clone(),
+                                correlation: rho,
+                            });
+                        }
+                    }
+                    ParameterReport {
+                        name: parameter.name.clone(),
+                        value,
+                        status: ParameterStatus::Free,
+                        cramer_rao_percent: Some(cramer_rao),
+                        insensitivity_percent: Some(insensitivity),
+                        flags,
+                    }
+                }
+                None => ParameterReport {
+                    name: parameter.name.clone(),
+                    value,
+                    status: ParameterStatus::Fixed,
+                    cramer_rao_percent: None,
+                    insensitivity_percent: None,
+                    flags: Vec::new(),
+                },
+            }
+        })
+        .collect();
+    reports.extend(structure.derived.iter().map(|derived| ParameterReport {
+        name: derived.name.clone(),
+        value: derived.expression.evaluate(values),
+        status: ParameterStatus::Constrained,
+        cramer_rao_percent: None,
+        insensitivity_percent: None,
+        flags: Vec::new(),
+    }));
+    reports
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::test_support::*;
+
+    fn assert_recovered(result: &FitResult, structure: &ModelStructure, truth: &[f64]) {
+        for index in structure.free_indices() {
+            let name = &structure.parameters[index].name;
+            let got = result.values[index];
+            let want = truth[index];
+            assert!(
+                (got - want).abs() <= 1e-4 * want.abs(),
+                "{name}: fitted {got}, truth {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn small_model_is_recovered_from_perturbed_starts() {
+        let structure = first_order_structure();
+        let truth = structure.values();
+        let document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 20);
+        // Start 40 % off on every (free) parameter.
+        let start: Vec<f64> = truth.iter().map(|v| v * 1.4).collect();
+        assert_eq!(structure.free_indices().len(), truth.len());
+        let perturbed = structure.with_values(&start).unwrap();
+        let result = fit(&perturbed, &document, &FitOptions::default()).unwrap();
+        assert_recovered(&result, &structure, &truth);
+        assert!(result.average_cost < 1e-12, "J_ave {}", result.average_cost);
+        assert!(result.minimum_confirmed);
+        assert!(result.starts.len() >= 2);
+    }
+
+    #[test]
+    fn hybrid_model_is_recovered_from_perturbed_starts() {
+        let structure = hybrid_structure();
+        let truth = hybrid_truth_values(&structure);
+        let document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 20);
+        // Every free parameter 15 % off, alternating sign (fixed ones stay true).
+        let mut start = truth.clone();
+        for (k, index) in structure.free_indices().into_iter().enumerate() {
+            start[index] *= if k % 2 == 0 { 1.15 } else { 0.85 };
+        }
+        let perturbed = structure.with_values(&start).unwrap();
+        let options = FitOptions {
+            max_starts: 3,
+            ..FitOptions::default()
+        };
+        let result = fit(&perturbed, &document, &options).unwrap();
+        assert_recovered(&result, &structure, &truth);
+        assert!(result.minimum_confirmed, "{:?}", result.starts);
+        assert!(result.average_cost < 1e-10, "J_ave {}", result.average_cost);
+        assert_eq!(result.pairs.len(), 29);
+        // Constrained Yb1s follows Xb1c.
+        let xb1c = result.parameter("Xb1c").unwrap();
+        assert_eq!(result.parameter("Yb1s").unwrap(), -xb1c);
+    }
+
+    #[test]
+    fn fit_is_deterministic_for_a_seed() {
+        let structure = first_order_structure();
+        let truth = structure.values();
+        let mut document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 60);
+        // Imperfect data so that the minimum is not exact and restarts matter.
+        for pair in &mut document.pairs {
+            for (k, value) in pair.mag_db.iter_mut().enumerate() {
+                *value += 0.3 * ((k * 7) as f64).sin();
+            }
+        }
+        let options = FitOptions {
+            seed: 42,
+            ..FitOptions::default()
+        };
+        let a = fit(&structure, &document, &options).unwrap();
+        let b = fit(&structure, &document, &options).unwrap();
+        assert_eq!(a.values, b.values);
+        assert_eq!(a.starts, b.starts);
+        assert!(a.average_cost > 0.01);
+    }
+
+    #[test]
+    fn malformed_pair_data_is_reported() {
+        let structure = first_order_structure();
+        let model = structure.model(&structure.values()).unwrap();
+        let mut document = synthetic_document(&model, &structure, 30);
+        document.pairs[0].coherence[3] = f64::NAN;
+        let error = fit(&structure, &document, &FitOptions::default()).unwrap_err();
+        assert!(matches!(error, FitError::BadPairData { .. }), "{error}");
+
+        let mut document = synthetic_document(&model, &structure, 30);
+        document.pairs[1].mag_db.pop();
+        let error = fit(&structure, &document, &FitOptions::default()).unwrap_err();
+        assert!(error.to_string().contains("differ in length"), "{error}");
+
+        // An explicit range outside the data's frequencies.
+        let text = test_support::FIRST_ORDER.replace("range = [0.1, 20.0]", "range = [50.0, 90.0]");
+        let outside = ModelStructure::parse(&text, "lag.toml").unwrap();
+        let document = synthetic_document(&model, &structure, 30);
+        let error = fit(&outside, &document, &FitOptions::default()).unwrap_err();
+        assert!(error.to_string().contains("does not overlap"), "{error}");
+    }
+
+    #[test]
+    fn missing_pair_names_the_line() {
+        let structure = first_order_structure();
+        let mut document = synthetic_document(
+            &structure.model(&structure.values()).unwrap(),
+            &structure,
+            30,
+        );
+        document.pairs.retain(|p| p.output != "y");
+        let error = fit(&structure, &document, &FitOptions::default()).unwrap_err();
+        let line = structure
+            .pairs
+            .iter()
+            .find(|p| p.output == "y")
+            .unwrap()
+            .line;
+        assert_eq!(
+            error,
+            FitError::MissingPair {
+                input: "u".into(),
+                output: "y".into(),
+                line
+            }
+        );
+        assert!(error.to_string().contains(&format!("line {line}")));
+    }
+
+    #[test]
+    fn auto_range_without_valid_range_is_an_error() {
+        let structure = first_order_structure();
+        let mut document = synthetic_document(
+            &structure.model(&structure.values()).unwrap(),
+            &structure,
+            30,
+        );
+        for pair in &mut document.pairs {
+            pair.valid_range = None;
+        }
+        let error = fit(&structure, &document, &FitOptions::default()).unwrap_err();
+        assert!(matches!(error, FitError::NoValidRange { .. }), "{error}");
+    }
+}

@@ -1,0 +1,174 @@
+//! Model structure reduction (CIFER practice, Tischler & Remple): drop the worst
+//! identified parameter — the most insensitive one while any insensitivity exceeds its
+//! limit, else the one with the largest Cramér–Rao bound while any exceeds its limit —
+//! by fixing it at zero, refit, and keep the smaller model while J_ave rises by less than
+//! a set amount per step. The first step that costs more is undone and ends the
+//! reduction (the paper keeps Lf_lat for that reason).
+
+use serde::{Deserialize, Serialize};
+
+use super::cost::PairGrid;
+use super::error::FitError;
+use super::structure::ParameterKind;
+use super::{fit_on_grids, FitOptions, FitResult, ParameterStatus};
+
+/// One reduction step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReductionStep {
+    /// The parameter fixed at zero.
+    pub dropped: String,
+    /// Why it was chosen, e.g. `insensitivity 35.2 %`.
+    pub reason: String,
+    /// J_ave before the step.
+    pub average_cost_before: f64,
+    /// J_ave after refitting without the parameter.
+    pub average_cost_after: f64,
+    /// Whether the smaller model was kept.
+    pub accepted: bool,
+}
+
+/// The parameter to drop next, with the reason, or None when every free parameter meets
+/// the guidelines.
+fn worst_parameter(result: &FitResult, options: &FitOptions) -> Option<(String, String)> {
+    let free = || {
+        result
+            .parameters
+            .iter()
+            .filter(|p| p.status == ParameterStatus::Free)
+    };
+    let worst_by = |key: fn(&super::ParameterReport) -> f64| {
+        free()
+            .map(|p| (p, key(p)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    };
+    let insensitivity =
+        |p: &super::ParameterReport| p.insensitivity_percent.unwrap_or(f64::INFINITY);
+    let cramer_rao = |p: &super::ParameterReport| p.cramer_rao_percent.unwrap_or(f64::INFINITY);
+    if let Some((parameter, value)) = worst_by(insensitivity) {
+        if value > options.insensitivity_limit_percent || value.is_nan() {
+            return Some((
+                parameter.name.clone(),
+                format!("insensitivity {value:.1} %"),
+            ));
+        }
+    }
+    if let Some((parameter, value)) = worst_by(cramer_rao) {
+        if value > options.cramer_rao_limit_percent || value.is_nan() {
+            return Some((parameter.name.clone(), format!("Cramér–Rao {value:.1} %")));
+        }
+    }
+    None
+}
+
+/// Reduce a fitted model step by step (see the module documentation).
+pub fn reduce(
+    initial: FitResult,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let mut current = initial;
+    let mut steps = Vec::new();
+    while let Some((name, reason)) = worst_parameter(&current, options) {
+        let mut smaller = current.structure.clone();
+        let Some(index) = smaller.parameter_index(&name) else {
+            break;
+        };
+        if smaller.free_indices().len() <= 1 {
+            break;
+        }
+        smaller.parameters[index].kind = ParameterKind::Fixed;
+        smaller.parameters[index].value = 0.0;
+        smaller.parameters[index].lower = None;
+        smaller.parameters[index].upper = None;
+        let before = current.average_cost;
+        let refit = match fit_on_grids(&smaller, grids, options) {
+            Ok(refit) => refit,
+            // A smaller model that cannot be evaluated (e.g. a pole moved onto the jω
+            // axis) is not an improvement.
+            Err(FitError::SingularSystem { .. }) => {
+                steps.push(ReductionStep {
+                    dropped: name,
+                    reason,
+                    average_cost_before: before,
+                    average_cost_after: f64::INFINITY,
+                    accepted: false,
+                });
+                break;
+            }
+            Err(other) => return Err(other),
+        };
+        let accepted = refit.average_cost - before < options.reduce_max_cost_rise;
+        steps.push(ReductionStep {
+            dropped: name,
+            reason,
+            average_cost_before: before,
+            average_cost_after: refit.average_cost,
+            accepted,
+        });
+        if !accepted {
+            break;
+        }
+        current = refit;
+    }
+    current.reduction = steps;
+    Ok(current)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::fit::structure::ModelStructure;
+    use crate::fit::test_support::synthetic_document;
+    use crate::fit::{fit, FitOptions, ParameterStatus};
+
+    #[test]
+    fn drops_a_parameter_the_data_do_not_need() {
+        // Truth: ẋ = −2x + 3u (no delay, no zero). The structure adds a feed-through-like
+        // H1 term `d` whose true value is 0 and a delay `tau` whose true value is 0:
+        // both are unidentifiable (insensitive) around zero and get dropped.
+        let truth_text = r#"
+name = "truth"
+states = ["x"]
+controls = ["u"]
+outputs = ["x"]
+pairs = [{ output = "x", input = "u", range = [0.1, 20.0] }]
+[parameters]
+a = -2.0
+b = 3.0
+[F.x]
+x = "a"
+[G.x]
+u = "b"
+"#;
+        let truth = ModelStructure::parse(truth_text, "truth.toml").unwrap();
+        let document = synthetic_document(&truth.model(&truth.values()).unwrap(), &truth, 20);
+        let candidate_text = truth_text.replace(
+            "b = 3.0",
+            "b = 3.0\nd = 0.001\ntau = { start = 0.0001, min = 0.0 }",
+        ) + "[H1.x]\nx = \"d\"\n[H0.x]\nx = 1.0\n[delays]\nu = \"tau\"\n";
+        let candidate = ModelStructure::parse(&candidate_text, "candidate.toml").unwrap();
+        let options = FitOptions {
+            reduce: true,
+            ..FitOptions::default()
+        };
+        let result = fit(&candidate, &document, &options).unwrap();
+        assert!(!result.reduction.is_empty());
+        let dropped: Vec<&str> = result
+            .reduction
+            .iter()
+            .filter(|s| s.accepted)
+            .map(|s| s.dropped.as_str())
+            .collect();
+        for name in &dropped {
+            let report = result.parameters.iter().find(|p| p.name == *name).unwrap();
+            assert_eq!(report.status, ParameterStatus::Fixed);
+            assert_eq!(report.value, 0.0);
+        }
+        // The true parameters survive and are recovered.
+        assert!(!dropped.contains(&"a") && !dropped.contains(&"b"));
+        assert!((result.parameter("a").unwrap() + 2.0).abs() < 1e-3);
+        assert!((result.parameter("b").unwrap() - 3.0).abs() < 1e-3);
+        for step in &result.reduction {
+            assert!(step.average_cost_after.is_finite());
+        }
+    }
+}

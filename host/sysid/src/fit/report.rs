@@ -1,0 +1,298 @@
+//! Fit reports: the `model.json` document (layout in `host/sysid/models/README.md`) and
+//! the text tables `sweephold fit` prints (parameters like the paper's Table 3, J per
+//! pair, reduction steps).
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use super::model::{Model, RowMajor};
+use super::reduce::ReductionStep;
+use super::{AccuracyFlag, FitResult, PairFit, ParameterStatus, StartOutcome};
+
+/// Version of the `model.json` layout.
+pub const MODEL_DOCUMENT_VERSION: u32 = 1;
+
+/// The matrices of the model, row-major.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelMatrices {
+    /// M, states × states.
+    #[serde(rename = "M")]
+    pub m: RowMajor,
+    /// F, states × states.
+    #[serde(rename = "F")]
+    pub f: RowMajor,
+    /// G, states × controls.
+    #[serde(rename = "G")]
+    pub g: RowMajor,
+    /// H0, outputs × states.
+    #[serde(rename = "H0")]
+    pub h0: RowMajor,
+    /// H1, outputs × states.
+    #[serde(rename = "H1")]
+    pub h1: RowMajor,
+}
+
+/// One parameter in `model.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParameterEntry {
+    /// Engineering name.
+    pub name: String,
+    /// Value (SI, controls per unit stick fraction).
+    pub value: f64,
+    /// free / fixed / constrained.
+    pub status: ParameterStatus,
+    /// Cramér–Rao bound in % of |value| (null unless free, or when infinite).
+    pub cramer_rao_percent: Option<f64>,
+    /// Insensitivity in % of |value| (null unless free, or when infinite).
+    pub insensitivity_percent: Option<f64>,
+    /// Guideline violations.
+    pub flags: Vec<AccuracyFlag>,
+}
+
+/// The correlation matrix of the free parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CorrelationMatrix {
+    /// Free-parameter names: rows and columns, in order.
+    pub names: Vec<String>,
+    /// Coefficients, row-major, names.len()².
+    pub values: Vec<f64>,
+}
+
+/// The `model.json` document `sweephold fit --out` writes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelDocument {
+    /// Layout version ([`MODEL_DOCUMENT_VERSION`]).
+    pub version: u32,
+    /// Structure name.
+    pub structure: String,
+    /// Structure description.
+    pub description: String,
+    /// State names.
+    pub states: Vec<String>,
+    /// Control names.
+    pub controls: Vec<String>,
+    /// Output names.
+    pub outputs: Vec<String>,
+    /// M F G H0 H1, row-major.
+    pub matrices: ModelMatrices,
+    /// Delay per control [s], in `controls` order.
+    pub delays: Vec<f64>,
+    /// Base parameters in structure order, then constrained ones.
+    pub parameters: Vec<ParameterEntry>,
+    /// J per pair.
+    pub pairs: Vec<PairFit>,
+    /// Mean J over the pairs.
+    pub average_cost: f64,
+    /// Correlation of the free parameters; null when the Hessian is singular.
+    pub correlation: Option<CorrelationMatrix>,
+    /// Every optimizer start.
+    pub starts: Vec<StartOutcome>,
+    /// Whether two starts reached the best minimum.
+    pub minimum_confirmed: bool,
+    /// Reduction steps (empty without `--reduce`).
+    pub reduction: Vec<ReductionStep>,
+}
+
+fn finite(value: Option<f64>) -> Option<f64> {
+    value.filter(|v| v.is_finite())
+}
+
+impl ModelDocument {
+    /// The document of a fit result.
+    pub fn from_result(result: &FitResult) -> Self {
+        let model = &result.model;
+        let correlation_values: Vec<f64> = RowMajor::from_matrix(&result.correlation).data;
+        Self {
+            version: MODEL_DOCUMENT_VERSION,
+            structure: result.structure.name.clone(),
+            description: result.structure.description.clone(),
+            states: model.states.clone(),
+            controls: model.controls.clone(),
+            outputs: model.outputs.clone(),
+            matrices: ModelMatrices {
+                m: RowMajor::from_matrix(&model.m),
+                f: RowMajor::from_matrix(&model.f),
+                g: RowMajor::from_matrix(&model.g),
+                h0: RowMajor::from_matrix(&model.h0),
+                h1: RowMajor::from_matrix(&model.h1),
+            },
+            delays: model.delays.clone(),
+            parameters: result
+                .parameters
+                .iter()
+                .map(|p| ParameterEntry {
+                    name: p.name.clone(),
+                    value: p.value,
+                    status: p.status,
+                    cramer_rao_percent: finite(p.cramer_rao_percent),
+                    insensitivity_percent: finite(p.insensitivity_percent),
+                    flags: p.flags.clone(),
+                })
+                .collect(),
+            pairs: result.pairs.clone(),
+            average_cost: result.average_cost,
+            correlation: (!result.hessian_singular
+                && correlation_values.iter().all(|v| v.is_finite()))
+            .then(|| CorrelationMatrix {
+                names: result.correlation_names.clone(),
+                values: correlation_values,
+            }),
+            starts: result.starts.clone(),
+            minimum_confirmed: result.minimum_confirmed,
+            reduction: result.reduction.clone(),
+        }
+    }
+
+    /// Value of a parameter by name.
+    pub fn parameter(&self, name: &str) -> Option<f64> {
+        self.parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.value)
+    }
+
+    /// The numeric model; `None` when a matrix has the wrong size.
+    pub fn model(&self) -> Option<Model> {
+        let (n, m, p) = (self.states.len(), self.controls.len(), self.outputs.len());
+        let sized = |matrix: &RowMajor, rows: usize, cols: usize| {
+            (matrix.rows == rows && matrix.cols == cols)
+                .then(|| matrix.to_matrix())
+                .flatten()
+        };
+        (self.delays.len() == m).then_some(())?;
+        Some(Model {
+            m: sized(&self.matrices.m, n, n)?,
+            f: sized(&self.matrices.f, n, n)?,
+            g: sized(&self.matrices.g, n, m)?,
+            h0: sized(&self.matrices.h0, p, n)?,
+            h1: sized(&self.matrices.h1, p, n)?,
+            delays: self.delays.clone(),
+            states: self.states.clone(),
+            controls: self.controls.clone(),
+            outputs: self.outputs.clone(),
+        })
+    }
+}
+
+fn percent_cell(value: Option<f64>) -> String {
+    match value {
+        Some(v) if v.is_finite() => format!("{v:.3}"),
+        Some(_) => "inf".into(),
+        None => "-".into(),
+    }
+}
+
+/// The parameter table (like the paper's Table 3): name, value, CR %, insensitivity %,
+/// status and flags (`CR>20%`, `I>10%`, `|r|>0.9 with X`).
+pub fn parameter_table(result: &FitResult) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<10} {:>14} {:>10} {:>10}  {:<11} flags",
+        "parameter", "value", "CR %", "insens. %", "status"
+    );
+    for p in &result.parameters {
+        let status = match p.status {
+            ParameterStatus::Free => "free",
+            ParameterStatus::Fixed => "fixed",
+            ParameterStatus::Constrained => "constrained",
+        };
+        let flags: Vec<String> = p
+            .flags
+            .iter()
+            .map(|flag| match flag {
+                AccuracyFlag::CramerRao => "CR>20%".to_string(),
+                AccuracyFlag::Insensitive => "I>10%".to_string(),
+                AccuracyFlag::Correlated { with, correlation } => {
+                    format!("r={correlation:+.2} with {with}")
+                }
+            })
+            .collect();
+        let _ = writeln!(
+            out,
+            "{:<10} {:>14.6} {:>10} {:>10}  {:<11} {}",
+            p.name,
+            p.value,
+            percent_cell(p.cramer_rao_percent),
+            percent_cell(p.insensitivity_percent),
+            status,
+            flags.join(", ")
+        );
+    }
+    out
+}
+
+/// The cost table: output/input, range and J per pair, then J_ave.
+pub fn cost_table(result: &FitResult) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "{:<12} {:>17} {:>10}", "pair", "range [rad/s]", "J");
+    for pair in &result.pairs {
+        let _ = writeln!(
+            out,
+            "{:<12} {:>8.3}-{:<8.3} {:>10.3}",
+            format!("{}/{}", pair.output, pair.input),
+            pair.range[0],
+            pair.range[1],
+            pair.cost
+        );
+    }
+    let _ = writeln!(
+        out,
+        "{:<12} {:>17} {:>10.3}",
+        "J_ave", "", result.average_cost
+    );
+    out
+}
+
+/// The reduction steps, one line each.
+pub fn reduction_table(steps: &[ReductionStep]) -> String {
+    let mut out = String::new();
+    for (number, step) in steps.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "step {}: drop {} ({}): J_ave {:.3} -> {:.3}  {}",
+            number + 1,
+            step.dropped,
+            step.reason,
+            step.average_cost_before,
+            step.average_cost_after,
+            if step.accepted {
+                "kept out"
+            } else {
+                "restored (cost rose too much)"
+            }
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::test_support::*;
+    use crate::fit::{fit, FitOptions};
+
+    #[test]
+    fn document_round_trips_through_json_and_rebuilds_the_model() {
+        let structure = first_order_structure();
+        let document_data = synthetic_document(
+            &structure.model(&structure.values()).unwrap(),
+            &structure,
+            40,
+        );
+        let result = fit(&structure, &document_data, &FitOptions::default()).unwrap();
+        let document = result.to_document();
+        let json = serde_json::to_string_pretty(&document).unwrap();
+        let back: ModelDocument = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.parameters.len(), document.parameters.len());
+        assert_eq!(back.model().unwrap(), result.model);
+        assert_eq!(back.parameter("b"), result.parameter("b"));
+        let correlation = back.correlation.unwrap();
+        assert_eq!(correlation.values.len(), correlation.names.len().pow(2));
+        let table = parameter_table(&result);
+        assert!(table.contains("tau") && table.contains("CR %"));
+        let costs = cost_table(&result);
+        assert!(costs.contains("x/u") && costs.contains("J_ave"));
+    }
+}

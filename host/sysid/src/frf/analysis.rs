@@ -1,0 +1,570 @@
+//! The whole computation: record groups → [`FrfDocument`].
+//!
+//! **How records combine (as in CIFER).** Each swept axis is one [`RecordGroup`]. The
+//! response of output y to control x comes from the group in which x is the swept
+//! (primary) input, conditioned on the other controls *excited in that group* (the
+//! off-axis noise, the attitude-hold commands, pilot inputs). A control that does not
+//! move in a group (the collective during a lateral sweep) carries no information and
+//! would make the input matrix singular, so it is left out of that group's conditioning
+//! and a note says so.
+//!
+//! Per group: join the records ([`RecordGroup::joined`]), choose the grid and window
+//! lengths ([`spectra`](super::spectra)), compute the spectral matrices of every window
+//! length once, then for every output and every window length the MISO-conditioned
+//! response of the primary input ([`miso`](super::miso)) and the plain SISO H1
+//! estimate, and blend the window lengths ([`composite`](super::composite)).
+//!
+//! Nothing non-finite reaches the document: frequencies where no window length gives a
+//! well-conditioned estimate are left out of that pair (each pair has its own `omega`)
+//! and counted in the notes.
+
+use num_complex::Complex64;
+
+use crate::document::{CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
+
+use super::coherence::{debiased_coherence, random_error, valid_range};
+use super::composite::{blend, Estimate};
+use super::miso::{InputFactor, MAX_INPUTS};
+use super::options::FrfOptions;
+use super::records::{rms, JoinedRecord, RecordGroup};
+use super::spectra::{
+    compute_spectra, log_grid, lowest_resolved, window_lengths, SpectraSettings, WindowSpectra,
+};
+use super::FrfError;
+
+/// Coherence between two controls versus frequency, for one record group.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoherenceCurve {
+    /// Primary axis of the group.
+    pub axis: String,
+    /// First control.
+    pub a: String,
+    /// Second control.
+    pub b: String,
+    /// Frequencies [rad/s].
+    pub omega: Vec<f64>,
+    /// Composite coherence γ²_ab.
+    pub coherence: Vec<f64>,
+}
+
+impl CoherenceCurve {
+    /// Mean coherence over the curve's (log-spaced) points; 0 for an empty curve.
+    pub fn mean(&self) -> f64 {
+        if self.coherence.is_empty() {
+            0.0
+        } else {
+            self.coherence.iter().sum::<f64>() / self.coherence.len() as f64
+        }
+    }
+}
+
+/// Multiple coherence of one output with the conditioning inputs of its group.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MultipleCoherence {
+    /// Swept input of the group.
+    pub input: String,
+    /// Output.
+    pub output: String,
+    /// Frequencies [rad/s].
+    pub omega: Vec<f64>,
+    /// γ²_y:u in [0, 1].
+    pub coherence: Vec<f64>,
+}
+
+/// What was done with one record group.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupSummary {
+    /// Primary axis.
+    pub axis: String,
+    /// Number of records joined.
+    pub records: usize,
+    /// Length of the joined record \[s\].
+    pub seconds: f64,
+    /// Frequency grid band [rad/s].
+    pub band: [f64; 2],
+    /// Window lengths used \[s\].
+    pub windows: Vec<f64>,
+    /// Controls in the conditioning (primary last).
+    pub conditioned_on: Vec<String>,
+}
+
+/// The document plus what the plots and the command-line summary need.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrfAnalysis {
+    /// The `frf.json` document.
+    pub document: FrfDocument,
+    /// Cross-control coherence versus frequency (the document has only the means).
+    pub cross_coherence_curves: Vec<CoherenceCurve>,
+    /// One summary per group.
+    pub groups: Vec<GroupSummary>,
+    /// Multiple coherence γ²_y:u of each output with all the conditioning inputs, one
+    /// per MISO pair in `document.pairs` order (composite, same weights as the response).
+    /// How much of the output the excited controls explain together; the partial
+    /// coherence in the document is the share of the swept control alone.
+    pub multiple_coherence: Vec<MultipleCoherence>,
+}
+
+/// Composite MISO-conditioned and SISO frequency responses of every (swept input,
+/// output) pair, and the cross-control coherences, of the given record groups (one per
+/// swept axis).
+pub fn compute_frequency_responses(
+    groups: &[RecordGroup],
+    opts: &FrfOptions,
+) -> Result<FrfDocument, FrfError> {
+    analyse(groups, opts).map(|analysis| analysis.document)
+}
+
+/// [`compute_frequency_responses`] with the coherence curves and group summaries.
+pub fn analyse(groups: &[RecordGroup], opts: &FrfOptions) -> Result<FrfAnalysis, FrfError> {
+    opts.validate()?;
+    if groups.is_empty() {
+        return Err(FrfError::NoRecords);
+    }
+    for (i, group) in groups.iter().enumerate() {
+        if groups[..i].iter().any(|g| g.primary() == group.primary()) {
+            return Err(FrfError::DuplicateAxis(group.primary().to_string()));
+        }
+    }
+    let mut analysis = FrfAnalysis {
+        document: FrfDocument {
+            version: FRF_DOCUMENT_VERSION,
+            pairs: Vec::new(),
+            siso: Vec::new(),
+            cross_coherence: Vec::new(),
+            coherence_threshold: opts.coherence_threshold,
+            notes: Vec::new(),
+        },
+        cross_coherence_curves: Vec::new(),
+        multiple_coherence: Vec::new(),
+        groups: Vec::new(),
+    };
+    for group in groups {
+        for record in group.records() {
+            analysis.document.notes.extend(record.notes.iter().cloned());
+        }
+        let prepared = prepare_group(group, opts, true)?;
+        analyse_group(&prepared, opts, &mut analysis);
+    }
+    Ok(analysis)
+}
+
+/// A group ready for spectra: joined, with grid, windows and channel selection.
+pub(crate) struct PreparedGroup {
+    pub primary: String,
+    pub joined: JoinedRecord,
+    pub grid: Vec<f64>,
+    pub windows: Vec<f64>,
+    /// Inputs in conditioning order (other excited controls, primary last), as indices
+    /// into `joined.inputs`.
+    pub conditioning: Vec<usize>,
+    /// Outputs with any variation, as indices into `joined.outputs`.
+    pub outputs: Vec<usize>,
+    pub records: usize,
+    pub notes: Vec<String>,
+}
+
+/// Join a group and choose its band, grid, windows, excited inputs and usable outputs.
+pub(crate) fn prepare_group(
+    group: &RecordGroup,
+    opts: &FrfOptions,
+    with_outputs: bool,
+) -> Result<PreparedGroup, FrfError> {
+    let axis = group.primary().to_string();
+    let fs = group.sample_rate_hz();
+    let joined = group.joined();
+    let seconds = joined.duration_s();
+    let mut notes = Vec::new();
+
+    let [lo, hi] = opts.band.or(group.sweep_band()).ok_or_else(|| {
+        FrfError::NoBand(format!(
+            "{axis} sweep: the sweep band is unknown (CSV records carry none): pass --band WMIN,WMAX"
+        ))
+    })?;
+    let nyquist = std::f64::consts::PI * fs;
+    if hi >= nyquist {
+        return Err(FrfError::InvalidOption(format!(
+            "band top {hi} rad/s is at or above the Nyquist frequency {nyquist:.1} rad/s of the {fs} Hz records"
+        )));
+    }
+    let too_short = |detail: String| FrfError::RecordTooShort {
+        axis: axis.clone(),
+        seconds,
+        detail,
+    };
+    let windows: Vec<f64> = window_lengths(seconds, hi, opts.windows)
+        .ok_or_else(|| {
+            too_short(format!(
+                "need at least {:.1} s (two windows of ten periods of ω_max = {hi} rad/s)",
+                40.0 * std::f64::consts::PI / hi
+            ))
+        })?
+        .into_iter()
+        .map(|t| (t * fs).round().max(2.0) / fs)
+        .collect();
+    let longest = windows.iter().copied().fold(0.0, f64::max);
+    let resolved = lowest_resolved(longest);
+    let lo_used = lo.max(resolved);
+    if lo_used >= hi {
+        return Err(too_short(format!(
+            "its longest window ({longest:.1} s) resolves only down to {resolved:.2} rad/s, above the band top {hi} rad/s"
+        )));
+    }
+    if lo_used > lo * (1.0 + 1e-9) {
+        notes.push(format!(
+            "{axis} sweep: band starts at {lo_used:.3} rad/s instead of {lo} rad/s: the longest window ({longest:.1} s, half the record) resolves down to 4π/T"
+        ));
+    }
+    let grid = log_grid(lo_used, hi, opts.points);
+
+    // Excitation of the controls.
+    let input_rms: Vec<f64> = joined.inputs.iter().map(|c| rms(&c.values)).collect();
+    let primary_index = joined
+        .inputs
+        .iter()
+        .position(|c| c.name == axis)
+        .ok_or_else(|| FrfError::NoExcitation { axis: axis.clone() })?;
+    let primary_rms = input_rms[primary_index];
+    if primary_rms.is_nan() || primary_rms <= 1e-12 {
+        return Err(FrfError::NoExcitation { axis });
+    }
+    let mut others: Vec<usize> = Vec::new();
+    for (i, channel) in joined.inputs.iter().enumerate() {
+        if i == primary_index {
+            continue;
+        }
+        if input_rms[i] >= opts.excitation_ratio * primary_rms && input_rms[i] > 0.0 {
+            others.push(i);
+        } else {
+            notes.push(format!(
+                "{axis} sweep: `{}` not excited (RMS {:.3e} vs {primary_rms:.3e} for `{axis}`): left out of the conditioning and the cross-control coherence",
+                channel.name, input_rms[i]
+            ));
+        }
+    }
+    if others.len() > MAX_INPUTS - 1 {
+        // Keep the most active controls; the conditioning handles four inputs.
+        others.sort_by(|&a, &b| input_rms[b].total_cmp(&input_rms[a]));
+        for &i in &others[MAX_INPUTS - 1..] {
+            notes.push(format!(
+                "{axis} sweep: `{}` left out of the conditioning (at most {MAX_INPUTS} inputs; the most active are kept)",
+                joined.inputs[i].name
+            ));
+        }
+        others.truncate(MAX_INPUTS - 1);
+        others.sort_unstable();
+    }
+    let mut conditioning = others;
+    conditioning.push(primary_index);
+
+    let mut outputs = Vec::new();
+    if with_outputs {
+        for (o, channel) in joined.outputs.iter().enumerate() {
+            if rms(&channel.values) > 0.0 {
+                outputs.push(o);
+            } else {
+                notes.push(format!(
+                    "{axis} sweep: output `{}` does not vary: no response computed",
+                    channel.name
+                ));
+            }
+        }
+    }
+    Ok(PreparedGroup {
+        primary: group.primary().to_string(),
+        joined,
+        grid,
+        windows,
+        conditioning,
+        outputs,
+        records: group.records().len(),
+        notes,
+    })
+}
+
+fn spectra_of(
+    prepared: &PreparedGroup,
+    opts: &FrfOptions,
+    with_outputs: bool,
+) -> Vec<WindowSpectra> {
+    let inputs: Vec<&[f64]> = prepared
+        .conditioning
+        .iter()
+        .map(|&i| prepared.joined.inputs[i].values.as_slice())
+        .collect();
+    let outputs: Vec<&[f64]> = if with_outputs {
+        prepared
+            .outputs
+            .iter()
+            .map(|&o| prepared.joined.outputs[o].values.as_slice())
+            .collect()
+    } else {
+        Vec::new()
+    };
+    compute_spectra(
+        &inputs,
+        &outputs,
+        &prepared.grid,
+        &prepared.windows,
+        SpectraSettings {
+            sample_rate_hz: prepared.joined.sample_rate_hz,
+            overlap: opts.overlap,
+            oversampling: opts.oversampling,
+        },
+    )
+}
+
+fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut FrfAnalysis) {
+    let axis = &prepared.primary;
+    let spectra = spectra_of(prepared, opts, true);
+    let grid = &prepared.grid;
+    let n_in = prepared.conditioning.len();
+    let primary = n_in - 1;
+
+    // Factor every window's input matrix once; all outputs share it.
+    let factors: Vec<Vec<Option<InputFactor>>> = spectra
+        .iter()
+        .map(|s| {
+            (s.valid_from.min(grid.len())..grid.len())
+                .map(|k| InputFactor::new(s.input_matrix(k), n_in, opts.min_pivot).ok())
+                .collect()
+        })
+        .collect();
+    let factor_at = |w: usize, k: usize| -> Option<&InputFactor> {
+        let s = &spectra[w];
+        (k >= s.valid_from)
+            .then(|| factors[w][k - s.valid_from].as_ref())
+            .flatten()
+    };
+    let unconditioned: Vec<f64> = (0..grid.len())
+        .filter(|&k| (0..spectra.len()).all(|w| factor_at(w, k).is_none()))
+        .map(|k| grid[k])
+        .collect();
+    let mut notes = prepared.notes.clone();
+    if let (Some(first), Some(last)) = (unconditioned.first(), unconditioned.last()) {
+        notes.push(format!(
+            "{axis} sweep: MISO responses left out at {} of {} frequencies ({first:.3}–{last:.3} rad/s): the excited controls are nearly collinear there (normalised pivot < {:e})",
+            unconditioned.len(),
+            grid.len(),
+            opts.min_pivot
+        ));
+    }
+
+    let input_name = |i: usize| {
+        prepared.joined.inputs[prepared.conditioning[i]]
+            .name
+            .clone()
+    };
+    for (o_local, &o) in prepared.outputs.iter().enumerate() {
+        let output = &prepared.joined.outputs[o].name;
+        let mut miso = Vec::with_capacity(grid.len());
+        let mut multiple = MultipleCoherence {
+            input: input_name(primary),
+            output: output.clone(),
+            omega: Vec::with_capacity(grid.len()),
+            coherence: Vec::with_capacity(grid.len()),
+        };
+        let mut siso = Vec::with_capacity(grid.len());
+        let mut guy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
+        for (k, &omega) in grid.iter().enumerate() {
+            let mut miso_estimates = Vec::with_capacity(spectra.len());
+            let mut multiple_estimates = Vec::with_capacity(spectra.len());
+            let mut siso_estimates = Vec::with_capacity(spectra.len());
+            for (w, s) in spectra.iter().enumerate() {
+                if k < s.valid_from {
+                    continue;
+                }
+                let gyy = s.output_auto(k, o_local);
+                if gyy.is_nan() || gyy <= 0.0 {
+                    continue;
+                }
+                if let Some(factor) = factor_at(w, k) {
+                    for (i, g) in guy.iter_mut().enumerate().take(n_in) {
+                        *g = s.input_output(k, i, o_local);
+                    }
+                    let c = factor.condition(&guy[..n_in], gyy);
+                    let error = random_error(c.partial_coherence, s.independent);
+                    miso_estimates.push(Estimate {
+                        response: c.response,
+                        coherence: c.partial_coherence,
+                        random_error: error,
+                    });
+                    multiple_estimates.push(Estimate {
+                        response: Complex64::new(0.0, 0.0),
+                        coherence: c.multiple_coherence,
+                        random_error: error,
+                    });
+                }
+                let gpp = s.input_input(k, primary, primary).re;
+                if gpp > 0.0 {
+                    let gpy = s.input_output(k, primary, o_local);
+                    let coherence = (gpy.norm_sqr() / (gpp * gyy)).clamp(0.0, 1.0);
+                    siso_estimates.push(Estimate {
+                        response: gpy / gpp,
+                        coherence,
+                        random_error: random_error(coherence, s.independent),
+                    });
+                }
+            }
+            if let Some(e) = blend(miso_estimates) {
+                miso.push((omega, e));
+            }
+            if let Some(e) = blend(multiple_estimates).filter(|e| e.coherence.is_finite()) {
+                multiple.omega.push(omega);
+                multiple.coherence.push(e.coherence.clamp(0.0, 1.0));
+            }
+            if let Some(e) = blend(siso_estimates) {
+                siso.push((omega, e));
+            }
+        }
+        let input = input_name(primary);
+        let (pair, dropped) = pair_response(&input, output, &miso, opts.coherence_threshold);
+        let (siso_pair, siso_dropped) =
+            pair_response(&input, output, &siso, opts.coherence_threshold);
+        if dropped + siso_dropped > 0 {
+            notes.push(format!(
+                "{input}→{output}: {} non-finite points left out",
+                dropped + siso_dropped
+            ));
+        }
+        analysis.document.pairs.push(pair);
+        analysis.multiple_coherence.push(multiple);
+        analysis.document.siso.push(siso_pair);
+    }
+
+    let curves = curves_from_spectra(prepared, &spectra);
+    for curve in &curves {
+        analysis.document.cross_coherence.push(CrossCoherence {
+            axis: curve.axis.clone(),
+            a: curve.a.clone(),
+            b: curve.b.clone(),
+            mean: curve.mean(),
+        });
+    }
+    analysis.cross_coherence_curves.extend(curves);
+    analysis.document.notes.extend(notes);
+    analysis.groups.push(GroupSummary {
+        axis: axis.clone(),
+        records: prepared.records,
+        seconds: prepared.joined.duration_s(),
+        band: [grid[0], grid[grid.len() - 1]],
+        windows: spectra.iter().map(|s| s.seconds).collect(),
+        conditioned_on: (0..n_in).map(input_name).collect(),
+    });
+}
+
+/// Cross-control coherence curves of a prepared group (inputs only).
+pub(crate) fn cross_control_curves(
+    prepared: &PreparedGroup,
+    opts: &FrfOptions,
+) -> Vec<CoherenceCurve> {
+    let spectra = spectra_of(prepared, opts, false);
+    curves_from_spectra(prepared, &spectra)
+}
+
+/// Composite coherence of every pair of excited controls, in the controls' record order.
+fn curves_from_spectra(prepared: &PreparedGroup, spectra: &[WindowSpectra]) -> Vec<CoherenceCurve> {
+    // Positions in the conditioning order, sorted by record order of the controls.
+    let mut order: Vec<(usize, usize)> = prepared
+        .conditioning
+        .iter()
+        .enumerate()
+        .map(|(position, &input)| (input, position))
+        .collect();
+    order.sort_unstable();
+    let mut curves = Vec::new();
+    for (x, &(input_a, a)) in order.iter().enumerate() {
+        for &(input_b, b) in &order[x + 1..] {
+            let mut curve = CoherenceCurve {
+                axis: prepared.primary.clone(),
+                a: prepared.joined.inputs[input_a].name.clone(),
+                b: prepared.joined.inputs[input_b].name.clone(),
+                omega: Vec::new(),
+                coherence: Vec::new(),
+            };
+            for (k, &omega) in prepared.grid.iter().enumerate() {
+                // Bias-corrected coherence of each window that resolves ω, weighted by its
+                // equivalent number of independent averages. The response composite's
+                // 1/εr² weighting would favour the long windows, whose few averages
+                // inflate coherence by ~1/n_d: two unrelated controls would read ~0.4.
+                let (mut sum, mut weight) = (0.0, 0.0);
+                for s in spectra.iter().filter(|s| k >= s.valid_from) {
+                    let (gaa, gbb) = (s.input_input(k, a, a).re, s.input_input(k, b, b).re);
+                    if !(gaa > 0.0 && gbb > 0.0) {
+                        continue;
+                    }
+                    let raw = s.input_input(k, a, b).norm_sqr() / (gaa * gbb);
+                    if let Some(coherence) = debiased_coherence(raw, s.welch_averages) {
+                        sum += s.welch_averages * coherence;
+                        weight += s.welch_averages;
+                    }
+                }
+                if weight > 0.0 && sum.is_finite() {
+                    curve.omega.push(omega);
+                    curve.coherence.push(sum / weight);
+                }
+            }
+            if !curve.omega.is_empty() {
+                curves.push(curve);
+            }
+        }
+    }
+    curves
+}
+
+/// Magnitude, unwrapped phase, coherence, random error and valid range of composite
+/// estimates; non-finite points are left out (their count is returned).
+fn pair_response(
+    input: &str,
+    output: &str,
+    points: &[(f64, Estimate)],
+    threshold: f64,
+) -> (PairResponse, usize) {
+    let mut pair = PairResponse {
+        input: input.to_string(),
+        output: output.to_string(),
+        omega: Vec::with_capacity(points.len()),
+        mag_db: Vec::with_capacity(points.len()),
+        phase_deg: Vec::with_capacity(points.len()),
+        coherence: Vec::with_capacity(points.len()),
+        random_error: Vec::with_capacity(points.len()),
+        valid_range: None,
+    };
+    let mut dropped = 0;
+    let mut previous_wrapped: Option<f64> = None;
+    for &(omega, e) in points {
+        let magnitude = e.response.norm();
+        let finite = omega.is_finite()
+            && e.response.re.is_finite()
+            && e.response.im.is_finite()
+            && e.coherence.is_finite()
+            && e.random_error.is_finite();
+        if !finite {
+            dropped += 1;
+            continue;
+        }
+        let wrapped = e.response.arg().to_degrees();
+        // Unwrap: add the step to the previous point, brought into (−180°, 180°].
+        let phase = match (previous_wrapped, pair.phase_deg.last()) {
+            (Some(previous), Some(&last)) => {
+                let mut step = wrapped - previous;
+                step -= 360.0 * ((step + 180.0) / 360.0).floor();
+                if step == -180.0 {
+                    step = 180.0;
+                }
+                last + step
+            }
+            _ => wrapped,
+        };
+        previous_wrapped = Some(wrapped);
+        pair.omega.push(omega);
+        pair.mag_db.push(20.0 * magnitude.max(1e-300).log10());
+        pair.phase_deg.push(phase);
+        pair.coherence.push(e.coherence.clamp(0.0, 1.0));
+        pair.random_error.push(e.random_error);
+    }
+    pair.valid_range = valid_range(&pair.omega, &pair.coherence, threshold);
+    (pair, dropped)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,361 @@
+//! Accuracy of the whole chain against analytic truth, and its refusals.
+
+use num_complex::Complex64;
+
+use super::*;
+use crate::frf::records::Channel;
+use crate::frf::testing::{add_noise, dump_bytes, record, sample, Block, DumpSpec, Noise, Sweep};
+use crate::frf::{load_dump_bytes, RecordGroup};
+
+const RATE: f64 = 200.0;
+
+fn paper_sweep(duration: f64) -> Sweep {
+    Sweep {
+        omega_min: 0.3,
+        omega_max: 31.4,
+        duration,
+        amplitude: 0.05,
+    }
+}
+
+/// Largest magnitude [dB] and phase [deg] errors against `truth` over the points with
+/// coherence ≥ `min_coherence`, and how many points that was.
+fn errors_against(
+    pair: &PairResponse,
+    truth: &dyn Fn(f64) -> Complex64,
+    min_coherence: f64,
+) -> (f64, f64, usize) {
+    let (mut worst_db, mut worst_deg, mut count) = (0.0f64, 0.0f64, 0);
+    for k in 0..pair.omega.len() {
+        if pair.coherence[k] < min_coherence {
+            continue;
+        }
+        let t = truth(pair.omega[k]);
+        let db = (pair.mag_db[k] - 20.0 * t.norm().log10()).abs();
+        let mut deg = pair.phase_deg[k] - t.arg().to_degrees();
+        deg -= 360.0 * (deg / 360.0).round();
+        if std::env::var("FRF_DEBUG").is_ok() {
+            eprintln!(
+                "{:8.3} γ²={:.4} εr={:.4} {db:7.3} dB {deg:7.2}°",
+                pair.omega[k], pair.coherence[k], pair.random_error[k]
+            );
+        }
+        worst_db = worst_db.max(db);
+        worst_deg = worst_deg.max(deg.abs());
+        count += 1;
+    }
+    (worst_db, worst_deg, count)
+}
+
+/// Seconds of trim (zero input) before and after each sweep, as a flight-test record has:
+/// the windows that cover the first and last seconds of the sweep (where it passes ω_min
+/// and ω_max) then see them with both halves of their taper.
+const TRIM_S: f64 = 3.0;
+
+/// Simulate `block` driven by `sweep` framed by [`TRIM_S`] of trim; return (input, noisy
+/// output).
+fn siso_run(block: &Block, sweep: Sweep, noise_ratio: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let len = ((sweep.duration + 2.0 * TRIM_S) * RATE) as usize;
+    let signal = move |t: f64| sweep.value(t - TRIM_S);
+    let input = sample(&signal, RATE, len);
+    let mut output = block.simulate(&signal, RATE, len, 4);
+    add_noise(&mut output, noise_ratio, &mut Noise::new(seed));
+    (input, output)
+}
+
+fn check_siso_accuracy(block: &Block, pair: &PairResponse, label: &str) {
+    let truth = |w: f64| block.response(w);
+    let (db, deg, count) = errors_against(pair, &truth, 0.9);
+    eprintln!(
+        "{label}: {count}/{} points with γ² ≥ 0.9, worst error {db:.3} dB, {deg:.2}°, valid range {:?}",
+        pair.omega.len(),
+        pair.valid_range
+    );
+    assert!(
+        count >= pair.omega.len() * 3 / 4,
+        "{label}: only {count} points with γ² ≥ 0.9"
+    );
+    assert!(db <= 0.5, "{label}: magnitude error {db} dB");
+    assert!(deg <= 3.0, "{label}: phase error {deg}°");
+}
+
+#[test]
+fn first_order_with_delay_from_two_joined_records() {
+    // K/(Ts+1)·e^{−sτ}, K = 2, T = 0.25 s, τ = 40 ms. Two 60 s sweeps with different
+    // trims and drifts, joined as the paper joins its two runs.
+    let block = Block::first_order(2.0, 0.25, 0.04);
+    let mut records = Vec::new();
+    for (seed, trim) in [(1u64, 0.3), (2, -0.1)] {
+        let (mut input, mut output) = siso_run(&block, paper_sweep(60.0), 0.1, seed);
+        for (k, v) in input.iter_mut().enumerate() {
+            *v += trim;
+            output[k] += 5.0 * trim + 1e-4 * k as f64; // output trim and a slow drift
+        }
+        records.push(record(
+            RATE,
+            [0.3, 31.4],
+            vec![("lat", input)],
+            vec![("p", output)],
+        ));
+    }
+    let group = RecordGroup::new(records).unwrap();
+    let document = compute_frequency_responses(&[group], &FrfOptions::default()).unwrap();
+    let pair = document.pair("lat", "p").unwrap();
+    assert_eq!(pair.omega.len(), 200);
+    check_siso_accuracy(&block, pair, "first order");
+    // With a single input the conditioned and plain responses coincide.
+    let siso = &document.siso[0];
+    for (a, b) in pair.mag_db.iter().zip(&siso.mag_db) {
+        assert!((a - b).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn second_order_with_delay() {
+    // K ωn²/(s² + 2ζωn s + ωn²)·e^{−sτ}: ωn = 6 rad/s, ζ = 0.3, τ = 30 ms.
+    let block = Block::second_order(1.5, 6.0, 0.3, 0.03);
+    let (input, output) = siso_run(&block, paper_sweep(90.0), 0.1, 7);
+    let rec = record(RATE, [0.3, 31.4], vec![("lon", input)], vec![("q", output)]);
+    let document = compute_frequency_responses(
+        &[RecordGroup::new(vec![rec]).unwrap()],
+        &FrfOptions::default(),
+    )
+    .unwrap();
+    let pair = document.pair("lon", "q").unwrap();
+    check_siso_accuracy(&block, pair, "second order");
+    let [lo, hi] = pair.valid_range.unwrap();
+    assert!(lo < 1.0 && hi > 20.0, "valid range {lo}..{hi}");
+}
+
+#[test]
+fn miso_conditioning_removes_the_bias_of_correlated_inputs() {
+    // y = H1·lat + H2·lon + noise, with lon = 0.8·lat + an independent multisine: the
+    // SISO estimate of y/lat picks up H2·G_lat,lon/G_lat,lat; conditioning removes it.
+    let sweep = paper_sweep(90.0);
+    let mut phases = Noise::new(5);
+    let tones: Vec<(f64, f64)> = (0..80)
+        .map(|j| {
+            let omega = 0.3 * (31.4f64 / 0.3).powf(j as f64 / 79.0);
+            (
+                omega,
+                std::f64::consts::TAU * (phases.gaussian() * 0.5 + 0.5),
+            )
+        })
+        .collect();
+    let lat = move |t: f64| sweep.value(t - TRIM_S);
+    let lon = move |t: f64| {
+        let multisine: f64 = tones.iter().map(|&(w, phi)| (w * t + phi).sin()).sum();
+        0.8 * sweep.value(t - TRIM_S) + 0.004 * multisine
+    };
+    let h1 = Block::first_order(1.0, 0.2, 0.02);
+    let h2 = Block::second_order(-1.5, 4.0, 0.5, 0.0);
+    let len = ((90.0 + 2.0 * TRIM_S) * RATE) as usize;
+    let mut y: Vec<f64> = h1
+        .simulate(&lat, RATE, len, 4)
+        .iter()
+        .zip(h2.simulate(&lon, RATE, len, 4))
+        .map(|(a, b)| a + b)
+        .collect();
+    add_noise(&mut y, 0.05, &mut Noise::new(9));
+    let rec = record(
+        RATE,
+        [0.3, 31.4],
+        vec![
+            ("lat", sample(&lat, RATE, len)),
+            ("lon", sample(&lon, RATE, len)),
+        ],
+        vec![("p", y)],
+    );
+    let analysis = analyse(
+        &[RecordGroup::new(vec![rec]).unwrap()],
+        &FrfOptions::default(),
+    )
+    .unwrap();
+    let document = &analysis.document;
+    // Multiple coherence ≥ partial coherence: 1 − γ²_y:u = (1 − γ²_y:r)(1 − γ²_py·r).
+    let multiple = &analysis.multiple_coherence[0];
+    let miso_pair = &document.pairs[0];
+    assert_eq!(multiple.omega, miso_pair.omega);
+    for (m, p) in multiple.coherence.iter().zip(&miso_pair.coherence) {
+        assert!(m + 1e-9 >= *p, "multiple {m} < partial {p}");
+    }
+    let truth = |w: f64| h1.response(w);
+    let miso = document.pair("lat", "p").unwrap();
+    let siso = document.siso.iter().find(|p| p.output == "p").unwrap();
+    let (siso_db, siso_deg, _) = errors_against(siso, &truth, 0.0);
+    let (db, deg, count) = errors_against(miso, &truth, 0.8);
+    eprintln!(
+        "MISO: {count}/{} points with partial γ² ≥ 0.8, worst {db:.3} dB {deg:.2}°; SISO worst {siso_db:.2} dB {siso_deg:.1}°",
+        miso.omega.len()
+    );
+    assert!(
+        siso_db > 3.0 || siso_deg > 15.0,
+        "SISO should be visibly biased"
+    );
+    assert!(
+        count >= miso.omega.len() / 2,
+        "only {count} points with γ² ≥ 0.8"
+    );
+    assert!(db <= 1.0, "MISO magnitude error {db} dB");
+    assert!(deg <= 5.0, "MISO phase error {deg}°");
+    // The inputs are strongly correlated, and the document says so.
+    let cc = &document.cross_coherence[0];
+    assert_eq!((cc.a.as_str(), cc.b.as_str()), ("lat", "lon"));
+    assert!(cc.mean > 0.5, "{}", cc.mean);
+}
+
+/// A dump of a simulated lateral sweep: lat swept, lon with small noise, ped and col
+/// constant; p responds to lat, everything else constant.
+fn simulated_dump(seconds: f64) -> Vec<u8> {
+    let rate = 100.0;
+    let sweep = Sweep {
+        omega_min: 0.5,
+        omega_max: 15.0,
+        duration: seconds,
+        amplitude: 0.05,
+    };
+    // The fades carry the trim around the sweep proper.
+    let len = ((seconds + 2.0 * TRIM_S) * rate) as usize;
+    let signal = move |t: f64| sweep.value(t - TRIM_S);
+    let lat = sample(&signal, rate, len);
+    let p = Block::first_order(3.0, 0.3, 0.0).simulate(&signal, rate, len, 4);
+    let mut noise = Noise::new(4);
+    let commands = lat
+        .iter()
+        .map(|&v| [v as f32, 0.004 * noise.gaussian() as f32, 0.1, 0.5])
+        .collect();
+    let meas = p
+        .iter()
+        .map(|&v| sweephold_protocol::Measurements {
+            p: v as f32,
+            ..Default::default()
+        })
+        .collect();
+    dump_bytes(&DumpSpec {
+        rate_hz: 100,
+        omega: [0.5, 15.0],
+        sweep_samples: len,
+        signals: Some((commands, meas)),
+        ..DumpSpec::default()
+    })
+}
+
+#[test]
+fn a_dump_end_to_end_with_notes_and_no_nan() {
+    let rec = load_dump_bytes(&simulated_dump(40.0), "sim.dump").unwrap();
+    let groups = crate::frf::group_by_primary(vec![rec]).unwrap();
+    let analysis = analyse(&groups, &FrfOptions::default()).unwrap();
+    let document = &analysis.document;
+    // Only p varies: one pair; ped and col unexcited; the other outputs constant.
+    assert_eq!(document.pairs.len(), 1);
+    let pair = document.pair("lat", "p").unwrap();
+    let truth = |w: f64| Block::first_order(3.0, 0.3, 0.0).response(w);
+    let (db, deg, count) = errors_against(pair, &truth, 0.9);
+    assert!(count > 100 && db < 0.5 && deg < 3.0, "{count} {db} {deg}");
+    let notes = document.notes.join("\n");
+    assert!(
+        notes.contains("`ped` not excited") && notes.contains("`col` not excited"),
+        "{notes}"
+    );
+    assert!(notes.contains("output `q` does not vary"), "{notes}");
+    assert_eq!(analysis.groups[0].conditioned_on, vec!["lon", "lat"]);
+    assert_eq!(document.cross_coherence.len(), 1);
+    // Valid JSON without NaN/null, and it reads back identically.
+    let json = serde_json::to_string(document).unwrap();
+    assert!(!json.contains("null") || json.contains("\"valid_range\":null"));
+    assert!(!json.contains("NaN"));
+    let back: crate::document::FrfDocument = serde_json::from_str(&json).unwrap();
+    assert_eq!(back.notes, document.notes);
+    // serde_json's default float parser may differ from the written value in the last bit.
+    for (a, b) in back.pairs[0]
+        .phase_deg
+        .iter()
+        .zip(&document.pairs[0].phase_deg)
+    {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0));
+    }
+}
+
+#[test]
+fn clear_refusals() {
+    let rec = load_dump_bytes(&simulated_dump(40.0), "sim.dump").unwrap();
+    // Too short for the band.
+    let mut short = rec.clone();
+    for c in short.inputs.iter_mut().chain(short.outputs.iter_mut()) {
+        c.values.truncate(300);
+    }
+    let err = compute_frequency_responses(
+        &[RecordGroup::new(vec![short]).unwrap()],
+        &FrfOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(err, FrfError::RecordTooShort { .. }), "{err}");
+    assert!(!err.to_string().contains('\n'));
+    // No excitation on the swept input.
+    let mut dead = rec.clone();
+    dead.inputs[0].values.iter_mut().for_each(|v| *v = 0.05);
+    let err = compute_frequency_responses(
+        &[RecordGroup::new(vec![dead]).unwrap()],
+        &FrfOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(err, FrfError::NoExcitation { .. }), "{err}");
+    // No band.
+    let mut unbanded = rec.clone();
+    unbanded.sweep_band = None;
+    let err = compute_frequency_responses(
+        &[RecordGroup::new(vec![unbanded.clone()]).unwrap()],
+        &FrfOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(err, FrfError::NoBand(_)), "{err}");
+    let banded = FrfOptions {
+        band: Some([1.0, 10.0]),
+        ..FrfOptions::default()
+    };
+    let document =
+        compute_frequency_responses(&[RecordGroup::new(vec![unbanded]).unwrap()], &banded).unwrap();
+    assert!((document.pairs[0].omega[0] - 1.0).abs() < 1e-12);
+    // Two groups for one axis.
+    let g = RecordGroup::new(vec![rec.clone()]).unwrap();
+    let err = compute_frequency_responses(&[g.clone(), g], &FrfOptions::default()).unwrap_err();
+    assert!(matches!(err, FrfError::DuplicateAxis(_)), "{err}");
+    // Bad options.
+    let bad = FrfOptions {
+        overlap: 1.5,
+        ..FrfOptions::default()
+    };
+    assert!(matches!(
+        compute_frequency_responses(&[RecordGroup::new(vec![rec]).unwrap()], &bad),
+        Err(FrfError::InvalidOption(_))
+    ));
+}
+
+#[test]
+fn collinear_controls_are_reported_not_emitted() {
+    // lon = exactly half of lat: the input matrix is singular at every frequency.
+    let sweep = paper_sweep(30.0);
+    let len = (30.0 * RATE) as usize;
+    let signal = move |t: f64| sweep.value(t);
+    let lat = sample(&signal, RATE, len);
+    let lon: Vec<f64> = lat.iter().map(|v| 0.5 * v).collect();
+    let p = Block::first_order(1.0, 0.2, 0.0).simulate(&signal, RATE, len, 2);
+    let mut rec = record(RATE, [1.0, 31.4], vec![("lat", lat)], vec![("p", p)]);
+    rec.inputs.push(Channel::new("lon", lon));
+    let document = compute_frequency_responses(
+        &[RecordGroup::new(vec![rec]).unwrap()],
+        &FrfOptions::default(),
+    )
+    .unwrap();
+    assert!(document.pairs[0].omega.is_empty());
+    assert!(document.pairs[0].valid_range.is_none());
+    assert_eq!(document.siso[0].omega.len(), 200);
+    assert!(
+        document
+            .notes
+            .iter()
+            .any(|n| n.contains("nearly collinear")),
+        "{:?}",
+        document.notes
+    );
+}

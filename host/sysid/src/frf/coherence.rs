@@ -1,0 +1,362 @@
+//! Coherence-derived quantities: random error, the valid frequency range of a pair, and
+//! the cross-control coherence between controls during a sweep.
+
+use crate::document::CrossCoherence;
+
+use super::analysis::{cross_control_curves, prepare_group};
+use super::options::FrfOptions;
+use super::records::{Record, RecordGroup};
+use super::FrfError;
+
+/// Smallest coherence used in [`random_error`], so that the error stays finite.
+const MIN_COHERENCE: f64 = 1e-12;
+
+/// Normalised random error of a response estimate (Bendat & Piersol; Tischler):
+///
+/// ```text
+///     εr = √(1 − γ²) / (|γ| · √(2·n_d))
+/// ```
+///
+/// with γ² the (partial) coherence and n_d the number of independent windows. γ² is
+/// clamped to [1e-12, 1] so the result is always finite.
+pub fn random_error(coherence: f64, independent_windows: f64) -> f64 {
+    let g2 = if coherence.is_finite() {
+        coherence.clamp(MIN_COHERENCE, 1.0)
+    } else {
+        MIN_COHERENCE
+    };
+    ((1.0 - g2) / g2).sqrt() / (2.0 * independent_windows.max(1e-12)).sqrt()
+}
+
+/// Equivalent number of independent averages of a Welch estimate: `segments` windows
+/// `window` long, each moved by `hop` samples (Welch 1967, Eq. 17):
+///
+/// ```text
+/// n_eq = K / (1 + 2 Σ_{j=1}^{K−1} (1 − j/K) ρ(j)²),   ρ(j) = Σ_i w_i w_{i+jH} / Σ_i w_i²
+/// ```
+///
+/// For a Hann window at 50 % overlap ρ(1) = 1/6 (so n_eq ≈ 0.95·K); at 80 % overlap
+/// neighbouring windows share most of their data and n_eq ≈ 0.42·K.
+pub fn welch_independent_averages(window: &[f64], hop: usize, segments: usize) -> f64 {
+    let energy: f64 = window.iter().map(|w| w * w).sum();
+    if segments == 0 || energy <= 0.0 || hop == 0 {
+        return segments as f64;
+    }
+    let k = segments as f64;
+    let mut correlation = 0.0;
+    for j in 1..segments {
+        let shift = j * hop;
+        if shift >= window.len() {
+            break;
+        }
+        let overlap: f64 = window
+            .iter()
+            .zip(&window[shift..])
+            .map(|(a, b)| a * b)
+            .sum();
+        let rho = overlap / energy;
+        correlation += (1.0 - j as f64 / k) * rho * rho;
+    }
+    k / (1.0 + 2.0 * correlation)
+}
+
+/// Magnitude-squared coherence corrected for its estimation bias. An estimate from n_d
+/// independent averages is biased upward, to first order (Carter, Knapp & Nuttall 1973;
+/// Bendat & Piersol §9.2.3)
+///
+/// ```text
+/// E[γ̂²] ≈ γ² + (1 − γ²)² / n_d
+/// ```
+///
+/// so two unrelated signals read about 1/n_d (0.4 from a window half the record long).
+/// Clipping at 0 leaves a floor of about 0.4/n_d on average for unrelated signals.
+/// Solving that quadratic for γ² gives the estimate returned here: 0 when γ̂² ≤ 1/n_d,
+/// nearly γ̂² when γ̂² is near 1 or n_d is large. Needs n_d > 2 (where the bias curve is
+/// monotonic); returns `None` otherwise.
+pub fn debiased_coherence(estimate: f64, independent_averages: f64) -> Option<f64> {
+    let n = independent_averages;
+    if n.is_nan() || n <= 2.0 || !estimate.is_finite() {
+        return None;
+    }
+    let c = estimate.clamp(0.0, 1.0);
+    let a = 1.0 / n;
+    if c <= a {
+        return Some(0.0);
+    }
+    // a·x² + (1 − 2a)·x + (a − c) = 0, the root in [0, 1].
+    let b = 1.0 - 2.0 * a;
+    let discriminant = (b * b - 4.0 * a * (a - c)).max(0.0);
+    Some(((-b + discriminant.sqrt()) / (2.0 * a)).clamp(0.0, 1.0))
+}
+
+/// The valid range of a response: the band where `coherence ≥ threshold`.
+///
+/// Coherence usually dips here and there (a lightly damped zero, the sweep's ends), so
+/// there may be several runs of valid points. One contiguous band is reported — the run
+/// spanning the most octaves (largest ω_hi/ω_lo), the earlier one on a tie — because a
+/// fit over a band with holes in it would weight points the data do not support. A run
+/// needs at least two points. `omega` must be ascending; returns `[ω_lo, ω_hi]`.
+pub fn valid_range(omega: &[f64], coherence: &[f64], threshold: f64) -> Option<[f64; 2]> {
+    let mut best: Option<(f64, [f64; 2])> = None;
+    let mut run_start: Option<usize> = None;
+    let len = omega.len().min(coherence.len());
+    // One step past the end closes a run that reaches the last point.
+    let flags = coherence[..len]
+        .iter()
+        .map(|&c| c >= threshold)
+        .chain([false]);
+    for (k, valid) in flags.enumerate() {
+        match (valid, run_start) {
+            (true, None) => run_start = Some(k),
+            (false, Some(start)) => {
+                run_start = None;
+                let end = k - 1;
+                if end > start {
+                    let span = (omega[end] / omega[start]).ln();
+                    if best.is_none_or(|(s, _)| span > s) {
+                        best = Some((span, [omega[start], omega[end]]));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    best.map(|(_, band)| band)
+}
+
+/// Mean cross-control coherence, over the sweep band, between the swept control of
+/// `record` and each other control that is excited in it (the guideline is ≤ 0.5; the
+/// paper's conditional attitude hold reaches 0.17).
+///
+/// The coherence of each control pair is computed with the same windows as the
+/// responses ([`FrfOptions`]: band, windows, overlap, points); at each frequency the
+/// bias-corrected estimates ([`debiased_coherence`]) of the windows that resolve it are
+/// averaged with weights equal to their equivalent numbers of independent averages
+/// ([`welch_independent_averages`]), and the result is averaged over the log-spaced grid
+/// points, i.e. evenly in log frequency. Controls with no excitation
+/// (RMS below `excitation_ratio` of the swept control's) have no defined coherence and
+/// are left out of the result.
+pub fn cross_control_coherence(
+    record: &Record,
+    opts: &FrfOptions,
+) -> Result<Vec<CrossCoherence>, FrfError> {
+    opts.validate()?;
+    let group = RecordGroup::new(vec![record.clone()])?;
+    let prepared = prepare_group(&group, opts, false)?;
+    let primary = prepared.primary.clone();
+    Ok(cross_control_curves(&prepared, opts)
+        .into_iter()
+        .filter(|curve| curve.a == primary || curve.b == primary)
+        .map(|curve| {
+            let other = if curve.a == primary {
+                curve.b.clone()
+            } else {
+                curve.a.clone()
+            };
+            CrossCoherence {
+                axis: primary.clone(),
+                a: primary.clone(),
+                b: other,
+                mean: curve.mean(),
+            }
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frf::testing::{record, Noise, Sweep};
+
+    #[test]
+    fn random_error_follows_the_formula() {
+        // γ² = 0.8, n_d = 4: √0.2/(√0.8·√8) = 0.5/√8
+        assert!((random_error(0.8, 4.0) - 0.5 / 8f64.sqrt()).abs() < 1e-12);
+        assert_eq!(random_error(1.0, 3.0), 0.0);
+        assert!(random_error(0.0, 3.0).is_finite());
+        assert!(random_error(f64::NAN, 3.0).is_finite());
+    }
+
+    #[test]
+    fn valid_range_picks_the_widest_run() {
+        let omega = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 16.0];
+        let coherence = [0.9, 0.9, 0.9, 0.2, 0.7, 0.7, 0.1, 0.9];
+        // Runs: 1..3 (ln 3) and 5..6 (ln 1.2); a single point does not count.
+        assert_eq!(valid_range(&omega, &coherence, 0.6), Some([1.0, 3.0]));
+        assert_eq!(valid_range(&omega, &coherence, 0.95), None);
+        assert_eq!(valid_range(&omega, &[0.7; 8], 0.6), Some([1.0, 16.0]));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+        /// The valid range is a run of valid points: every point inside it passes the
+        /// threshold and it cannot be extended by a valid neighbour.
+        #[test]
+        fn valid_range_is_a_maximal_valid_run(
+            coherence in proptest::collection::vec(0.0f64..1.0, 2..60),
+            threshold in 0.1f64..0.9,
+        ) {
+            let omega: Vec<f64> = (0..coherence.len()).map(|k| 1.1f64.powi(k as i32)).collect();
+            if let Some([lo, hi]) = valid_range(&omega, &coherence, threshold) {
+                let first = omega.iter().position(|&w| w == lo).unwrap();
+                let last = omega.iter().position(|&w| w == hi).unwrap();
+                proptest::prop_assert!(last > first);
+                proptest::prop_assert!(coherence[first..=last].iter().all(|&c| c >= threshold));
+                proptest::prop_assert!(first == 0 || coherence[first - 1] < threshold);
+                proptest::prop_assert!(last + 1 == omega.len() || coherence[last + 1] < threshold);
+            } else {
+                // No two neighbouring valid points anywhere.
+                proptest::prop_assert!(coherence
+                    .windows(2)
+                    .all(|w| w[0] < threshold || w[1] < threshold));
+            }
+        }
+    }
+
+    #[test]
+    fn independent_and_dependent_controls() {
+        let fs = 50.0;
+        let sweep = Sweep {
+            omega_min: 0.5,
+            omega_max: 20.0,
+            duration: 60.0,
+            amplitude: 0.05,
+        };
+        let len = (60.0 * fs) as usize;
+        let lat: Vec<f64> = (0..len).map(|k| sweep.value(k as f64 / fs)).collect();
+        let mut noise = Noise::new(11);
+        // lon: independent noise; ped: half the sweep plus a little noise; col: constant.
+        let lon: Vec<f64> = (0..len).map(|_| 0.02 * noise.gaussian()).collect();
+        let ped: Vec<f64> = lat
+            .iter()
+            .map(|v| 0.5 * v + 0.002 * noise.gaussian())
+            .collect();
+        let col = vec![0.3; len];
+        let p: Vec<f64> = lat.iter().map(|v| 2.0 * v).collect();
+        let rec = record(
+            fs,
+            [0.5, 20.0],
+            vec![("lat", lat), ("lon", lon), ("ped", ped), ("col", col)],
+            vec![("p", p)],
+        );
+        let result = cross_control_coherence(&rec, &FrfOptions::default()).unwrap();
+        assert_eq!(result.len(), 2, "{result:?}");
+        let lon = result.iter().find(|c| c.b == "lon").unwrap();
+        let ped = result.iter().find(|c| c.b == "ped").unwrap();
+        assert!(lon.mean < 0.3, "independent noise: {}", lon.mean);
+        assert!(ped.mean > 0.9, "dependent control: {}", ped.mean);
+        assert!(result.iter().all(|c| c.a == "lat" && c.axis == "lat"));
+    }
+
+    #[test]
+    fn welch_averages_of_hann_windows() {
+        let hann = |n: usize| -> Vec<f64> {
+            (0..n)
+                .map(|i| {
+                    (std::f64::consts::PI * (i as f64 + 0.5) / n as f64)
+                        .sin()
+                        .powi(2)
+                })
+                .collect()
+        };
+        let w = hann(1000);
+        // No overlap: every window independent.
+        assert!((welch_independent_averages(&w, 1000, 10) - 10.0).abs() < 1e-12);
+        // 50 % overlap: ρ(1) = 1/6 exactly for the periodic Hann window.
+        let k = 10.0;
+        let expected = k / (1.0 + 2.0 * (1.0 - 1.0 / k) / 36.0);
+        assert!((welch_independent_averages(&w, 500, 10) - expected).abs() < 1e-3);
+        // 80 % overlap: n_eq ≈ 0.42·K.
+        let n80 = welch_independent_averages(&w, 200, 100);
+        assert!((0.40..0.44).contains(&(n80 / 100.0)), "{n80}");
+    }
+
+    #[test]
+    fn debiasing_inverts_the_bias_model() {
+        for n in [2.5, 5.0, 20.0, 100.0] {
+            for truth in [0.0, 0.1, 0.3, 0.5, 0.8, 0.95, 1.0] {
+                let biased = truth + (1.0f64 - truth).powi(2) / n;
+                let back = debiased_coherence(biased, n).unwrap();
+                assert!((back - truth).abs() < 1e-9, "n {n}, truth {truth}: {back}");
+            }
+            assert_eq!(debiased_coherence(0.5 / n, n), Some(0.0));
+        }
+        assert_eq!(debiased_coherence(0.5, 1.5), None);
+        assert_eq!(debiased_coherence(f64::NAN, 10.0), None);
+    }
+
+    /// Two independent white noises: the raw coherence of a few-average estimate reads
+    /// about 1/n_d; the debiased one about 0.
+    #[test]
+    fn debiasing_removes_the_floor_of_unrelated_signals() {
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut noise = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let a: Vec<f64> = (0..40_000).map(|_| noise()).collect();
+        let b: Vec<f64> = (0..40_000).map(|_| noise()).collect();
+        let n = 4000;
+        let w: Vec<f64> = (0..n)
+            .map(|i| {
+                (std::f64::consts::PI * (i as f64 + 0.5) / n as f64)
+                    .sin()
+                    .powi(2)
+            })
+            .collect();
+        let hop = n / 5;
+        let (mut gaa, mut gbb, mut gab) = (
+            vec![0.0; 200],
+            vec![0.0; 200],
+            vec![num_complex::Complex64::new(0.0, 0.0); 200],
+        );
+        let mut segments = 0;
+        let mut start = 0;
+        while start + n <= a.len() {
+            for (bin, ((pa, pb), pab)) in gaa
+                .iter_mut()
+                .zip(gbb.iter_mut())
+                .zip(gab.iter_mut())
+                .enumerate()
+            {
+                let omega = std::f64::consts::TAU * (bin + 10) as f64 / n as f64;
+                let dft = |x: &[f64]| {
+                    x.iter().zip(&w).enumerate().fold(
+                        num_complex::Complex64::new(0.0, 0.0),
+                        |acc, (i, (v, wi))| {
+                            acc + num_complex::Complex64::from_polar(v * wi, -omega * i as f64)
+                        },
+                    )
+                };
+                let (xa, xb) = (dft(&a[start..start + n]), dft(&b[start..start + n]));
+                *pa += xa.norm_sqr();
+                *pb += xb.norm_sqr();
+                *pab += xa.conj() * xb;
+            }
+            segments += 1;
+            start += hop;
+        }
+        let n_eq = welch_independent_averages(&w, hop, segments);
+        let raw: f64 = (0..200)
+            .map(|k| gab[k].norm_sqr() / (gaa[k] * gbb[k]))
+            .sum::<f64>()
+            / 200.0;
+        let fixed: f64 = (0..200)
+            .map(|k| debiased_coherence(gab[k].norm_sqr() / (gaa[k] * gbb[k]), n_eq).unwrap())
+            .sum::<f64>()
+            / 200.0;
+        assert!(
+            (raw - 1.0 / n_eq).abs() < 0.5 / n_eq,
+            "raw {raw} vs 1/n_eq {}",
+            1.0 / n_eq
+        );
+        // Estimates above 1/n_d stay positive after the correction: the mean keeps a
+        // floor of about 0.4/n_eq instead of 1/n_eq.
+        assert!(
+            fixed < 0.5 * raw && fixed < 0.6 / n_eq,
+            "debiased {fixed} vs raw {raw}"
+        );
+    }
+}

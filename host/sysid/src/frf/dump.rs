@@ -1,0 +1,332 @@
+//! Records from telemetry dumps.
+//!
+//! The excitation record of a dump is every Sample whose phase is fade-in, sweep or
+//! fade-out, of the first test (Header) that has any, plus up to [`SETTLE_S`] of trim
+//! on either side. Inputs are the applied commands
+//! `lat lon ped col`; outputs are `u v w p q r ax ay az phi theta`. The rate and the
+//! swept axis come from the Header, the sweep band from its ω_min..ω_max. Ticks lost in
+//! transmission are filled by linear interpolation (and noted); a record missing more
+//! than 10 % of its ticks is refused.
+
+use std::path::Path;
+
+use sweephold_protocol::{Decoder, Frame, FrameError, Header, InputKind, Phase, Sample};
+
+use super::records::{Channel, Record};
+use super::FrfError;
+
+/// Names of the dump's input channels, in wire order.
+pub const DUMP_INPUTS: [&str; 4] = ["lat", "lon", "ped", "col"];
+
+/// Names of the dump's output channels.
+pub const DUMP_OUTPUTS: [&str; 11] = [
+    "u", "v", "w", "p", "q", "r", "ax", "ay", "az", "phi", "theta",
+];
+
+/// Largest fraction of missing ticks that is filled rather than refused.
+const MAX_MISSING_FRACTION: f64 = 0.1;
+
+/// Load the excitation record of a telemetry dump file.
+pub fn load_dump(path: impl AsRef<Path>) -> Result<Record, FrfError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|source| FrfError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    load_dump_bytes(&bytes, &path.display().to_string())
+}
+
+fn is_excitation(phase: Phase) -> bool {
+    matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
+}
+
+fn outputs_of(sample: &Sample) -> [f64; 11] {
+    let m = &sample.meas;
+    [
+        m.u, m.v, m.w, m.p, m.q, m.r, m.ax, m.ay, m.az, m.phi, m.theta,
+    ]
+    .map(f64::from)
+}
+
+/// Seconds of trim kept on either side of the excitation: contiguous trim-capture
+/// samples before the fade-in and done samples after the fade-out (the commands there are
+/// the pilot's sticks passed through, so inputs and outputs still match). Windows that
+/// cover the first and last seconds of the sweep — where it passes ω_min and ω_max —
+/// then see that data with both halves of their taper; without it the band edges are
+/// biased by a few degrees.
+pub const SETTLE_S: f64 = 2.0;
+
+/// Load the excitation record from the bytes of a dump; `source` names it in messages.
+pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, FrfError> {
+    let mut decoder = Decoder::new();
+    // Samples per test: a new segment starts at every Header.
+    let mut segments: Vec<(Option<Header>, Vec<Sample>)> = vec![(None, Vec::new())];
+    for result in decoder.feed(bytes) {
+        match result {
+            Ok(Frame::Header(h)) => segments.push((Some(h), Vec::new())),
+            Ok(Frame::Sample(sample)) => {
+                if let Some((_, samples)) = segments.last_mut() {
+                    samples.push(sample);
+                }
+            }
+            Ok(_) => {}
+            Err(mismatch @ FrameError::VersionMismatch { .. }) => {
+                return Err(FrfError::Protocol {
+                    path: source.into(),
+                    message: mismatch.to_string(),
+                })
+            }
+            Err(_) => {} // counted by the decoder; a damaged frame is skipped
+        }
+    }
+    let stats = decoder.stats();
+    let chosen = segments
+        .iter()
+        .find(|(_, samples)| samples.iter().any(|s| is_excitation(s.phase)));
+    let Some((record_header, all)) = chosen else {
+        let any_header = segments.iter().any(|(h, _)| h.is_some());
+        return Err(if stats.good_frames == 0 {
+            FrfError::NoSweep {
+                path: source.into(),
+                detail: "no valid frame".into(),
+            }
+        } else if !any_header {
+            FrfError::NoHeader {
+                path: source.into(),
+            }
+        } else {
+            FrfError::NoSweep {
+                path: source.into(),
+                detail: "no Sample in the fade-in, sweep or fade-out phases".into(),
+            }
+        });
+    };
+    let header = record_header.ok_or_else(|| FrfError::NoHeader {
+        path: source.into(),
+    })?;
+    record_from_samples(&header, all, source)
+}
+
+/// The excitation record of one test from its Header and its Samples in stream order
+/// (for callers that hold decoded frames, e.g. a campaign flown in-process): the samples
+/// in the fade-in, sweep and fade-out phases plus up to [`SETTLE_S`] of trim either side,
+/// with lost ticks filled. `source` names the record in messages.
+pub fn record_from_samples(
+    header: &Header,
+    all: &[Sample],
+    source: &str,
+) -> Result<Record, FrfError> {
+    let Some(first) = all.iter().position(|s| is_excitation(s.phase)) else {
+        return Err(FrfError::NoSweep {
+            path: source.into(),
+            detail: "no Sample in the fade-in, sweep or fade-out phases".into(),
+        });
+    };
+    let last = all
+        .iter()
+        .rposition(|s| is_excitation(s.phase))
+        .unwrap_or(0);
+    let settle = (SETTLE_S * f64::from(header.rate_hz)).round() as usize;
+    let before = all[..first]
+        .iter()
+        .rev()
+        .take(settle)
+        .take_while(|s| s.phase == Phase::TrimCapture)
+        .count();
+    let after = all[last + 1..]
+        .iter()
+        .take(settle)
+        .take_while(|s| s.phase == Phase::Done)
+        .count();
+    let samples = &all[first - before..=last + after];
+    let test = header.test;
+    if test.input != InputKind::Sweep {
+        return Err(FrfError::NoSweep {
+            path: source.into(),
+            detail: format!("the test is a {:?}, not a sweep", test.input),
+        });
+    }
+    if header.rate_hz == 0 {
+        return Err(FrfError::InvalidRecord {
+            source: source.into(),
+            message: "Header rate is 0 Hz".into(),
+        });
+    }
+
+    let first_tick = samples[0].tick;
+    let span = samples
+        .last()
+        .map_or(0, |s| s.tick.wrapping_sub(first_tick) as usize)
+        + 1;
+    let missing = span.saturating_sub(samples.len());
+    if missing as f64 > MAX_MISSING_FRACTION * span as f64 {
+        return Err(FrfError::InvalidRecord {
+            source: source.into(),
+            message: format!("{missing} of {span} sweep ticks are missing"),
+        });
+    }
+
+    // Rows on the tick grid, with gaps filled by linear interpolation.
+    let mut inputs: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(span)).collect();
+    let mut outputs: Vec<Vec<f64>> = (0..11).map(|_| Vec::with_capacity(span)).collect();
+    let mut previous: Option<(u32, [f64; 4], [f64; 11])> = None;
+    for sample in samples {
+        let command = sample.command.to_array().map(f64::from);
+        let output = outputs_of(sample);
+        if let Some((tick, last_in, last_out)) = previous {
+            let step = sample.tick.wrapping_sub(tick);
+            if step == 0 || step > span as u32 {
+                // A repeated or backwards tick (firmware restart): ignore the sample.
+                continue;
+            }
+            for k in 1..step {
+                let t = f64::from(k) / f64::from(step);
+                for (channel, (&a, &b)) in inputs.iter_mut().zip(last_in.iter().zip(&command)) {
+                    channel.push(a + t * (b - a));
+                }
+                for (channel, (&a, &b)) in outputs.iter_mut().zip(last_out.iter().zip(&output)) {
+                    channel.push(a + t * (b - a));
+                }
+            }
+        }
+        for (channel, &v) in inputs.iter_mut().zip(&command) {
+            channel.push(v);
+        }
+        for (channel, &v) in outputs.iter_mut().zip(&output) {
+            channel.push(v);
+        }
+        previous = Some((sample.tick, command, output));
+    }
+
+    let mut notes = Vec::new();
+    if missing > 0 {
+        notes.push(format!(
+            "{source}: {missing} missing ticks filled by linear interpolation"
+        ));
+    }
+    let record = Record {
+        source: source.into(),
+        sample_rate_hz: f64::from(header.rate_hz),
+        primary: test.primary.name().to_string(),
+        sweep_band: Some([
+            f64::from(test.sweep.omega_min),
+            f64::from(test.sweep.omega_max),
+        ]),
+        inputs: DUMP_INPUTS
+            .iter()
+            .zip(inputs)
+            .map(|(name, values)| Channel::new(*name, values))
+            .collect(),
+        outputs: DUMP_OUTPUTS
+            .iter()
+            .zip(outputs)
+            .map(|(name, values)| Channel::new(*name, values))
+            .collect(),
+        notes,
+    };
+    record.validate()?;
+    Ok(record)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frf::testing::{dump_bytes, DumpSpec};
+
+    #[test]
+    fn reads_the_excitation_of_a_dump() {
+        let spec = DumpSpec::default();
+        let bytes = dump_bytes(&spec);
+        let record = load_dump_bytes(&bytes, "test.dump").unwrap();
+        assert_eq!(record.primary, "lat");
+        assert_eq!(record.sample_rate_hz, 100.0);
+        assert_eq!(record.len(), spec.sweep_samples);
+        assert_eq!(record.inputs.len(), 4);
+        assert_eq!(record.outputs.len(), 11);
+        let band = record.sweep_band.unwrap();
+        assert!((band[0] - 0.5).abs() < 1e-6 && (band[1] - 20.0).abs() < 1e-5);
+        // The first excitation sample carries its own tick value in `p` (see DumpSpec).
+        assert_eq!(
+            record.output("p").unwrap()[0],
+            f64::from(spec.first_sweep_tick())
+        );
+    }
+
+    #[test]
+    fn keeps_two_seconds_of_trim_on_either_side() {
+        let spec = DumpSpec {
+            settle_samples: 300,
+            ..DumpSpec::default()
+        };
+        let record = load_dump_bytes(&dump_bytes(&spec), "settle.dump").unwrap();
+        assert_eq!(record.len(), spec.sweep_samples + 2 * 200);
+        let p = record.output("p").unwrap();
+        assert_eq!(p[0], f64::from(spec.first_sweep_tick() - 200));
+        assert!(p.windows(2).all(|w| w[1] - w[0] == 1.0));
+    }
+
+    #[test]
+    fn fills_lost_ticks() {
+        let spec = DumpSpec {
+            drop_every: Some(50),
+            ..DumpSpec::default()
+        };
+        let record = load_dump_bytes(&dump_bytes(&spec), "lossy.dump").unwrap();
+        assert_eq!(record.len(), spec.sweep_samples);
+        assert_eq!(record.notes.len(), 1);
+        // `p` carries the tick: interpolation restores it exactly.
+        let p = record.output("p").unwrap();
+        for pair in p.windows(2) {
+            assert!((pair[1] - pair[0] - 1.0).abs() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn record_from_decoded_samples() {
+        let spec = DumpSpec::default();
+        let mut decoder = Decoder::new();
+        let mut header = None;
+        let mut samples = Vec::new();
+        for frame in decoder.feed(&dump_bytes(&spec)).flatten() {
+            match frame {
+                Frame::Header(h) => header = Some(h),
+                Frame::Sample(s) => samples.push(s),
+                _ => {}
+            }
+        }
+        let header = header.unwrap();
+        let record = record_from_samples(&header, &samples, "in-process").unwrap();
+        assert_eq!(record.len(), spec.sweep_samples);
+        let idle: Vec<Sample> = samples
+            .iter()
+            .filter(|s| s.phase == Phase::Idle)
+            .copied()
+            .collect();
+        let err = record_from_samples(&header, &idle, "idle").unwrap_err();
+        assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
+    }
+
+    #[test]
+    fn refuses_dumps_without_a_sweep() {
+        let no_sweep = DumpSpec {
+            sweep_samples: 0,
+            ..DumpSpec::default()
+        };
+        let err = load_dump_bytes(&dump_bytes(&no_sweep), "idle.dump").unwrap_err();
+        assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
+        let headless = DumpSpec {
+            with_header: false,
+            ..DumpSpec::default()
+        };
+        let err = load_dump_bytes(&dump_bytes(&headless), "x.dump").unwrap_err();
+        assert!(matches!(err, FrfError::NoHeader { .. }), "{err}");
+        let err = load_dump_bytes(b"not a dump at all", "junk").unwrap_err();
+        assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
+        let doublet = DumpSpec {
+            input: InputKind::Doublet,
+            ..DumpSpec::default()
+        };
+        let err = load_dump_bytes(&dump_bytes(&doublet), "d.dump").unwrap_err();
+        assert!(err.to_string().contains("not a sweep"), "{err}");
+    }
+}

@@ -1,0 +1,206 @@
+//! Frequency responses from sweep records, the way CIFER computes them:
+//! FRESPID (windowed Chirp-Z spectra), MISOSA (multi-input conditioning) and COMPOSITE
+//! (blending several window lengths).
+//!
+//! The chain, one module per step:
+//!
+//! 1. [`records`] — [`Record`]s (from telemetry dumps via [`load_dump`] or from CSV via
+//!    [`load_csv`]) are gathered into one [`RecordGroup`] per swept axis; the records of
+//!    a group are detrended and joined into one excitation record.
+//! 2. [`spectra`] — Hann-tapered, overlapped windows of several lengths; each window of
+//!    each channel is transformed once with the [`chirp_z()`] transform and all auto- and
+//!    cross-spectra are formed from those transforms, then interpolated onto a
+//!    log-spaced frequency grid.
+//! 3. [`miso`] — per frequency and window length, the conditioned responses
+//!    `H = Guu⁻¹·Guy` (Cholesky solve), partial and multiple coherence.
+//! 4. [`composite`] — per frequency, the window-length estimates are blended with
+//!    weights 1/εr².
+//! 5. [`coherence`] — random error, valid ranges, cross-control coherence.
+//! 6. [`analysis`] — the whole computation into an [`FrfDocument`]; [`plots`] draws it.
+//!
+//! ```no_run
+//! use sysid::frf::{compute_frequency_responses, group_by_primary, load_dump, FrfOptions};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let records = vec![load_dump("lat-1.dump")?, load_dump("lat-2.dump")?, load_dump("lon.dump")?];
+//! let groups = group_by_primary(records)?; // lat (two records joined), lon
+//! let document = compute_frequency_responses(&groups, &FrfOptions::default())?;
+//! if let Some(pair) = document.pair("lat", "p") {
+//!     println!("lat → p valid over {:?} rad/s", pair.valid_range);
+//! }
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! [`FrfDocument`]: crate::document::FrfDocument
+
+pub mod analysis;
+pub mod chirp_z;
+pub mod coherence;
+pub mod composite;
+pub mod csv;
+pub mod dump;
+pub mod miso;
+pub mod options;
+pub mod plots;
+pub mod records;
+pub mod spectra;
+
+#[cfg(test)]
+pub(crate) mod testing;
+
+pub use analysis::{
+    analyse, compute_frequency_responses, CoherenceCurve, FrfAnalysis, GroupSummary,
+    MultipleCoherence,
+};
+pub use chirp_z::{chirp_z, ChirpZ};
+pub use coherence::{
+    cross_control_coherence, debiased_coherence, random_error, valid_range,
+    welch_independent_averages,
+};
+pub use csv::{load_csv, CsvColumns};
+pub use dump::{load_dump, load_dump_bytes, record_from_samples};
+pub use options::FrfOptions;
+pub use plots::write_plots;
+pub use records::{group_by_primary, Channel, Record, RecordGroup};
+
+use std::path::PathBuf;
+
+/// Why frequency responses could not be computed. Every message fits on one line.
+#[derive(Debug)]
+pub enum FrfError {
+    /// A file could not be read or written.
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The dump was written with another protocol major version.
+    Protocol {
+        /// The dump.
+        path: String,
+        /// The decoder's message.
+        message: String,
+    },
+    /// The dump has no Header frame: rate and primary axis are unknown.
+    NoHeader {
+        /// The dump.
+        path: String,
+    },
+    /// The dump holds no sweep (no Sample in the fade-in, sweep or fade-out phases, or
+    /// the test was not a sweep).
+    NoSweep {
+        /// The dump.
+        path: String,
+        /// What was found instead.
+        detail: String,
+    },
+    /// A CSV file is malformed.
+    Csv {
+        /// The file.
+        path: String,
+        /// Line number (1-based), 0 for the whole file.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A record is unusable (inconsistent lengths, non-finite values, bad rate, …).
+    InvalidRecord {
+        /// The record's source.
+        source: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Records grouped together disagree (primary axis, rate, channel names).
+    InconsistentGroup(String),
+    /// Two groups sweep the same axis.
+    DuplicateAxis(String),
+    /// No record was given.
+    NoRecords,
+    /// The sweep band is unknown (CSV records carry none and no band was given).
+    NoBand(String),
+    /// The records are too short for the band and windows asked for.
+    RecordTooShort {
+        /// Primary axis of the group.
+        axis: String,
+        /// Length of the (joined) record \[s\].
+        seconds: f64,
+        /// Why it is too short.
+        detail: String,
+    },
+    /// The swept input of a group does not move.
+    NoExcitation {
+        /// Primary axis of the group.
+        axis: String,
+    },
+    /// An option is out of range.
+    InvalidOption(String),
+    /// Writing a plot failed.
+    Plot(String),
+}
+
+impl std::fmt::Display for FrfError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FrfError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            FrfError::Protocol { path, message } => write!(f, "{path}: {message}"),
+            FrfError::NoHeader { path } => {
+                write!(
+                    f,
+                    "{path}: no Header frame (sample rate and swept axis unknown)"
+                )
+            }
+            FrfError::NoSweep { path, detail } => {
+                write!(f, "{path}: no sweep in this dump ({detail})")
+            }
+            FrfError::Csv {
+                path,
+                line,
+                message,
+            } if *line > 0 => {
+                write!(f, "{path}:{line}: {message}")
+            }
+            FrfError::Csv { path, message, .. } => write!(f, "{path}: {message}"),
+            FrfError::InvalidRecord { source, message } => write!(f, "{source}: {message}"),
+            FrfError::InconsistentGroup(message) => {
+                write!(f, "records do not fit together: {message}")
+            }
+            FrfError::DuplicateAxis(axis) => {
+                write!(
+                    f,
+                    "two record groups sweep `{axis}`: put its records in one group"
+                )
+            }
+            FrfError::NoRecords => write!(f, "no records given"),
+            FrfError::NoBand(message) => write!(f, "{message}"),
+            FrfError::RecordTooShort {
+                axis,
+                seconds,
+                detail,
+            } => {
+                write!(
+                    f,
+                    "{axis} sweep: record of {seconds:.1} s is too short: {detail}"
+                )
+            }
+            FrfError::NoExcitation { axis } => {
+                write!(
+                    f,
+                    "{axis} sweep: the swept input `{axis}` has no excitation (constant)"
+                )
+            }
+            FrfError::InvalidOption(message) => write!(f, "invalid option: {message}"),
+            FrfError::Plot(message) => write!(f, "plot failed: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for FrfError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            FrfError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,86 @@
+//! Settings of the frequency-response computation.
+
+use super::FrfError;
+
+/// Settings of [`compute_frequency_responses`](super::compute_frequency_responses).
+/// `FrfOptions::default()` gives the CIFER-like defaults listed per field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrfOptions {
+    /// Frequency band [ω_lo, ω_hi] rad/s of the output grid. `None`: the sweep band of
+    /// each group's records (ω_min..ω_max of the dump Header).
+    pub band: Option<[f64; 2]>,
+    /// Number of log-spaced grid frequencies (default 200).
+    pub points: usize,
+    /// Number of window lengths (default 5), log-spaced from ten periods of the highest
+    /// grid frequency (20π/ω_hi) up to half the record.
+    pub windows: usize,
+    /// Fraction of overlap between consecutive windows, in [0, 0.95] (default 0.8).
+    pub overlap: f64,
+    /// Coherence γ² at or above which a frequency counts as valid (default 0.6).
+    pub coherence_threshold: f64,
+    /// A control whose RMS is below this fraction of the swept control's RMS counts as
+    /// not excited and is left out of the conditioning (default 0.01).
+    pub excitation_ratio: f64,
+    /// Smallest normalised Cholesky pivot of the input spectral matrix accepted by the
+    /// MISO solve (default 1e-3): a pivot is 1 − (multiple coherence of that input with
+    /// the others), so 1e-3 rejects inputs that are > 99.9 % coherent with the rest.
+    pub min_pivot: f64,
+    /// Chirp-Z points per resolution bin 2π/T of a window (default 8): spectra are
+    /// computed on this linear grid and interpolated onto the log grid.
+    pub oversampling: usize,
+}
+
+impl Default for FrfOptions {
+    fn default() -> Self {
+        FrfOptions {
+            band: None,
+            points: 200,
+            windows: 5,
+            overlap: 0.8,
+            coherence_threshold: 0.6,
+            excitation_ratio: 0.01,
+            min_pivot: 1e-3,
+            oversampling: 8,
+        }
+    }
+}
+
+impl FrfOptions {
+    /// Check every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), FrfError> {
+        let bad = |message: String| Err(FrfError::InvalidOption(message));
+        if let Some([lo, hi]) = self.band {
+            if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+                return bad(format!("band {lo},{hi}: need 0 < WMIN < WMAX"));
+            }
+        }
+        if !(2..=100_000).contains(&self.points) {
+            return bad(format!("points {}: need 2..=100000", self.points));
+        }
+        if !(1..=20).contains(&self.windows) {
+            return bad(format!("windows {}: need 1..=20", self.windows));
+        }
+        if !(0.0..=0.95).contains(&self.overlap) {
+            return bad(format!("overlap {}: need 0..=0.95", self.overlap));
+        }
+        if !(0.0..=1.0).contains(&self.coherence_threshold) {
+            return bad(format!(
+                "coherence threshold {}: need 0..=1",
+                self.coherence_threshold
+            ));
+        }
+        if !(0.0..1.0).contains(&self.excitation_ratio) {
+            return bad(format!(
+                "excitation ratio {}: need 0..1",
+                self.excitation_ratio
+            ));
+        }
+        if !(self.min_pivot > 0.0 && self.min_pivot < 1.0) {
+            return bad(format!("min pivot {}: need 0 < p < 1", self.min_pivot));
+        }
+        if !(1..=64).contains(&self.oversampling) {
+            return bad(format!("oversampling {}: need 1..=64", self.oversampling));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,466 @@
+//! Excitation records and record groups, and how the records of a group are joined.
+//!
+//! **Joining.** The paper concatenates its two 90 s records per axis into one 180 s
+//! record. Each record has its own trim, so its mean and drift are removed first: every
+//! channel of every record is detrended (least-squares straight line removed). A
+//! detrended record still ends at some non-zero value, and butting two records together
+//! would put a step into every window that spans the join — broadband energy that is
+//! in no way a response to the input. So at every *join* (the end of one record and the
+//! start of the next, not the outer ends of the group) both records are tapered to zero
+//! with a raised cosine `½ − ½cos(πt/T_taper)` over `T_taper` = 2 % of that record
+//! (at least 2 samples). Inputs and outputs get the same taper, so the windows that
+//! span a join see the same slow gain on both sides of the input/output relation.
+
+use super::FrfError;
+
+/// One named channel of samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    /// Name: for inputs `lat lon ped col`, for outputs `u v w p q r ax ay az phi theta`
+    /// (CSV records may use any names).
+    pub name: String,
+    /// Samples at the record's rate.
+    pub values: Vec<f64>,
+}
+
+impl Channel {
+    /// A channel from a name and its samples.
+    pub fn new(name: impl Into<String>, values: Vec<f64>) -> Channel {
+        Channel {
+            name: name.into(),
+            values,
+        }
+    }
+}
+
+/// One excitation record: uniformly sampled inputs (controls) and outputs (responses).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Record {
+    /// Where it came from (file name), for messages.
+    pub source: String,
+    /// Sample rate \[Hz\].
+    pub sample_rate_hz: f64,
+    /// Name of the swept input (one of `inputs`), e.g. `lat`.
+    pub primary: String,
+    /// Sweep band [ω_min, ω_max] rad/s, when known (from the dump Header).
+    pub sweep_band: Option<[f64; 2]>,
+    /// Input channels (controls), e.g. `lat lon ped col`.
+    pub inputs: Vec<Channel>,
+    /// Output channels (responses), e.g. `u v w p q r ax ay az phi theta`.
+    pub outputs: Vec<Channel>,
+    /// Remarks made while loading (gaps filled, …); copied into the document's notes.
+    pub notes: Vec<String>,
+}
+
+impl Record {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.inputs
+            .first()
+            .or(self.outputs.first())
+            .map_or(0, |c| c.values.len())
+    }
+
+    /// `true` when the record has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Length in seconds.
+    pub fn duration_s(&self) -> f64 {
+        self.len() as f64 / self.sample_rate_hz
+    }
+
+    /// The samples of the input called `name`.
+    pub fn input(&self, name: &str) -> Option<&[f64]> {
+        self.inputs
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
+
+    /// The samples of the output called `name`.
+    pub fn output(&self, name: &str) -> Option<&[f64]> {
+        self.outputs
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
+
+    /// Check the record: positive finite rate, the primary among the inputs, at least one
+    /// output, equal channel lengths, unique names, finite samples, a sane band.
+    pub fn validate(&self) -> Result<(), FrfError> {
+        let bad = |message: String| {
+            Err(FrfError::InvalidRecord {
+                source: self.source.clone(),
+                message,
+            })
+        };
+        if !(self.sample_rate_hz.is_finite() && self.sample_rate_hz > 0.0) {
+            return bad(format!("sample rate {} Hz", self.sample_rate_hz));
+        }
+        if self.input(&self.primary).is_none() {
+            return bad(format!(
+                "swept input `{}` is not among the inputs",
+                self.primary
+            ));
+        }
+        if self.outputs.is_empty() {
+            return bad("no output channels".into());
+        }
+        let len = self.len();
+        let channels = self.inputs.iter().chain(&self.outputs);
+        let mut names = std::collections::HashSet::new();
+        for channel in channels {
+            if !names.insert(channel.name.as_str()) {
+                return bad(format!("channel `{}` appears twice", channel.name));
+            }
+            if channel.values.len() != len {
+                return bad(format!(
+                    "channel `{}` has {} samples, others {len}",
+                    channel.name,
+                    channel.values.len()
+                ));
+            }
+            if let Some(i) = channel.values.iter().position(|v| !v.is_finite()) {
+                return bad(format!(
+                    "channel `{}` sample {i} is not finite",
+                    channel.name
+                ));
+            }
+        }
+        if let Some([lo, hi]) = self.sweep_band {
+            if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+                return bad(format!("sweep band {lo}..{hi} rad/s"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The records of one swept axis, analysed as one joined record.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordGroup {
+    records: Vec<Record>,
+}
+
+impl RecordGroup {
+    /// Group records that sweep the same input at the same rate with the same channels.
+    pub fn new(records: Vec<Record>) -> Result<RecordGroup, FrfError> {
+        let first = records.first().ok_or(FrfError::NoRecords)?;
+        for record in &records {
+            record.validate()?;
+            let names = |cs: &[Channel]| cs.iter().map(|c| c.name.clone()).collect::<Vec<_>>();
+            let mismatch = if record.primary != first.primary {
+                Some(format!(
+                    "sweeps `{}`, not `{}`",
+                    record.primary, first.primary
+                ))
+            } else if (record.sample_rate_hz - first.sample_rate_hz).abs()
+                > 1e-9 * first.sample_rate_hz
+            {
+                Some(format!(
+                    "is sampled at {} Hz, not {} Hz",
+                    record.sample_rate_hz, first.sample_rate_hz
+                ))
+            } else if names(&record.inputs) != names(&first.inputs)
+                || names(&record.outputs) != names(&first.outputs)
+            {
+                Some("has other channels".to_string())
+            } else {
+                None
+            };
+            if let Some(what) = mismatch {
+                return Err(FrfError::InconsistentGroup(format!(
+                    "{} {what} than {}",
+                    record.source, first.source
+                )));
+            }
+        }
+        Ok(RecordGroup { records })
+    }
+
+    /// The records, in joining order.
+    pub fn records(&self) -> &[Record] {
+        &self.records
+    }
+
+    /// Name of the swept input.
+    pub fn primary(&self) -> &str {
+        &self.records[0].primary
+    }
+
+    /// Sample rate \[Hz\].
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.records[0].sample_rate_hz
+    }
+
+    /// Total samples over all records.
+    pub fn len(&self) -> usize {
+        self.records.iter().map(Record::len).sum()
+    }
+
+    /// `true` when no record has samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The sweep band covering every record's band: [min ω_min, max ω_max].
+    pub fn sweep_band(&self) -> Option<[f64; 2]> {
+        self.records
+            .iter()
+            .filter_map(|r| r.sweep_band)
+            .reduce(|a, b| [a[0].min(b[0]), a[1].max(b[1])])
+    }
+
+    /// The records detrended, tapered at the joins and concatenated (module docs).
+    pub fn joined(&self) -> JoinedRecord {
+        let count = self.records.len();
+        let join = |channel_of: &dyn Fn(&Record) -> &[Channel], index: usize| {
+            let mut values = Vec::with_capacity(self.len());
+            for (r, record) in self.records.iter().enumerate() {
+                let mut piece = channel_of(record)[index].values.clone();
+                remove_line(&mut piece);
+                let taper = (piece.len() / 50).max(2);
+                if r > 0 {
+                    taper_start(&mut piece, taper);
+                }
+                if r + 1 < count {
+                    taper_end(&mut piece, taper);
+                }
+                values.extend_from_slice(&piece);
+            }
+            values
+        };
+        let first = &self.records[0];
+        let inputs = (0..first.inputs.len())
+            .map(|i| Channel::new(first.inputs[i].name.clone(), join(&|r| &r.inputs, i)))
+            .collect();
+        let outputs = (0..first.outputs.len())
+            .map(|i| Channel::new(first.outputs[i].name.clone(), join(&|r| &r.outputs, i)))
+            .collect();
+        JoinedRecord {
+            sample_rate_hz: first.sample_rate_hz,
+            primary: first.primary.clone(),
+            inputs,
+            outputs,
+        }
+    }
+}
+
+/// The detrended, joined channels of a [`RecordGroup`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct JoinedRecord {
+    /// Sample rate \[Hz\].
+    pub sample_rate_hz: f64,
+    /// Name of the swept input.
+    pub primary: String,
+    /// Input channels.
+    pub inputs: Vec<Channel>,
+    /// Output channels.
+    pub outputs: Vec<Channel>,
+}
+
+impl JoinedRecord {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.inputs.first().map_or(0, |c| c.values.len())
+    }
+
+    /// `true` when empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Length \[s\].
+    pub fn duration_s(&self) -> f64 {
+        self.len() as f64 / self.sample_rate_hz
+    }
+}
+
+/// Put records into one [`RecordGroup`] per swept input, in order of first appearance.
+pub fn group_by_primary(records: Vec<Record>) -> Result<Vec<RecordGroup>, FrfError> {
+    if records.is_empty() {
+        return Err(FrfError::NoRecords);
+    }
+    let mut by_axis: Vec<(String, Vec<Record>)> = Vec::new();
+    for record in records {
+        match by_axis.iter_mut().find(|(axis, _)| *axis == record.primary) {
+            Some((_, list)) => list.push(record),
+            None => by_axis.push((record.primary.clone(), vec![record])),
+        }
+    }
+    by_axis
+        .into_iter()
+        .map(|(_, list)| RecordGroup::new(list))
+        .collect()
+}
+
+/// Root mean square.
+pub(crate) fn rms(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt()
+}
+
+/// Subtract the least-squares line `a + b·(n − n̄)` (mean and trend).
+pub(crate) fn remove_line(values: &mut [f64]) {
+    let len = values.len();
+    if len == 0 {
+        return;
+    }
+    let centre = (len as f64 - 1.0) / 2.0;
+    let mean = values.iter().sum::<f64>() / len as f64;
+    // b = Σ(n − n̄)(x_n − x̄) / Σ(n − n̄)²
+    let (mut num, mut den) = (0.0, 0.0);
+    for (n, &v) in values.iter().enumerate() {
+        let d = n as f64 - centre;
+        num += d * (v - mean);
+        den += d * d;
+    }
+    let slope = if den > 0.0 { num / den } else { 0.0 };
+    for (n, v) in values.iter_mut().enumerate() {
+        *v -= mean + slope * (n as f64 - centre);
+    }
+}
+
+/// Raised-cosine gain rising from 0 (sample 0) towards 1 over `len` samples.
+fn ramp(n: usize, len: usize) -> f64 {
+    0.5 - 0.5 * (std::f64::consts::PI * n as f64 / len as f64).cos()
+}
+
+fn taper_start(values: &mut [f64], len: usize) {
+    let len = len.min(values.len());
+    for (n, v) in values.iter_mut().take(len).enumerate() {
+        *v *= ramp(n, len);
+    }
+}
+
+fn taper_end(values: &mut [f64], len: usize) {
+    let len = len.min(values.len());
+    for (n, v) in values.iter_mut().rev().take(len).enumerate() {
+        *v *= ramp(n, len);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(source: &str, primary: &str, lat: Vec<f64>, p: Vec<f64>) -> Record {
+        Record {
+            source: source.into(),
+            sample_rate_hz: 100.0,
+            primary: primary.into(),
+            sweep_band: Some([1.0, 10.0]),
+            inputs: vec![Channel::new("lat", lat)],
+            outputs: vec![Channel::new("p", p)],
+            notes: vec![],
+        }
+    }
+
+    #[test]
+    fn line_removal_leaves_zero_mean_and_no_trend() {
+        let mut values: Vec<f64> = (0..101).map(|n| 3.0 + 0.25 * n as f64).collect();
+        remove_line(&mut values);
+        assert!(values.iter().all(|v| v.abs() < 1e-9));
+    }
+
+    #[test]
+    fn joins_have_no_step() {
+        // Two records with different trims and drifts: joined naively they would jump.
+        let a = record(
+            "a",
+            "lat",
+            (0..400).map(|n| 1.0 + 0.01 * n as f64).collect(),
+            vec![0.5; 400],
+        );
+        let b = record(
+            "b",
+            "lat",
+            (0..400).map(|n| -2.0 + (n as f64 * 0.3).sin()).collect(),
+            (0..400).map(|n| 7.0 + (n as f64 * 0.2).cos()).collect(),
+        );
+        let joined = RecordGroup::new(vec![a, b]).unwrap().joined();
+        assert_eq!(joined.len(), 800);
+        for channel in joined.inputs.iter().chain(&joined.outputs) {
+            let v = &channel.values;
+            // Around the join both sides go to zero: no step, small differences only.
+            assert!(
+                v[399].abs() < 0.01 && v[400].abs() < 1e-12,
+                "{:?}",
+                &v[398..402]
+            );
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            assert!(mean.abs() < 0.05, "{mean}");
+        }
+    }
+
+    #[test]
+    fn groups_reject_mixed_axes_and_rates() {
+        let a = record("a", "lat", vec![0.0; 10], vec![0.0; 10]);
+        let mut b = record("b", "lat", vec![0.0; 10], vec![0.0; 10]);
+        b.sample_rate_hz = 50.0;
+        assert!(matches!(
+            RecordGroup::new(vec![a.clone(), b]),
+            Err(FrfError::InconsistentGroup(_))
+        ));
+        let mut c = a.clone();
+        c.inputs.push(Channel::new("lon", vec![0.0; 10]));
+        c.primary = "lon".into();
+        let groups = group_by_primary(vec![a.clone(), c, a]).unwrap();
+        assert_eq!(groups.len(), 2);
+        assert_eq!(groups[0].records().len(), 2);
+        assert_eq!(groups[1].primary(), "lon");
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(32))]
+        /// Whatever the trims and drifts, the joined record has no step at the joins:
+        /// both sides reach zero, and near a join the signal changes no faster than the
+        /// signal itself plus the taper allow.
+        #[test]
+        fn joins_never_step(
+            offsets in proptest::collection::vec(-10.0f64..10.0, 3),
+            slopes in proptest::collection::vec(-0.1f64..0.1, 3),
+            len in 100usize..400,
+        ) {
+            let records: Vec<Record> = offsets
+                .iter()
+                .zip(&slopes)
+                .enumerate()
+                .map(|(r, (&offset, &slope))| {
+                    let values: Vec<f64> = (0..len)
+                        .map(|n| offset + slope * n as f64 + (0.1 * n as f64 + r as f64).sin())
+                        .collect();
+                    record(&format!("r{r}"), "lat", values.clone(), values)
+                })
+                .collect();
+            let joined = RecordGroup::new(records).unwrap().joined();
+            let v = &joined.inputs[0].values;
+            for join in [len, 2 * len] {
+                proptest::prop_assert!(v[join - 1].abs() < 1e-9 && v[join].abs() < 1e-9);
+                let near = v[join - 5..join + 5].windows(2).map(|w| (w[1] - w[0]).abs());
+                // |Δ(x·ramp)| ≤ |Δx| + max|x|·max|Δramp|: sin(0.1n) moves ≤ 0.1 per
+                // sample and the raised cosine ≤ π/(2·T_taper).
+                let taper = (len / 50).max(2) as f64;
+                let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let bound = 0.1 + largest * std::f64::consts::PI / (2.0 * taper) + 1e-9;
+                proptest::prop_assert!(near.fold(0.0, f64::max) <= bound);
+            }
+        }
+    }
+
+    #[test]
+    fn validation_catches_bad_records() {
+        let mut r = record("x", "lat", vec![0.0; 10], vec![0.0; 9]);
+        assert!(r.validate().is_err());
+        r.outputs[0].values.push(f64::NAN);
+        assert!(r.validate().is_err());
+        r.outputs[0].values[9] = 0.0;
+        assert!(r.validate().is_ok());
+        r.primary = "lon".into();
+        assert!(r.validate().is_err());
+    }
+}

@@ -1,0 +1,146 @@
+//! `sweephold fly`: the firmware's tick in lockstep with the simulator.
+
+use sweephold_tests::{fly, fly_args, Scratch};
+
+/// The same seed gives byte-identical dumps; another seed does not.
+#[test]
+fn same_seed_same_bytes() {
+    let (a, b, c) = (
+        Scratch::new("seed-a"),
+        Scratch::new("seed-b"),
+        Scratch::new("seed-c"),
+    );
+    let run = |dir: &Scratch, seed: &str| {
+        let out = dir.path().to_str().unwrap();
+        fly(&fly_args(&[
+            "--axes", "lat", "--t-rec", "10", "--seed", seed, "--out", out,
+        ]))
+    };
+    let first = run(&a, "7");
+    run(&b, "7");
+    run(&c, "8");
+    for dump in &first.dumps {
+        let name = dump.file_name().unwrap();
+        let bytes_a = std::fs::read(a.path().join(name)).unwrap();
+        let bytes_b = std::fs::read(b.path().join(name)).unwrap();
+        let bytes_c = std::fs::read(c.path().join(name)).unwrap();
+        assert!(
+            bytes_a.len() > 100_000,
+            "a real record: {} bytes",
+            bytes_a.len()
+        );
+        assert_eq!(
+            bytes_a, bytes_b,
+            "{name:?} differs between two runs of seed 7"
+        );
+        assert_ne!(bytes_a, bytes_c, "{name:?} is the same for seeds 7 and 8");
+    }
+    let summary_a = std::fs::read_to_string(a.path().join("summary.json")).unwrap();
+    let summary_b = std::fs::read_to_string(b.path().join("summary.json")).unwrap();
+    assert_eq!(summary_a, summary_b);
+}
+
+/// The pilot moving the stick aborts the test with `pilot_override`, at the time given.
+#[test]
+fn pilot_override_aborts() {
+    let dir = Scratch::new("override");
+    let out = dir.path().to_str().unwrap();
+    let outcome = fly(&fly_args(&[
+        "--axes",
+        "lon",
+        "--t-rec",
+        "20",
+        "--pilot-override",
+        "4",
+        "--out",
+        out,
+    ]));
+    for run in &outcome.summary.runs {
+        assert!(run.aborted, "{}", run.file);
+        assert_eq!(run.abort_reason.as_deref(), Some("pilot_override"));
+        // Arming after 10 idle ticks (0.05 s), override at 4 s after arming.
+        assert!(
+            (run.duration_s - 4.05).abs() < 0.02,
+            "aborted at {} s",
+            run.duration_s
+        );
+    }
+}
+
+/// A sensor that keeps dropping samples aborts the test as stale.
+#[test]
+fn sensor_dropout_aborts_as_stale() {
+    let dir = Scratch::new("dropout");
+    let out = dir.path().to_str().unwrap();
+    let outcome = fly(&fly_args(&[
+        "--axes",
+        "lat",
+        "--t-rec",
+        "20",
+        "--sensor-dropout",
+        "0.6",
+        "--out",
+        out,
+    ]));
+    for run in &outcome.summary.runs {
+        assert_eq!(
+            run.abort_reason.as_deref(),
+            Some("sensor_stale"),
+            "{}",
+            run.file
+        );
+    }
+}
+
+/// Spikes and gusts end in the documented behaviour — the hold, or an abort on a limit —
+/// and never in an error of the tool.
+#[test]
+fn spikes_and_gusts_end_in_hold_or_a_limit_abort() {
+    let dir = Scratch::new("spike");
+    let out = dir.path().to_str().unwrap();
+    let outcome = fly(&fly_args(&[
+        "--axes",
+        "lat,ped",
+        "--t-rec",
+        "20",
+        "--sensor-spike",
+        "0.01",
+        "--gust",
+        "1.0",
+        "--out",
+        out,
+    ]));
+    assert_eq!(outcome.summary.runs.len(), 4);
+    for run in &outcome.summary.runs {
+        match run.abort_reason.as_deref() {
+            None => assert!(run.max_abs_deg.phi < 20.0 && run.max_abs_deg.theta < 20.0),
+            Some(reason) => assert!(
+                ["attitude_limit", "rate_limit"].contains(&reason),
+                "{}: unexpected abort {reason}",
+                run.file
+            ),
+        }
+    }
+}
+
+/// Bad arguments are refused before anything is flown or written.
+#[test]
+fn bad_configuration_is_refused_up_front() {
+    let dir = Scratch::new("refused");
+    let out = dir.path().join("never");
+    let args = fly_args(&[
+        "--axes",
+        "lat",
+        "--rate",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let error = sweephold::fly::fly(&args, &|| {
+        Box::new(sweephold::fly::link::InProcessLink::new())
+    })
+    .err()
+    .expect("20 Hz is refused");
+    assert!(error.to_string().contains("rate"), "{error}");
+    assert!(!out.exists(), "nothing written");
+}
