@@ -167,6 +167,16 @@ fn write_report(out: &mut String, result: &sysid::fit::FitResult) -> std::fmt::R
     }
     writeln!(out)?;
     write!(out, "{}", cost_table(result))?;
+    if !result.skipped_pairs.is_empty() {
+        writeln!(out, "\nskipped (no usable coherent range in the data):")?;
+        for pair in &result.skipped_pairs {
+            writeln!(
+                out,
+                "  {}/{} (line {}): {}",
+                pair.output, pair.input, pair.line, pair.reason
+            )?;
+        }
+    }
     Ok(())
 }
 

@@ -111,6 +111,11 @@ pub enum FitError {
         /// Line of the pair in the structure file.
         line: usize,
     },
+    /// Every pair of the structure was skipped for lack of a usable coherent range.
+    NoUsablePairs {
+        /// How many pairs were skipped.
+        skipped: usize,
+    },
     /// The pair's range does not overlap the frequencies of its data, or the data are
     /// malformed (lengths differ, frequencies not ascending or not positive, NaN).
     BadPairData {
@@ -158,6 +163,10 @@ impl fmt::Display for FitError {
             } => write!(
                 f,
                 "line {line}: pair {output}/{input} is not in the frequency-response data"
+            ),
+            Self::NoUsablePairs { skipped } => write!(
+                f,
+                "none of the {skipped} pairs has a usable coherent range in the data (see the skipped pairs; lower the coherence threshold of `sweephold frf` or give explicit ranges)"
             ),
             Self::NoValidRange {
                 input,

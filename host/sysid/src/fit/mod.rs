@@ -63,6 +63,10 @@ pub struct FitOptions {
     pub insensitivity_limit_percent: f64,
     /// Flag a parameter pair correlated beyond this |ρ|.
     pub correlation_limit: f64,
+    /// An `auto` pair is fitted only when its valid range (after the structure's
+    /// `auto_range_limit`) spans at least this ratio ω_hi/ω_lo; narrower ones — usually a
+    /// sliver where noise crossed the coherence threshold — are skipped and reported.
+    pub min_auto_range_ratio: f64,
 }
 
 impl Default for FitOptions {
@@ -79,6 +83,7 @@ impl Default for FitOptions {
             cramer_rao_limit_percent: 20.0,
             insensitivity_limit_percent: 10.0,
             correlation_limit: 0.9,
+            min_auto_range_ratio: 3.0,
         }
     }
 }
@@ -181,6 +186,8 @@ pub struct FitResult {
     pub minimum_confirmed: bool,
     /// Reduction steps (empty without `reduce`).
     pub reduction: Vec<ReductionStep>,
+    /// `auto` pairs left out because their data support no usable range.
+    pub skipped_pairs: Vec<SkippedPair>,
 }
 
 impl FitResult {
@@ -217,13 +224,86 @@ pub fn fit(
     data: &FrfDocument,
     options: &FitOptions,
 ) -> Result<FitResult, FitError> {
-    let grids = cost::build_pair_grids(structure, data, options.points_per_pair)?;
-    let result = fit_on_grids(structure, &grids, options)?;
-    if options.reduce {
-        reduce::reduce(result, &grids, options)
-    } else {
-        Ok(result)
+    let (usable, skipped) = usable_pairs(structure, data, options.min_auto_range_ratio);
+    if usable.pairs.is_empty() && !structure.pairs.is_empty() {
+        return Err(FitError::NoUsablePairs {
+            skipped: skipped.len(),
+        });
     }
+    let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
+    let mut result = fit_on_grids(&usable, &grids, options)?;
+    if options.reduce {
+        result = reduce::reduce(result, &grids, options)?;
+    }
+    result.skipped_pairs = skipped;
+    Ok(result)
+}
+
+/// A pair of the structure left out of the fit, and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SkippedPair {
+    /// Control name.
+    pub input: String,
+    /// Output name.
+    pub output: String,
+    /// Line of the pair in the structure file.
+    pub line: usize,
+    /// Why it was left out.
+    pub reason: String,
+}
+
+/// The structure with its `auto` pairs whose data support no usable range removed: no
+/// valid range at all, or one (after `auto_range_limit`) narrower than `min_ratio`.
+/// Pairs missing from the data are kept, so that the fit reports them as errors.
+pub fn usable_pairs(
+    structure: &ModelStructure,
+    data: &FrfDocument,
+    min_ratio: f64,
+) -> (ModelStructure, Vec<SkippedPair>) {
+    let mut usable = structure.clone();
+    let mut skipped = Vec::new();
+    usable.pairs.retain(|spec| {
+        if spec.range != structure::PairRange::Auto {
+            return true;
+        }
+        let Some(pair) = data.pair(&spec.input, &spec.output) else {
+            return true;
+        };
+        let reason = match pair.valid_range {
+            None => Some("coherence never reaches the threshold".to_string()),
+            Some(band) => {
+                let [lo, hi] = match structure.auto_range_limit {
+                    Some([lo, hi]) => [band[0].max(lo), band[1].min(hi)],
+                    None => band,
+                };
+                (hi < min_ratio * lo).then(|| {
+                    format!(
+                        "valid range {:.3}-{:.3} rad/s{} spans less than a factor {min_ratio}",
+                        band[0],
+                        band[1],
+                        if structure.auto_range_limit.is_some() {
+                            " (clipped)"
+                        } else {
+                            ""
+                        }
+                    )
+                })
+            }
+        };
+        match reason {
+            Some(reason) => {
+                skipped.push(SkippedPair {
+                    input: spec.input.clone(),
+                    output: spec.output.clone(),
+                    line: spec.line,
+                    reason,
+                });
+                false
+            }
+            None => true,
+        }
+    });
+    (usable, skipped)
 }
 
 /// Base-parameter vector with the free entries replaced by `free_values`.
@@ -363,6 +443,7 @@ pub(crate) fn fit_on_grids(
         starts,
         minimum_confirmed,
         reduction: Vec::new(),
+        skipped_pairs: Vec::new(),
     })
 }
 
@@ -562,7 +643,7 @@ mod tests {
     }
 
     #[test]
-    fn auto_range_without_valid_range_is_an_error() {
+    fn auto_pairs_without_a_valid_range_leave_nothing_to_fit() {
         let structure = first_order_structure();
         let mut document = synthetic_document(
             &structure.model(&structure.values()).unwrap(),
@@ -572,7 +653,55 @@ mod tests {
         for pair in &mut document.pairs {
             pair.valid_range = None;
         }
-        let error = fit(&structure, &document, &FitOptions::default()).unwrap_err();
-        assert!(matches!(error, FitError::NoValidRange { .. }), "{error}");
+        // The explicit pair still fits; the auto pair is skipped and reported.
+        let result = fit(&structure, &document, &FitOptions::default()).unwrap();
+        assert_eq!(result.pairs.len(), 1);
+        assert_eq!(result.skipped_pairs.len(), 1);
+        assert_eq!(result.skipped_pairs[0].output, "y");
+        // With only auto pairs, nothing is left to fit: an error, not an empty fit.
+        let mut only_auto = structure.clone();
+        only_auto
+            .pairs
+            .retain(|p| p.range == structure::PairRange::Auto);
+        let error = fit(&only_auto, &document, &FitOptions::default()).unwrap_err();
+        assert!(
+            matches!(error, FitError::NoUsablePairs { skipped: 1 }),
+            "{error}"
+        );
+        assert!(
+            error.to_string().contains("usable coherent range"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn sliver_ranges_are_skipped_and_reported() {
+        let mut structure = first_order_structure();
+        structure
+            .pairs
+            .retain(|p| p.range == structure::PairRange::Auto);
+        assert_eq!(structure.pairs.len(), 1);
+        let mut document = synthetic_document(
+            &structure.model(&structure.values()).unwrap(),
+            &structure,
+            30,
+        );
+        // A factor 2 is too narrow at the default ratio 3; a factor 4 is fine.
+        for (band, kept) in [([1.0, 2.0], false), ([1.0, 4.0], true)] {
+            for pair in &mut document.pairs {
+                pair.valid_range = Some(band);
+            }
+            let (usable, skipped) = usable_pairs(&structure, &document, 3.0);
+            assert_eq!(
+                usable.pairs.len() == structure.pairs.len(),
+                kept,
+                "{band:?}"
+            );
+            assert_eq!(skipped.len(), usize::from(!kept));
+            if let Some(s) = skipped.first() {
+                assert!(s.reason.contains("factor 3"), "{}", s.reason);
+                assert_eq!(s.line, structure.pairs[0].line);
+            }
+        }
     }
 }

@@ -92,6 +92,9 @@ pub struct ModelDocument {
     pub minimum_confirmed: bool,
     /// Reduction steps (empty without `--reduce`).
     pub reduction: Vec<ReductionStep>,
+    /// `auto` pairs left out of the fit, and why.
+    #[serde(default)]
+    pub skipped_pairs: Vec<super::SkippedPair>,
 }
 
 fn finite(value: Option<f64>) -> Option<f64> {
@@ -141,6 +144,7 @@ impl ModelDocument {
             starts: result.starts.clone(),
             minimum_confirmed: result.minimum_confirmed,
             reduction: result.reduction.clone(),
+            skipped_pairs: result.skipped_pairs.clone(),
         }
     }
 

@@ -217,6 +217,7 @@ mod tests {
             starts: Vec::new(),
             minimum_confirmed: true,
             reduction: Vec::new(),
+            skipped_pairs: Vec::new(),
         }
     }
 
