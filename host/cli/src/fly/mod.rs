@@ -284,11 +284,11 @@ pub fn fly(
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
 
-    let sim_options = if args.perfect_sensors {
-        bo105::SimOptions::perfect()
-    } else {
-        bo105::SimOptions::default()
-    };
+    let mut sim_options = bo105::SimOptions::default();
+    if args.perfect_sensors {
+        // Sensors only: the actuators keep their servo dynamics and delay.
+        sim_options.sensor_noise = bo105::SensorNoise::perfect();
+    }
     let disturbances = Disturbances {
         gust_level: args.gust,
         sensor_dropout: args.sensor_dropout,
