@@ -563,7 +563,33 @@ fn pair_response(
         pair.random_error.push(e.random_error);
     }
     pair.valid_range = valid_range(&pair.omega, &pair.coherence, threshold);
+    anchor_phase_branch(&mut pair);
     (pair, dropped)
+}
+
+/// Shift the unwrapped phase by a whole number of turns so that it lies in (−180°, 180°]
+/// at the low end of the valid range (or, without one, at the most coherent point).
+/// Unwrapping starts at the lowest frequency, where coherence is often poor; a spurious
+/// turn there would otherwise offset the whole valid band by ±360°.
+fn anchor_phase_branch(pair: &mut PairResponse) {
+    let anchor = match pair.valid_range {
+        Some([lo, _]) => pair.omega.iter().position(|&w| w >= lo),
+        None => pair
+            .coherence
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(k, _)| k),
+    };
+    let Some(&phase) = anchor.and_then(|k| pair.phase_deg.get(k)) else {
+        return;
+    };
+    let turns = ((phase - 180.0) / 360.0).ceil();
+    if turns != 0.0 {
+        for p in &mut pair.phase_deg {
+            *p -= 360.0 * turns;
+        }
+    }
 }
 
 #[cfg(test)]

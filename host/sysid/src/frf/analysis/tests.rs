@@ -359,3 +359,25 @@ fn collinear_controls_are_reported_not_emitted() {
         document.notes
     );
 }
+
+#[test]
+fn phase_branch_is_anchored_at_the_low_end_of_the_valid_range() {
+    let mut pair = PairResponse {
+        input: "lat".into(),
+        output: "p".into(),
+        omega: vec![0.1, 0.2, 0.5, 1.0, 2.0],
+        mag_db: vec![0.0; 5],
+        phase_deg: vec![-140.0, -250.0, -365.0, -370.0, -420.0],
+        coherence: vec![0.3, 0.4, 0.9, 0.95, 0.9],
+        random_error: vec![0.1; 5],
+        valid_range: Some([0.5, 2.0]),
+    };
+    anchor_phase_branch(&mut pair);
+    assert_eq!(pair.phase_deg, vec![220.0, 110.0, -5.0, -10.0, -60.0]);
+    // Without a valid range the most coherent point sets the branch; ±180 stays put.
+    pair.valid_range = None;
+    pair.phase_deg = vec![-100.0, 180.0, 540.0, 0.0, 0.0];
+    pair.coherence = vec![0.1, 0.2, 0.9, 0.3, 0.3];
+    anchor_phase_branch(&mut pair);
+    assert_eq!(pair.phase_deg, vec![-460.0, -180.0, 180.0, -360.0, -360.0]);
+}
