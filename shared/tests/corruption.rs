@@ -63,40 +63,7 @@ fn sample(tick: u32, rng: &mut Rng) -> Frame {
 }
 
 fn header() -> Frame {
-    Frame::Header(Header {
-        protocol: PROTOCOL_VERSION,
-        firmware: FirmwareVersion {
-            major: 0,
-            minor: 1,
-            patch: 0,
-        },
-        vehicle: VehicleId::Bo105,
-        rate_hz: 200,
-        test: TestConfig {
-            mode: ExcitationMode::ConditionalAttitudeHold,
-            primary: Axis::Lat,
-            input: InputKind::Sweep,
-            sweep: SweepSettings {
-                t_rec_s: 90.0,
-                amplitude: 0.05,
-                omega_min: 0.3,
-                omega_max: 31.4,
-                fade_s: 2.0,
-                start_hold_cycles: 0,
-            },
-            pulse: PulseSettings {
-                amplitude: 0.05,
-                width_s: 1.0,
-            },
-            noise_rms: 0.01,
-            noise_cutoff_rad_s: 31.4,
-            seed: 1,
-            hold_engage_rad: 6f32.to_radians(),
-            hold_release_rad: 4f32.to_radians(),
-            freeze_in_band: false,
-            warnings: 0,
-        },
-    })
+    Frame::Header(synthetic::header())
 }
 
 struct Case {
