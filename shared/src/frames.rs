@@ -25,7 +25,8 @@ pub struct ProtocolVersion {
 }
 
 /// The protocol version this crate speaks.
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 0 };
+/// 1.1 added [`Frame::Configure`] and [`Frame::ConfigureResult`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 1 };
 
 impl core::fmt::Display for ProtocolVersion {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -460,6 +461,38 @@ pub struct ActuatorOut {
     pub servo_us: [u16; 4],
 }
 
+/// Host → flight controller (protocol 1.1): fly `test` on `vehicle` at `rate_hz`.
+///
+/// The flight controller builds its configuration from its own preset for `vehicle` and
+/// `test.primary` (gains, mixer, safety limits, trim capture), replaces the preset's
+/// rate and test with these, and restarts its flight logic on it (tick 0, sequencer
+/// Idle). Everything else of the configuration stays the preset's, so a host that needs
+/// other settings must rebuild the image. The answer is a [`ConfigureResult`]; when the
+/// new configuration is accepted a [`Header`] describing it goes out before the answer.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LinkConfig {
+    /// The vehicle whose preset the configuration starts from.
+    pub vehicle: VehicleId,
+    /// Tick rate of the flight logic [Hz] (the firmware accepts 50–1000).
+    pub rate_hz: u16,
+    /// The test to fly; its `warnings` are recomputed by the flight controller.
+    pub test: TestConfig,
+}
+
+/// Flight controller → host (protocol 1.1): the answer to a [`LinkConfig`].
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ConfigureResult {
+    /// `true`: the new configuration is in force and the flight logic restarted on it.
+    /// `false`: it was refused and the previous configuration stays in force.
+    pub accepted: bool,
+    /// Why it was refused: the position of the firmware's `ConfigError` variant in its
+    /// declaration (0 when accepted). The host names it by validating the same
+    /// configuration with the firmware library itself.
+    pub refusal: u8,
+}
+
 /// Everything that crosses the wire. `Header` must stay variant 0: a decoder peeks at
 /// the protocol version of a Header it cannot fully decode.
 #[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
@@ -476,4 +509,8 @@ pub enum Frame {
     SensorIn(SensorIn),
     /// In-the-loop outputs (flight controller → host).
     ActuatorOut(ActuatorOut),
+    /// Run-time configuration (host → flight controller). Since protocol 1.1.
+    Configure(LinkConfig),
+    /// The answer to a [`Frame::Configure`] (flight controller → host). Since 1.1.
+    ConfigureResult(ConfigureResult),
 }

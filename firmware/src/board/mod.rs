@@ -21,6 +21,7 @@ pub mod link;
 pub mod nvic;
 pub mod regs;
 pub mod runner;
+pub mod semihosting;
 pub mod servo;
 pub mod ticker;
 pub mod usart;

@@ -15,13 +15,26 @@
 //! [`LINK_TIMEOUT_S`] without a SensorIn the loop steps on its own again, on the last
 //! SensorIn, whose unchanging `seq` makes the flight logic's stale-sensor check abort
 //! any running test to pilot pass-through; the next SensorIn resumes lockstep.
+//!
+//! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the compiled-in
+//! configuration at run time. The image builds the preset of the frame's vehicle for
+//! its test's primary axis, puts the frame's rate and test in, and restarts the flight
+//! logic on it (tick 0); a configuration the flight logic refuses leaves the running
+//! one in place. Either way a [`ConfigureResult`] answers, preceded by the new Header
+//! when accepted, and the loop is in the loop from then on (the Header is the mode
+//! entry's, so the first SensorIn does not send another). TIM2 keeps the boot rate: in
+//! the loop it is only the link watchdog, still [`LINK_TIMEOUT_S`] long.
 
 use sweephold_firmware::{Config, FlightController};
-use sweephold_protocol::{ActuatorOut, Axis, Controls, Frame, FrameError, SensorIn, VehicleId};
+use sweephold_protocol::{
+    ActuatorOut, Axis, ConfigureResult, Controls, Frame, FrameError, LinkConfig, SensorIn,
+    VehicleId,
+};
 
-use super::clocks::{self, Clocks};
+use super::clocks::{self, ClockSource, Clocks};
 use super::dividers;
 use super::link::{self, Inbound, Telemetry};
+use super::semihosting;
 use super::servo::{self, ServoChannel, Servos};
 use super::ticker::Ticker;
 use super::usart::{self, UsartTx};
@@ -90,14 +103,28 @@ const fn parse_axis(name: &str) -> Option<Axis> {
     None
 }
 
-/// The flight-logic configuration compiled into the image: the preset of [`VEHICLE`]
-/// flying the paper's test on [`PRIMARY_AXIS`]. Protocol 1.0 has no frame to change it
-/// at run time, so a campaign over four axes in QEMU uses four builds (each ~1 s).
-fn image_config() -> Config {
-    match VEHICLE {
-        VehicleId::Bo105 => Config::bo105_default(PRIMARY_AXIS),
-        VehicleId::Trex700l => Config::trex700l_default(PRIMARY_AXIS),
+/// The preset of `vehicle` flying the paper's test on `axis`.
+fn preset(vehicle: VehicleId, axis: Axis) -> Config {
+    match vehicle {
+        VehicleId::Bo105 => Config::bo105_default(axis),
+        VehicleId::Trex700l => Config::trex700l_default(axis),
     }
+}
+
+/// The flight-logic configuration the image boots with: the preset of [`VEHICLE`]
+/// flying the paper's test on [`PRIMARY_AXIS`]. A host changes it at run time with a
+/// Configure frame (protocol 1.1).
+fn image_config() -> Config {
+    preset(VEHICLE, PRIMARY_AXIS)
+}
+
+/// The configuration a Configure frame asks for: the vehicle's preset for the test's
+/// primary axis with the frame's rate and test.
+fn link_config(request: &LinkConfig) -> Config {
+    let mut config = preset(request.vehicle, request.test.primary);
+    config.rate_hz = request.rate_hz;
+    config.test = request.test;
+    config
 }
 
 /// How the loop is paced.
@@ -125,6 +152,10 @@ pub struct LoopStats {
     pub ignored_frames: u32,
     /// Frames from the host that failed COBS, CRC or decoding.
     pub bad_frames: u32,
+    /// Configure frames accepted.
+    pub reconfigured: u32,
+    /// Configure frames refused.
+    pub refused: u32,
 }
 
 /// The flight logic and its outputs.
@@ -220,6 +251,41 @@ impl Runner {
         }
     }
 
+    /// A Configure frame: restart the flight logic on the requested configuration, or
+    /// keep the running one if the flight logic refuses it, and answer.
+    fn configure(&mut self, request: &LinkConfig) {
+        let result = match FlightController::new(link_config(request)) {
+            Ok(fc) => {
+                self.fc = fc;
+                let neutral =
+                    sweephold_firmware::mix(&self.fc.config().mixer, &Controls::default());
+                servo::set_failsafe(neutral);
+                self.stats.reconfigured = self.stats.reconfigured.wrapping_add(1);
+                defmt::info!(
+                    "configured by the host: {=str}, {=u16} Hz",
+                    request.vehicle.name(),
+                    request.rate_hz
+                );
+                self.announce();
+                ConfigureResult {
+                    accepted: true,
+                    refusal: 0,
+                }
+            }
+            Err(error) => {
+                self.stats.refused = self.stats.refused.wrapping_add(1);
+                defmt::warn!("configuration refused: {=str}", error.message());
+                ConfigureResult {
+                    accepted: false,
+                    // The variant's position: the host names it with the same library.
+                    refusal: error as u8,
+                }
+            }
+        };
+        self.mode = Mode::InTheLoop { silent_ticks: 0 };
+        link::send_waiting(&mut self.tx, &Frame::ConfigureResult(result));
+    }
+
     /// A frame (or a decoding error) from the host.
     fn on_frame(&mut self, frame: Result<Frame, FrameError>) {
         match frame {
@@ -232,6 +298,7 @@ impl Runner {
                 self.input = input;
                 self.step(Some(input.seq));
             }
+            Ok(Frame::Configure(request)) => self.configure(&request),
             Ok(_) => self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1),
             // The decoder has resynchronised on the next delimiter already.
             Err(_) => self.stats.bad_frames = self.stats.bad_frames.wrapping_add(1),
@@ -282,6 +349,10 @@ pub fn run() -> ! {
         ticker.achieved_millihz
     );
 
+    if clocks.source == ClockSource::NoRcc && semihosting::requested() {
+        run_semihosting(runner);
+    }
+
     let mut inbound = Inbound::new(rx);
     loop {
         inbound.poll(|frame| runner.on_frame(frame));
@@ -296,5 +367,54 @@ pub fn run() -> ! {
                 cortex_m::asm::wfi();
             }
         });
+    }
+}
+
+/// The in-the-loop mode over semihosting (QEMU only, see [`semihosting`]): block in
+/// SYS_READ for the host's frames, answer each, and hand the tick's frames to the host in
+/// one SYS_WRITE before reading again. The host is the only clock here (no watchdog
+/// steps: the read blocks); when it goes away (end of file) QEMU is asked to exit.
+fn run_semihosting(mut runner: Runner) -> ! {
+    usart::capture();
+    let (Some(input), Some(output)) = (
+        semihosting::open(b"sweephold-in\0", false),
+        semihosting::open(b"sweephold-out\0", true),
+    ) else {
+        defmt::error!("semihosting FIFOs missing");
+        semihosting::exit()
+    };
+    defmt::info!("frame link over semihosting");
+    // The boot Header went to the USART before the switch: this one tells the host the
+    // link is up.
+    runner.announce();
+    let mut decoder = sweephold_protocol::Decoder::new();
+    let mut received = [0u8; 256];
+    loop {
+        send_captured(output);
+        let count = semihosting::read(input, &mut received);
+        if count == 0 {
+            semihosting::exit();
+        }
+        decoder.feed_with(received.get(..count).unwrap_or(&[]), |frame| {
+            runner.on_frame(frame);
+            // After every frame, so the transmit ring (1 KiB, a tick needs ~400 B)
+            // never fills: its writer would wait for room forever.
+            send_captured(output);
+        });
+    }
+}
+
+/// Hand everything queued in the transmit ring to the host; ask QEMU to exit if the
+/// host is gone.
+fn send_captured(output: usize) {
+    let mut outgoing = [0u8; 512];
+    loop {
+        let count = usart::take_captured(&mut outgoing);
+        if count == 0 {
+            return;
+        }
+        if !semihosting::write(output, outgoing.get(..count).unwrap_or(&[])) {
+            semihosting::exit();
+        }
     }
 }

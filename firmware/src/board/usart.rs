@@ -13,7 +13,7 @@
 
 use core::cell::RefCell;
 use core::convert::Infallible;
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::{self, CriticalSection, Mutex};
 use heapless::Deque;
@@ -78,6 +78,9 @@ pub fn init(clocks: &Clocks) -> Result<(UsartTx, UsartRx), DividerError> {
 /// Feed the data register from the ring while it has room, and keep the TXE interrupt
 /// on exactly while bytes are waiting.
 fn pump(cs: &CriticalSection) {
+    if CAPTURED.load(Ordering::Relaxed) {
+        return;
+    }
     let mut ring = TX.borrow(cs).borrow_mut();
     while usart1::SR.read() & SR_TXE != 0 {
         match ring.pop_front() {
@@ -90,6 +93,32 @@ fn pump(cs: &CriticalSection) {
     } else {
         usart1::CR1.set_bits(CR1_TXEIE);
     }
+}
+
+/// Set when the frames leave through semihosting instead of the pin (QEMU only, see
+/// `board::semihosting`): the transmit ring then keeps what is queued until
+/// [`take_captured`] empties it.
+static CAPTURED: AtomicBool = AtomicBool::new(false);
+
+/// From now on keep queued frames in the ring for [`take_captured`].
+pub fn capture() {
+    CAPTURED.store(true, Ordering::Relaxed);
+}
+
+/// Move queued bytes (at most `buf.len()`) into `buf`; returns how many.
+pub fn take_captured(buf: &mut [u8]) -> usize {
+    interrupt::free(|cs| {
+        let mut ring = TX.borrow(cs).borrow_mut();
+        let mut count = 0;
+        for slot in buf.iter_mut() {
+            match ring.pop_front() {
+                Some(byte) => *slot = byte,
+                None => break,
+            }
+            count += 1;
+        }
+        count
+    })
 }
 
 /// USART1 interrupt: move a received byte into the ring, feed the transmitter.

@@ -127,7 +127,10 @@ fn handle_frame<W: Write>(
             }
         }
         // In-the-loop traffic is not telemetry; a dump of a serial link may hold it.
-        Frame::SensorIn(_) | Frame::ActuatorOut(_) => {}
+        Frame::SensorIn(_)
+        | Frame::ActuatorOut(_)
+        | Frame::Configure(_)
+        | Frame::ConfigureResult(_) => {}
     }
     Ok(())
 }

@@ -10,7 +10,10 @@ use std::path::PathBuf;
 use anyhow::{bail, Context};
 use clap::Args;
 use sysid::document::FrfDocument;
-use sysid::fit::report::{cost_table, parameter_table, reduction_table};
+use sysid::fit::report::{
+    cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
+    TruthSection,
+};
 use sysid::fit::{fit, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure};
 
 /// Arguments of `sweephold fit`.
@@ -46,6 +49,10 @@ pub struct FitArgs {
     /// Fit frequencies per pair (n_ω).
     #[arg(long, default_value_t = 20)]
     pub points: usize,
+    /// Score the fit against a simulator's linearization at hover (`bo105`, `trex700l`):
+    /// truth and error % per parameter, J against the truth model per pair.
+    #[arg(long, value_name = "VEHICLE")]
+    pub truth: Option<bo105::Vehicle>,
 }
 
 /// Run `sweephold fit`.
@@ -97,9 +104,20 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     };
     let result = fit(&structure, &data, &options)?;
 
-    write_report(&mut report, &result).expect("writing to a String cannot fail");
+    let truth = match args.truth {
+        Some(vehicle) => Some(crate::truth::score_fit(
+            &result,
+            &crate::truth::VehicleTruth::at_hover(vehicle)?,
+        )?),
+        None => None,
+    };
+    write_report(&mut report, &result, truth.as_ref()).expect("writing to a String cannot fail");
     if let Some(path) = &args.out {
-        let json = serde_json::to_string_pretty(&result.to_document())?;
+        let document = ScoredModelDocument {
+            model: result.to_document(),
+            truth,
+        };
+        let json = serde_json::to_string_pretty(&document)?;
         fs::write(path, json + "\n").with_context(|| format!("cannot write {}", path.display()))?;
         let _ = writeln!(report, "\nwrote {}", path.display());
     }
@@ -119,7 +137,11 @@ fn emit(report: &str) -> anyhow::Result<()> {
 }
 
 /// The text report: starts, reduction steps, parameter table, cost table.
-fn write_report(out: &mut String, result: &sysid::fit::FitResult) -> std::fmt::Result {
+fn write_report(
+    out: &mut String,
+    result: &sysid::fit::FitResult,
+    truth: Option<&TruthSection>,
+) -> std::fmt::Result {
     writeln!(
         out,
         "structure {} ({} states, {} controls, {} outputs), {} pairs, {} free parameters",
@@ -157,7 +179,17 @@ fn write_report(out: &mut String, result: &sysid::fit::FitResult) -> std::fmt::R
         write!(out, "{}", reduction_table(&result.reduction))?;
     }
     writeln!(out)?;
-    write!(out, "{}", parameter_table(result))?;
+    match truth {
+        Some(section) => {
+            writeln!(
+                out,
+                "truth: {} linearized at hover trim (error % = 100·(value − truth)/|truth|)",
+                section.vehicle
+            )?;
+            write!(out, "{}", parameter_table_with_truth(result, section))?;
+        }
+        None => write!(out, "{}", parameter_table(result))?,
+    }
     if result.hessian_singular {
         writeln!(
             out,
@@ -167,6 +199,10 @@ fn write_report(out: &mut String, result: &sysid::fit::FitResult) -> std::fmt::R
     }
     writeln!(out)?;
     write!(out, "{}", cost_table(result))?;
+    if let Some(section) = truth {
+        writeln!(out)?;
+        write!(out, "{}", section.cost_table())?;
+    }
     if !result.skipped_pairs.is_empty() {
         writeln!(out, "\nskipped (no usable coherent range in the data):")?;
         for pair in &result.skipped_pairs {
@@ -227,6 +263,7 @@ lat = "b"
             start_from: None,
             max_starts: 4,
             points: 20,
+            truth: None,
         };
         run(&args).unwrap();
         let document: ModelDocument =

@@ -9,6 +9,8 @@ pub mod fly;
 pub mod frf;
 pub mod sim;
 pub mod table;
+pub mod truth;
+pub mod verify;
 
 /// Identify helicopter dynamics from automated frequency sweeps flown under conditional
 /// attitude hold (Jung, Shim & Kim).
@@ -33,6 +35,8 @@ pub enum Command {
     Frf(frf::FrfArgs),
     /// Trim and linearize the simulated helicopters (bo105, trex700l).
     Sim(sim::SimArgs),
+    /// Simulate an identified model on recorded inputs and score it (Theil's inequality coefficient).
+    Verify(verify::VerifyArgs),
 }
 
 /// Run one parsed command line.
@@ -43,5 +47,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fly(args) => fly::run(&args),
         Command::Frf(args) => frf::run(&args),
         Command::Sim(args) => sim::run(&args),
+        Command::Verify(args) => verify::run(&args),
     }
 }

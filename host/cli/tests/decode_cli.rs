@@ -98,7 +98,10 @@ fn csv_has_a_header_row_and_one_row_per_sample() {
     assert!(err.contains("402 good frames"), "{err}");
     assert!(err.contains("0 corrupt frames skipped"), "{err}");
     assert!(err.contains("vehicle bo105"), "{err}");
-    assert!(err.contains("protocol 1.0"), "{err}");
+    assert!(
+        err.contains(&format!("protocol {PROTOCOL_VERSION}")),
+        "{err}"
+    );
     assert!(err.contains("duration 1.995 s"), "{err}");
     assert!(
         err.contains("ABORT (pilot_override)"),

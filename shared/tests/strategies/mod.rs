@@ -256,5 +256,24 @@ pub fn frame() -> impl Strategy<Value = Frame> {
         event().prop_map(Frame::Event),
         sensor_in().prop_map(Frame::SensorIn),
         actuator_out().prop_map(Frame::ActuatorOut),
+        link_config().prop_map(Frame::Configure),
+        configure_result().prop_map(Frame::ConfigureResult),
     ]
+}
+
+pub fn link_config() -> impl Strategy<Value = LinkConfig> {
+    (any::<bool>(), any::<u16>(), test_config()).prop_map(|(bo, rate_hz, test)| LinkConfig {
+        vehicle: if bo {
+            VehicleId::Bo105
+        } else {
+            VehicleId::Trex700l
+        },
+        rate_hz,
+        test,
+    })
+}
+
+pub fn configure_result() -> impl Strategy<Value = ConfigureResult> {
+    (any::<bool>(), any::<u8>())
+        .prop_map(|(accepted, refusal)| ConfigureResult { accepted, refusal })
 }

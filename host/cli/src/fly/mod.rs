@@ -2,6 +2,7 @@
 //! controller in the loop and the nonlinear simulator as the aircraft.
 
 pub mod link;
+pub mod link_qemu;
 pub mod plan;
 pub mod record;
 pub mod summary;
@@ -162,6 +163,25 @@ pub struct FlyArgs {
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Flight controller in the loop: `in-process` (the firmware library called
+    /// directly), `qemu` (the board image in qemu-system-arm, one per worker) or
+    /// `qemu-usart` (the same over its emulated USART: slow).
+    #[arg(long, value_enum, default_value_t = FcArg::InProcess)]
+    pub fc: FcArg,
+    /// Board image for `--fc qemu` [default: target/thumbv7em-none-eabihf/firmware/sweephold-fc].
+    #[arg(long, value_name = "PATH")]
+    pub elf: Option<PathBuf>,
+}
+
+/// Flight controller on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FcArg {
+    /// The firmware's flight logic called in-process.
+    InProcess,
+    /// The board image (`cargo fw`) in QEMU's netduinoplus2, frames over semihosting.
+    Qemu,
+    /// The same, frames over USART1 on a TCP socket (as on the board; ~200 ticks/s).
+    QemuUsart,
 }
 
 fn parse_axis(text: &str) -> Result<Axis, String> {
@@ -226,7 +246,25 @@ pub struct FlyOutcome {
 
 /// Run `sweephold fly`.
 pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
-    let outcome = fly(args, &|| Box::new(InProcessLink::new()))?;
+    let outcome = match args.fc {
+        FcArg::InProcess => fly(args, &|| Box::new(InProcessLink::new()))?,
+        FcArg::Qemu | FcArg::QemuUsart => {
+            link_qemu::qemu_available()?;
+            let image = match &args.elf {
+                Some(path) => path.clone(),
+                None => link_qemu::default_image()?,
+            };
+            let extra = link_qemu::extra_args_from_env();
+            let transport = if args.fc == FcArg::Qemu {
+                link_qemu::QemuTransport::Semihosting
+            } else {
+                link_qemu::QemuTransport::Usart
+            };
+            fly(args, &|| {
+                Box::new(link_qemu::QemuLink::new(&image, transport, &extra))
+            })?
+        }
+    };
     if !args.quiet {
         for run in &outcome.summary.runs {
             let coherence: Vec<String> = run

@@ -19,6 +19,7 @@ pub mod report;
 pub mod start;
 pub mod structure;
 pub mod synthetic;
+pub mod verify;
 
 #[cfg(test)]
 pub(crate) mod test_support;

@@ -97,6 +97,100 @@ pub struct ModelDocument {
     pub skipped_pairs: Vec<super::SkippedPair>,
 }
 
+/// `model.json` with its optional `truth` section: the [`ModelDocument`] keys at the top
+/// level plus `"truth"` when the fit was scored against a simulator
+/// (`sweephold fit --truth`). A [`ModelDocument`] reads such a file too (it ignores the
+/// extra key); the section is kept apart so that existing code building a
+/// `ModelDocument` is unaffected.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScoredModelDocument {
+    /// The model document.
+    #[serde(flatten)]
+    pub model: ModelDocument,
+    /// Scoring against a simulator's truth; absent without `--truth`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth: Option<TruthSection>,
+}
+
+/// One parameter compared with the value the simulator's linearization implies.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthParameter {
+    /// Parameter name.
+    pub name: String,
+    /// Identified value.
+    pub value: f64,
+    /// Truth value; null when the truth mapping does not know the parameter.
+    pub truth: Option<f64>,
+    /// 100·(value − truth)/|truth|; null without a (non-zero) truth.
+    pub error_percent: Option<f64>,
+}
+
+/// J of the identified model against the truth model on one fitted pair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthPairCost {
+    /// Control name.
+    pub input: String,
+    /// Output name.
+    pub output: String,
+    /// Range [rad/s] (the fitted one).
+    pub range: [f64; 2],
+    /// J (the DERIVID cost with the truth model as data, coherence 1).
+    pub cost: f64,
+}
+
+/// The `truth` section of `model.json`: the fit scored against a simulator.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthSection {
+    /// Simulated vehicle (`bo105`, `trex700l`), linearized at hover trim.
+    pub vehicle: String,
+    /// Every parameter of the fit with its truth and error.
+    pub parameters: Vec<TruthParameter>,
+    /// J against the truth model per fitted pair.
+    pub pairs: Vec<TruthPairCost>,
+    /// Mean of the pair costs.
+    pub average_cost: f64,
+    /// Structure parameters the truth mapping does not know (held at 0 in the truth model).
+    #[serde(default)]
+    pub unmapped: Vec<String>,
+}
+
+impl TruthSection {
+    /// The text table of J against the truth model per pair, then J_ave (the parameters
+    /// with their truth are in [`parameter_table_with_truth`]).
+    pub fn cost_table(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(out, "J against the truth model ({}):", self.vehicle);
+        let _ = writeln!(
+            out,
+            "{:<12} {:>17} {:>10}",
+            "pair", "range [rad/s]", "J truth"
+        );
+        for pair in &self.pairs {
+            let _ = writeln!(
+                out,
+                "{:<12} {:>8.3}-{:<8.3} {:>10.3}",
+                format!("{}/{}", pair.output, pair.input),
+                pair.range[0],
+                pair.range[1],
+                pair.cost
+            );
+        }
+        let _ = writeln!(
+            out,
+            "{:<12} {:>17} {:>10.3}",
+            "J_ave", "", self.average_cost
+        );
+        if !self.unmapped.is_empty() {
+            let _ = writeln!(
+                out,
+                "no truth for: {} (held at 0 in the truth model)",
+                self.unmapped.join(" ")
+            );
+        }
+        out
+    }
+}
+
 fn finite(value: Option<f64>) -> Option<f64> {
     value.filter(|v| v.is_finite())
 }
@@ -190,10 +284,25 @@ fn percent_cell(value: Option<f64>) -> String {
 /// The parameter table (like the paper's Table 3): name, value, CR %, insensitivity %,
 /// status and flags (`CR>20%`, `I>10%`, `|r|>0.9 with X`).
 pub fn parameter_table(result: &FitResult) -> String {
+    parameter_rows(result, None)
+}
+
+/// [`parameter_table`] with two more columns from a truth scoring: the truth value and the
+/// error in % of |truth| (`-` where the truth mapping has no value).
+pub fn parameter_table_with_truth(result: &FitResult, truth: &TruthSection) -> String {
+    parameter_rows(result, Some(truth))
+}
+
+fn parameter_rows(result: &FitResult, truth: Option<&TruthSection>) -> String {
     let mut out = String::new();
+    let truth_header = if truth.is_some() {
+        format!(" {:>14} {:>10}", "truth", "error %")
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         out,
-        "{:<10} {:>14} {:>10} {:>10}  {:<11} flags",
+        "{:<10} {:>14} {:>10} {:>10}{truth_header}  {:<11} flags",
         "parameter", "value", "CR %", "insens. %", "status"
     );
     for p in &result.parameters {
@@ -213,9 +322,23 @@ pub fn parameter_table(result: &FitResult) -> String {
                 }
             })
             .collect();
+        let truth_cells = match truth {
+            Some(section) => {
+                let entry = section.parameters.iter().find(|t| t.name == p.name);
+                let cell = |v: Option<f64>, precision: usize| {
+                    v.map_or_else(|| "-".to_string(), |v| format!("{v:.precision$}"))
+                };
+                format!(
+                    " {:>14} {:>10}",
+                    cell(entry.and_then(|t| t.truth), 6),
+                    cell(entry.and_then(|t| t.error_percent), 1)
+                )
+            }
+            None => String::new(),
+        };
         let _ = writeln!(
             out,
-            "{:<10} {:>14.6} {:>10} {:>10}  {:<11} {}",
+            "{:<10} {:>14.6} {:>10} {:>10}{truth_cells}  {:<11} {}",
             p.name,
             p.value,
             percent_cell(p.cramer_rao_percent),

@@ -1,0 +1,693 @@
+//! The board image flown in QEMU: `sweephold fly --fc qemu` (and `--fc qemu-usart`).
+//!
+//! [`QemuLink`] boots the flight-controller image (`cargo fw`) in
+//! `qemu-system-arm -M netduinoplus2` and runs the same lockstep protocol with it as
+//! over a serial cable to the real board: each tick one SensorIn out, then the tick's
+//! telemetry in, closed by the ActuatorOut that answers the SensorIn's `seq`; everything
+//! before that ActuatorOut is handed on as raw bytes, exactly as received. The record's
+//! configuration travels in a Configure frame (protocol 1.1), so one image flies every
+//! axis, vehicle and test.
+//!
+//! Two transports ([`QemuTransport`]). **Semihosting** (the default): two host FIFOs the
+//! image reads and writes with ARM semihosting calls, a whole frame per call; ~45× real
+//! time. **USART**: USART1 on a TCP socket, the board's own link; QEMU's USART model takes
+//! one received byte per main-loop iteration, so it runs at about real time. For it the
+//! host is the server: it listens on an ephemeral port of 127.0.0.1 first and QEMU
+//! connects as a client, so no other program can take the port in between.
+//!
+//! QEMU is killed when the link is dropped — at the end of the run, on an error, and when
+//! the thread unwinds — and a failed record boots a fresh one for the next. On Ctrl-C the
+//! terminal's SIGINT reaches QEMU too (same foreground process group), which terminates
+//! on it; over semihosting the image also asks QEMU to exit when the host's end of the
+//! FIFO closes, so even a killed host leaves no emulator behind (only its FIFO folder in
+//! the temporary directory, which Drop removes otherwise).
+
+use std::io::{ErrorKind, Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context};
+use sweephold_firmware::{Config, FlightController};
+use sweephold_protocol::codec::{encode_to_vec, DELIMITER};
+use sweephold_protocol::decoder::decode_frame;
+use sweephold_protocol::{ActuatorOut, ConfigureResult, Frame, LinkConfig, SensorIn, VehicleId};
+
+use super::link::FlightControllerLink;
+
+/// The QEMU binary.
+pub const QEMU: &str = "qemu-system-arm";
+
+/// The image `cargo fw` builds, relative to a cargo target directory.
+pub const IMAGE_IN_TARGET_DIR: &str = "thumbv7em-none-eabihf/firmware/sweephold-fc";
+
+/// How long QEMU may take to start and connect to the host.
+const CONNECT_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// How long the image may take to answer a Configure (boot included).
+const CONFIGURE_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// How long the image may take to answer one SensorIn. A tick needs well under a
+/// millisecond of emulated time; this only catches a dead or wedged emulator.
+const TICK_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Last bytes of QEMU's stderr kept for error messages.
+const STDERR_KEEP: usize = 4096;
+
+/// Where the image is when `--elf` is not given: `$CARGO_TARGET_DIR/…` if that variable
+/// is set, else `target/…` under the workspace this binary was built from.
+pub fn default_image() -> anyhow::Result<PathBuf> {
+    let mut candidates = Vec::new();
+    if let Some(dir) = std::env::var_os("CARGO_TARGET_DIR") {
+        candidates.push(PathBuf::from(dir).join(IMAGE_IN_TARGET_DIR));
+    }
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    candidates.push(workspace.join("target").join(IMAGE_IN_TARGET_DIR));
+    candidates
+        .iter()
+        .find(|path| path.is_file())
+        .cloned()
+        .ok_or_else(|| {
+            anyhow!(
+                "no flight-controller image at {}: build it with `cargo fw` or pass --elf PATH",
+                candidates
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(" or ")
+            )
+        })
+}
+
+/// `Ok` when `qemu-system-arm` can be started, else the one-line reason.
+pub fn qemu_available() -> anyhow::Result<()> {
+    match Command::new(QEMU)
+        .arg("--version")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+    {
+        Ok(status) if status.success() => Ok(()),
+        Ok(status) => bail!("{QEMU} --version failed ({status})"),
+        Err(e) if e.kind() == ErrorKind::NotFound => {
+            bail!("{QEMU} not found: install it with `apt-get install qemu-system-arm`")
+        }
+        Err(e) => bail!("cannot run {QEMU}: {e}"),
+    }
+}
+
+/// What the image can be told at run time: a configuration the Configure frame carries
+/// exactly, i.e. the vehicle's preset for the primary axis with another rate and test.
+fn link_config(config: &Config) -> anyhow::Result<LinkConfig> {
+    let mut preset = match config.vehicle {
+        VehicleId::Bo105 => Config::bo105_default(config.test.primary),
+        VehicleId::Trex700l => Config::trex700l_default(config.test.primary),
+    };
+    preset.rate_hz = config.rate_hz;
+    preset.test = config.test;
+    if preset != *config {
+        bail!(
+            "the QEMU link can only change the vehicle, rate and test of the image's preset; \
+             this configuration differs in other settings (gains, mixer, limits, trim \
+             capture): build an image with them"
+        );
+    }
+    Ok(LinkConfig {
+        vehicle: config.vehicle,
+        rate_hz: config.rate_hz,
+        test: config.test,
+    })
+}
+
+/// Extra QEMU arguments from `SWEEPHOLD_QEMU_ARGS` (split on white space), e.g.
+/// `-icount shift=0,sleep=off`.
+pub fn extra_args_from_env() -> Vec<String> {
+    std::env::var("SWEEPHOLD_QEMU_ARGS")
+        .map(|text| text.split_whitespace().map(str::to_string).collect())
+        .unwrap_or_default()
+}
+
+/// How the host reaches the image in QEMU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QemuTransport {
+    /// ARM semihosting: SYS_READ / SYS_WRITE on two host FIFOs, a whole frame per call
+    /// (`board/semihosting.rs`). QEMU only; the fast one.
+    Semihosting,
+    /// USART1 on a TCP socket, as a serial cable to the board would carry it. QEMU's
+    /// USART model takes one received byte per main-loop iteration: ~200 ticks/s.
+    Usart,
+}
+
+impl QemuTransport {
+    /// Name in `summary.json` and messages.
+    pub fn link_name(self) -> &'static str {
+        match self {
+            QemuTransport::Semihosting => "qemu",
+            QemuTransport::Usart => "qemu-usart",
+        }
+    }
+}
+
+/// The mailbox words that ask the image for the semihosting link (see the firmware's
+/// `board/semihosting.rs`): "SHST" and its complement at 0x2001_0000.
+const SEMIHOSTING_MAILBOX: [(u32, u32); 2] =
+    [(0x2001_0000, 0x5348_5354), (0x2001_0004, !0x5348_5354)];
+
+/// The board image flown in QEMU. QEMU is booted by the first record (so making the
+/// link costs nothing) and killed when the link is dropped or a record fails; the next
+/// record then boots a fresh one.
+pub struct QemuLink {
+    image: PathBuf,
+    transport: QemuTransport,
+    extra_args: Vec<String>,
+    session: Option<Session>,
+    /// ActuatorOut frames that answered no outstanding SensorIn (dropped), all sessions.
+    stray_answers: u64,
+}
+
+impl QemuLink {
+    /// A link that will boot `image`, reach it over `transport`, and add `extra_args`
+    /// to QEMU's command line.
+    pub fn new(image: &Path, transport: QemuTransport, extra_args: &[String]) -> Self {
+        QemuLink {
+            image: image.to_path_buf(),
+            transport,
+            extra_args: extra_args.to_vec(),
+            session: None,
+            stray_answers: 0,
+        }
+    }
+
+    /// The image this link boots.
+    pub fn image(&self) -> &Path {
+        &self.image
+    }
+
+    /// ActuatorOut frames received that answered no outstanding SensorIn.
+    pub fn stray_answers(&self) -> u64 {
+        self.stray_answers
+    }
+
+    /// The running session, booting QEMU if there is none.
+    fn session(&mut self) -> anyhow::Result<&mut Session> {
+        if self.session.is_none() {
+            self.session = Some(Session::start(
+                &self.image,
+                self.transport,
+                &self.extra_args,
+            )?);
+        }
+        self.session
+            .as_mut()
+            .ok_or_else(|| anyhow!("QEMU session missing"))
+    }
+
+    /// Keep the session after `result` only if it is `Ok`: a failed exchange leaves the
+    /// stream at an unknown point, and the next record starts from a fresh boot.
+    fn keep_if_ok<T>(&mut self, result: anyhow::Result<T>) -> anyhow::Result<T> {
+        if result.is_err() {
+            self.session = None;
+        }
+        result
+    }
+}
+
+/// The byte stream to the image.
+enum Wire {
+    /// USART1's TCP socket.
+    Tcp(TcpStream),
+    /// The semihosting FIFOs, both opened read-write (so neither open blocks and the
+    /// host never sees end of file), in a scratch folder removed on drop.
+    Fifo {
+        to_image: std::fs::File,
+        from_image: std::fs::File,
+        folder: PathBuf,
+    },
+}
+
+impl Wire {
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        match self {
+            Wire::Tcp(stream) => stream.write_all(bytes),
+            Wire::Fifo { to_image, .. } => to_image.write_all(bytes),
+        }
+    }
+
+    /// Read what is there, waiting at most `timeout`; `Err(TimedOut)` when nothing came.
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> std::io::Result<usize> {
+        match self {
+            Wire::Tcp(stream) => {
+                stream.set_read_timeout(Some(timeout.max(Duration::from_millis(1))))?;
+                stream.read(buf)
+            }
+            Wire::Fifo { from_image, .. } => {
+                use std::os::fd::AsRawFd;
+                let mut poll = libc::pollfd {
+                    fd: from_image.as_raw_fd(),
+                    events: libc::POLLIN,
+                    revents: 0,
+                };
+                let millis = libc::c_int::try_from(timeout.as_millis().max(1)).unwrap_or(1000);
+                // SAFETY: one valid pollfd, count 1, for the duration of the call.
+                let ready = unsafe { libc::poll(&mut poll, 1, millis) };
+                match ready {
+                    0 => Err(ErrorKind::TimedOut.into()),
+                    n if n < 0 => Err(std::io::Error::last_os_error()),
+                    _ => from_image.read(buf),
+                }
+            }
+        }
+    }
+
+    fn shutdown(&mut self) {
+        match self {
+            Wire::Tcp(stream) => {
+                let _ = stream.shutdown(std::net::Shutdown::Both);
+            }
+            Wire::Fifo { folder, .. } => {
+                let _ = std::fs::remove_dir_all(folder);
+            }
+        }
+    }
+}
+
+/// A fresh scratch folder with the two FIFOs the image opens (`sweephold-in`,
+/// `sweephold-out`), both opened read-write.
+fn make_fifos() -> anyhow::Result<Wire> {
+    use std::sync::atomic::{AtomicU32, Ordering};
+    static COUNT: AtomicU32 = AtomicU32::new(0);
+    let folder = std::env::temp_dir().join(format!(
+        "sweephold-qemu-{}-{}",
+        std::process::id(),
+        COUNT.fetch_add(1, Ordering::Relaxed)
+    ));
+    let _ = std::fs::remove_dir_all(&folder);
+    std::fs::create_dir_all(&folder)
+        .with_context(|| format!("cannot create {}", folder.display()))?;
+    let mut files = Vec::new();
+    for name in ["sweephold-in", "sweephold-out"] {
+        let path = folder.join(name);
+        let c_path = std::ffi::CString::new(path.as_os_str().as_encoded_bytes())
+            .map_err(|_| anyhow!("NUL in {}", path.display()))?;
+        // SAFETY: a valid NUL-terminated path for the duration of the call.
+        if unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) } != 0 {
+            let error = std::io::Error::last_os_error();
+            let _ = std::fs::remove_dir_all(&folder);
+            return Err(error).with_context(|| format!("mkfifo {}", path.display()));
+        }
+        // Read-write: Linux opens a FIFO so without waiting for the other end.
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("cannot open {}", path.display()))?;
+        files.push(file);
+    }
+    let from_image = files.pop().ok_or_else(|| anyhow!("FIFO missing"))?;
+    let to_image = files.pop().ok_or_else(|| anyhow!("FIFO missing"))?;
+    Ok(Wire::Fifo {
+        to_image,
+        from_image,
+        folder,
+    })
+}
+
+/// One QEMU process running the image, and the byte stream to it.
+struct Session {
+    child: Child,
+    wire: Wire,
+    /// Bytes received and not yet handed out (the start of a frame, or frames after the
+    /// one that closed the last exchange).
+    pending: Vec<u8>,
+    /// Where in `pending` the search for the next delimiter resumes.
+    scanned: usize,
+    stderr: Arc<Mutex<Vec<u8>>>,
+}
+
+impl Session {
+    /// Boot `image` in QEMU and connect to its USART1. `extra_args` go to QEMU as they
+    /// are (e.g. `-icount shift=0`).
+    fn start(
+        image: &Path,
+        transport: QemuTransport,
+        extra_args: &[String],
+    ) -> anyhow::Result<Self> {
+        qemu_available()?;
+        if !image.is_file() {
+            bail!(
+                "flight-controller image {} not found: build it with `cargo fw`",
+                image.display()
+            );
+        }
+        let image = std::path::absolute(image)
+            .with_context(|| format!("cannot resolve {}", image.display()))?;
+        let mut command = Command::new(QEMU);
+        command
+            .args(["-M", "netduinoplus2", "-nographic", "-monitor", "none"])
+            .arg("-kernel")
+            .arg(&image);
+        let (listener, fifos) = match transport {
+            QemuTransport::Usart => {
+                let listener = TcpListener::bind("127.0.0.1:0")
+                    .context("cannot listen on 127.0.0.1 for QEMU")?;
+                let port = listener.local_addr()?.port();
+                listener.set_nonblocking(true)?;
+                // USART1 is the first serial port of the machine.
+                command
+                    .arg("-chardev")
+                    .arg(format!(
+                        "socket,id=usart1,host=127.0.0.1,port={port},server=off,nodelay=on"
+                    ))
+                    .args(["-serial", "chardev:usart1"]);
+                (Some(listener), None)
+            }
+            QemuTransport::Semihosting => {
+                let fifos = make_fifos()?;
+                if let Wire::Fifo { folder, .. } = &fifos {
+                    // The image opens the FIFOs by relative name.
+                    command.current_dir(folder);
+                }
+                command
+                    .args(["-serial", "null"])
+                    .args(["-semihosting-config", "enable=on,target=native"]);
+                for (address, word) in SEMIHOSTING_MAILBOX {
+                    command.arg("-device").arg(format!(
+                        "loader,addr={address:#x},data={word:#x},data-len=4"
+                    ));
+                }
+                (None, Some(fifos))
+            }
+        };
+        let mut child = command
+            .args(extra_args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .with_context(|| format!("cannot start {QEMU}"))?;
+        let stderr = Arc::new(Mutex::new(Vec::new()));
+        if let Some(mut pipe) = child.stderr.take() {
+            let keep = Arc::clone(&stderr);
+            std::thread::spawn(move || {
+                let mut chunk = [0u8; 512];
+                while let Ok(n @ 1..) = pipe.read(&mut chunk) {
+                    let mut kept = keep.lock().unwrap_or_else(|e| e.into_inner());
+                    kept.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
+                    let excess = kept.len().saturating_sub(STDERR_KEEP);
+                    kept.drain(..excess);
+                }
+            });
+        }
+        let wire = match (listener, fifos) {
+            (Some(listener), _) => Wire::Tcp(accept(&listener, &mut child, &stderr)?),
+            (None, Some(fifos)) => fifos,
+            (None, None) => bail!("no transport"),
+        };
+        let mut session = Session {
+            child,
+            wire,
+            pending: Vec::with_capacity(4096),
+            scanned: 0,
+            stderr,
+        };
+        // QEMU's USART drops what arrives before the image has enabled it, which would
+        // cut the first Configure. The image's first frame (its boot Header) comes
+        // after it is enabled: wait for it.
+        session.read_until(
+            CONFIGURE_TIMEOUT,
+            "boot frame (an image older than this host? rebuild it with `cargo fw`)",
+            |_| Some(true),
+            &mut Vec::new(),
+        )?;
+        Ok(session)
+    }
+
+    fn send(&mut self, frame: &Frame) -> anyhow::Result<()> {
+        let bytes = encode_to_vec(frame).map_err(|e| anyhow!("cannot encode {e:?}"))?;
+        self.wire
+            .send(bytes.as_bytes())
+            .map_err(|e| self.failure(&format!("sending to the image: {e}")))
+    }
+
+    /// Read until a frame for which `closes` returns `true` arrives; return the bytes of
+    /// every frame before it (the delimiters included, exactly as received) and that frame.
+    /// Frames for which `closes` returns `None` are dropped from the returned bytes.
+    fn read_until(
+        &mut self,
+        timeout: Duration,
+        what: &str,
+        mut closes: impl FnMut(&Frame) -> Option<bool>,
+        before: &mut Vec<u8>,
+    ) -> anyhow::Result<Frame> {
+        let deadline = Instant::now() + timeout;
+        let mut start = 0;
+        loop {
+            while let Some(offset) = self
+                .pending
+                .get(self.scanned..)
+                .and_then(|rest| rest.iter().position(|&b| b == DELIMITER))
+            {
+                let end = self.scanned + offset + 1;
+                self.scanned = end;
+                let body = self.pending.get(start..end - 1).unwrap_or(&[]);
+                let decoded = decode_frame(body);
+                match decoded.as_ref().ok().map(&mut closes) {
+                    Some(Some(true)) => {
+                        let frame = decoded.map_err(|e| anyhow!("{e:?}"))?;
+                        before.extend_from_slice(self.pending.get(..start).unwrap_or(&[]));
+                        self.pending.drain(..end);
+                        self.scanned = 0;
+                        return Ok(frame);
+                    }
+                    Some(None) => {
+                        // Not telemetry of this exchange: cut it out.
+                        self.pending.drain(start..end);
+                        self.scanned = start;
+                    }
+                    // Telemetry (or a corrupt frame, which the decoder of the dump
+                    // reports): keep it in place.
+                    Some(Some(false)) | None => start = end,
+                }
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(self.failure(&format!(
+                    "no {what} from the image within {} s ({} bytes received meanwhile)",
+                    timeout.as_secs(),
+                    self.pending.len()
+                )));
+            }
+            let mut chunk = [0u8; 4096];
+            match self.wire.recv(&mut chunk, deadline - now) {
+                Ok(0) => return Err(self.failure("QEMU closed the connection")),
+                Ok(n) => self
+                    .pending
+                    .extend_from_slice(chunk.get(..n).unwrap_or(&[])),
+                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(e) => return Err(self.failure(&format!("reading from the image: {e}"))),
+            }
+        }
+    }
+
+    /// An error naming `what` went wrong, with QEMU's state and the end of its stderr.
+    fn failure(&mut self, what: &str) -> anyhow::Error {
+        let state = match self.child.try_wait() {
+            Ok(Some(status)) => format!("QEMU exited ({status})"),
+            Ok(None) => "QEMU still running".to_string(),
+            Err(e) => format!("QEMU state unknown ({e})"),
+        };
+        let stderr = stderr_text(&self.stderr);
+        if stderr.is_empty() {
+            anyhow!("{what}; {state}")
+        } else {
+            anyhow!("{what}; {state}; QEMU said: {stderr}")
+        }
+    }
+}
+
+fn stderr_text(stderr: &Mutex<Vec<u8>>) -> String {
+    let bytes = stderr.lock().unwrap_or_else(|e| e.into_inner());
+    String::from_utf8_lossy(&bytes).trim().replace('\n', " | ")
+}
+
+impl FlightControllerLink for QemuLink {
+    fn describe(&self) -> String {
+        self.transport.link_name().to_string()
+    }
+
+    fn begin_record(&mut self, config: &Config) -> anyhow::Result<()> {
+        let request = link_config(config)?;
+        let answer = self
+            .session()
+            .and_then(|session| session.configure(request));
+        let answer = self.keep_if_ok(answer)?;
+        if answer.accepted {
+            return Ok(());
+        }
+        let reason = FlightController::new(*config)
+            .err()
+            .map_or("a reason this host's firmware library does not see", |e| {
+                e.message()
+            });
+        bail!(
+            "the image refused the configuration (ConfigError #{}): {reason}",
+            answer.refusal
+        )
+    }
+
+    fn exchange(
+        &mut self,
+        input: &SensorIn,
+        telemetry: &mut Vec<u8>,
+    ) -> anyhow::Result<ActuatorOut> {
+        let mut stray = 0;
+        let result = self
+            .session()
+            .and_then(|session| session.exchange(input, telemetry, &mut stray));
+        self.stray_answers += stray;
+        self.keep_if_ok(result)
+    }
+}
+
+impl Session {
+    /// Send `request` and wait for its answer.
+    fn configure(&mut self, request: LinkConfig) -> anyhow::Result<ConfigureResult> {
+        self.send(&Frame::Configure(request))?;
+        // Everything before the answer belongs to the previous configuration (boot
+        // Header, standalone Samples, the watchdog's own steps): discarded.
+        let mut discarded = Vec::new();
+        let answer = self.read_until(
+            CONFIGURE_TIMEOUT,
+            "ConfigureResult (an image older than protocol 1.1? rebuild it with `cargo fw`)",
+            |frame| Some(matches!(frame, Frame::ConfigureResult(_))),
+            &mut discarded,
+        )?;
+        match answer {
+            Frame::ConfigureResult(result) => Ok(result),
+            other => bail!("unexpected answer to Configure: {other:?}"),
+        }
+    }
+
+    /// One lockstep tick; ActuatorOut frames answering another seq are counted in `stray`.
+    fn exchange(
+        &mut self,
+        input: &SensorIn,
+        telemetry: &mut Vec<u8>,
+        stray: &mut u64,
+    ) -> anyhow::Result<ActuatorOut> {
+        self.send(&Frame::SensorIn(*input))?;
+        let seq = input.seq;
+        let answer = self.read_until(
+            TICK_TIMEOUT,
+            "ActuatorOut",
+            |frame| match frame {
+                Frame::ActuatorOut(out) if out.seq == seq => Some(true),
+                Frame::ActuatorOut(_) => {
+                    *stray += 1;
+                    None
+                }
+                Frame::ConfigureResult(_) => None,
+                _ => Some(false),
+            },
+            telemetry,
+        )?;
+        match answer {
+            Frame::ActuatorOut(out) => Ok(out),
+            other => bail!("unexpected frame closing the tick: {other:?}"),
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        self.wire.shutdown();
+    }
+}
+
+/// Wait for QEMU to connect to `listener` (it is the client), watching that it runs.
+fn accept(
+    listener: &TcpListener,
+    child: &mut Child,
+    stderr: &Mutex<Vec<u8>>,
+) -> anyhow::Result<TcpStream> {
+    let deadline = Instant::now() + CONNECT_TIMEOUT;
+    let stream = loop {
+        match listener.accept() {
+            Ok((stream, _)) => break stream,
+            Err(e) if e.kind() == ErrorKind::WouldBlock => {}
+            Err(e) => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(e).context("accepting QEMU's connection");
+            }
+        }
+        if let Ok(Some(status)) = child.try_wait() {
+            std::thread::sleep(Duration::from_millis(50));
+            bail!(
+                "{QEMU} exited ({status}) before connecting: {}",
+                stderr_text(stderr)
+            );
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            bail!(
+                "{QEMU} did not connect within {} s",
+                CONNECT_TIMEOUT.as_secs()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    stream.set_nonblocking(false)?;
+    stream.set_nodelay(true)?;
+    Ok(stream)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sweephold_protocol::Axis;
+
+    #[test]
+    fn a_preset_with_another_test_travels_in_a_configure_frame() {
+        let mut config = Config::bo105_default(Axis::Lon);
+        config.rate_hz = 250;
+        config.test.seed = 77;
+        config.test.sweep.t_rec_s = 12.0;
+        let request = link_config(&config).expect("representable");
+        assert_eq!(request.vehicle, VehicleId::Bo105);
+        assert_eq!(request.rate_hz, 250);
+        assert_eq!(request.test, config.test);
+    }
+
+    #[test]
+    fn settings_outside_the_configure_frame_are_refused() {
+        let mut config = Config::trex700l_default(Axis::Lat);
+        config.trim_capture_s += 0.5;
+        let error = link_config(&config).expect_err("not representable");
+        assert!(error.to_string().contains("build an image"), "{error}");
+    }
+
+    #[test]
+    fn a_missing_image_is_named_with_the_command_that_builds_it() {
+        let mut link = QemuLink::new(
+            Path::new("/nonexistent/sweephold-fc"),
+            QemuTransport::Semihosting,
+            &[],
+        );
+        let error = link
+            .begin_record(&Config::bo105_default(Axis::Lat))
+            .expect_err("no image");
+        let text = error.to_string();
+        assert!(
+            text.contains("cargo fw") || text.contains("apt-get install qemu-system-arm"),
+            "{text}"
+        );
+    }
+}

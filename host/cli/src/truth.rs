@@ -1,0 +1,666 @@
+//! Truth scoring: the parameter values a model structure takes when it is fitted to the
+//! simulator's own linearization, the truth `Model` built from them, and the cost of an
+//! identified model against it.
+//!
+//! The simulator (`bo105`) is linearized at hover trim: `ẋ = A x + B u` with
+//! `x = [u v w p q r phi theta psi beta1c beta1s]`, `u = [lat lon ped col]` stick fractions.
+//! Parameters are mapped by name:
+//!
+//! - **Structures without flapping states** (the quasi-steady 6-DOF): a derivative
+//!   `X|Y|Z|L|M|N` + `u|v|w|p|q|r|lat|lon|ped|col` is the simulator's quasi-static
+//!   derivative of that name (flapping residualized, L and N primed — the entries of ṗ, ṙ).
+//! - **Structures with flapping states `b1c`, `b1s`** (the 9-DOF hybrid): body derivatives
+//!   are entries of the full A and B (`Xw = A[u, w]`, `Lb1s = s_s·A[p, beta1s]`, …), with
+//!   the structure's flapping states `b1c = s_c·beta1c`, `b1s = s_s·beta1s`. The signs are
+//!   derived from the structure's own flap equations: its row
+//!   `M[b1c,b1c] β̇ = F[b1c,b1c] β + F[b1c,q] q + …` has the rate coupling
+//!   `F[b1c,q]/M[b1c,b1c]` (−1 for `τ_f β̇1c = −β1c − τ_f q`); the disc lags the shaft in the
+//!   simulator with `∂β̇1c/∂q = A[beta1c, q]` (+1.05 in Padfield's convention), so
+//!   `s_c = sign(F[b1c,q]/M[b1c,b1c]) · sign(A[beta1c,q])` (−1 for the shipped file), and
+//!   likewise `s_s` with p. Then `tau_f` is the simulator's flap time constant,
+//!   `Mf_k = τ_f·s_c·B[beta1c, k]` and `Lf_k = τ_f·s_s·B[beta1s, k]` (the structure
+//!   multiplies the flap equation by τ_f), and a body row's flapping column is
+//!   `F[row, b1c] = A[row, beta1c]/s_c`.
+//! - **Delays**: A and B exclude the servos. Their second-order lag (ω_n, ζ) acts like a
+//!   delay of `2ζ/ω_n` (the low-frequency phase of `ω_n²/(s² + 2ζω_n s + ω_n²)`) plus the
+//!   transport delay; `tau_lat … tau_col` take that. The 6-DOF equivalent delays
+//!   `teq_lat`, `teq_lon` add the rotor lag τ_f (the flapping folded in), `teq_ped`,
+//!   `teq_col` do not. These delays are approximations of the truth, not exact entries.
+//!
+//! A structure parameter the mapping does not know is left out of the truth values; the
+//! truth model then holds it at 0 (listed in [`StructureTruth::unmapped`]). Truth values
+//! the structure has no parameter for are simply not used.
+
+use std::collections::BTreeMap;
+
+use anyhow::{anyhow, Context};
+use bo105::{linearize, trim, Linearization, SimOptions, Vehicle};
+use sysid::fit::report::{TruthPairCost, TruthParameter, TruthSection};
+use sysid::fit::structure::MatrixName;
+use sysid::fit::{cost_between_models, FitResult, Model, ModelComparison, ModelStructure};
+
+/// Fit points per pair when an identified model is scored against the truth (n_ω).
+pub const TRUTH_POINTS_PER_PAIR: usize = 20;
+
+/// The simulator's linear truth at hover trim.
+#[derive(Clone, Debug)]
+pub struct VehicleTruth {
+    /// Which vehicle.
+    pub vehicle: Vehicle,
+    /// Linearization at hover trim (flapping states included, quasi-static derivatives).
+    pub linearization: Linearization,
+    /// Equivalent delay of the default servos: 2ζ/ω_n + transport delay [s].
+    pub actuator_delay_s: f64,
+}
+
+impl VehicleTruth {
+    /// Trim `vehicle` at hover and linearize it; the servos are `SimOptions::default()`'s,
+    /// the ones `sweephold fly` flies with.
+    pub fn at_hover(vehicle: Vehicle) -> anyhow::Result<VehicleTruth> {
+        let heli = vehicle.helicopter();
+        let trimmed =
+            trim(&heli, 0.0).map_err(|e| anyhow!("cannot trim {vehicle} at hover: {e}"))?;
+        let linearization = linearize(&heli, &trimmed);
+        let actuator = SimOptions::default().actuator;
+        let servo_lag = if actuator.natural_frequency_rad_s.is_finite()
+            && actuator.natural_frequency_rad_s > 0.0
+        {
+            2.0 * actuator.damping / actuator.natural_frequency_rad_s
+        } else {
+            0.0
+        };
+        Ok(VehicleTruth {
+            vehicle,
+            linearization,
+            actuator_delay_s: servo_lag + actuator.transport_delay_s,
+        })
+    }
+
+    fn state(&self, name: &str) -> Option<usize> {
+        self.linearization.states.iter().position(|s| *s == name)
+    }
+
+    fn control(&self, name: &str) -> Option<usize> {
+        self.linearization.controls.iter().position(|c| *c == name)
+    }
+
+    fn a(&self, row: &str, column: &str) -> Option<f64> {
+        Some(self.linearization.a[self.state(row)?][self.state(column)?])
+    }
+
+    fn b(&self, row: &str, control: &str) -> Option<f64> {
+        Some(self.linearization.b[self.state(row)?][self.control(control)?])
+    }
+
+    /// The full linearization as a [`Model`] on the rigid-body outputs
+    /// `u v w p q r phi theta` (each measuring its state; no feed-through), with `delays`
+    /// per control: the reference the truth mapping is checked against.
+    pub fn linear_model(&self, delays: &[f64]) -> Model {
+        let lin = &self.linearization;
+        let states: Vec<String> = lin.states.iter().map(|s| s.to_string()).collect();
+        let controls: Vec<String> = lin.controls.iter().map(|s| s.to_string()).collect();
+        let outputs: Vec<String> = ["u", "v", "w", "p", "q", "r", "phi", "theta"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let mut model = Model::zeros(states, controls, outputs.clone());
+        for i in 0..lin.states.len() {
+            model.m[(i, i)] = 1.0;
+            for j in 0..lin.states.len() {
+                model.f[(i, j)] = lin.a[i][j];
+            }
+            for j in 0..lin.controls.len() {
+                model.g[(i, j)] = lin.b[i][j];
+            }
+        }
+        for (row, name) in outputs.iter().enumerate() {
+            if let Some(state) = self.state(name) {
+                model.h0[(row, state)] = 1.0;
+            }
+        }
+        for (k, delay) in delays.iter().enumerate().take(model.delays.len()) {
+            model.delays[k] = *delay;
+        }
+        model
+    }
+}
+
+/// The truth of one structure.
+#[derive(Clone, Debug)]
+pub struct StructureTruth {
+    /// Truth value of every parameter (base and constrained) the mapping knows, by name.
+    pub values: BTreeMap<String, f64>,
+    /// Base-parameter vector in structure order (unmapped ones at 0).
+    pub base_values: Vec<f64>,
+    /// Base parameters the mapping does not know (held at 0 in `model`).
+    pub unmapped: Vec<String>,
+    /// Flapping-state signs (structure state = sign · simulator state), when the
+    /// structure has `b1c` / `b1s`.
+    pub flap_signs: BTreeMap<String, f64>,
+    /// The structure's model at the truth values.
+    pub model: Model,
+}
+
+/// Body axis letter → the state whose row it is.
+fn axis_state(axis: char) -> Option<&'static str> {
+    Some(match axis {
+        'X' => "u",
+        'Y' => "v",
+        'Z' => "w",
+        'L' => "p",
+        'M' => "q",
+        'N' => "r",
+        _ => return None,
+    })
+}
+
+const BODY_STATES: [&str; 6] = ["u", "v", "w", "p", "q", "r"];
+const CONTROLS: [&str; 4] = ["lat", "lon", "ped", "col"];
+
+/// Sign of `coefficient of rate column / coefficient of the own column of M` in the
+/// structure's flap row `flap`, i.e. the sign of the structure's ∂β̇/∂(rate).
+fn structure_rate_coupling(structure: &ModelStructure, flap: &str, rate: &str) -> Option<f64> {
+    let row = structure.states.iter().position(|s| s == flap)?;
+    let column = structure.states.iter().position(|s| s == rate)?;
+    let values = structure.values();
+    let entry = |matrix: MatrixName, col: usize| {
+        structure
+            .entries
+            .iter()
+            .find(|e| e.matrix == matrix && e.row == row && e.column == col)
+            .map(|e| e.expression.evaluate(&values))
+    };
+    let coupling = entry(MatrixName::F, column)?;
+    // M defaults to the identity.
+    let mass = entry(MatrixName::M, row).unwrap_or(1.0);
+    let ratio = coupling / mass;
+    (ratio != 0.0 && ratio.is_finite()).then(|| ratio.signum())
+}
+
+/// The simulator's flapping responds to more than the structure's flap equations carry
+/// (speed and cross-axis rates, the other flap state, a rate coupling of 1.05 instead of
+/// 1). Quasi-statically that difference is
+///
+/// ```text
+/// Δβ = Q − P,   Q = −A_ff⁻¹ [A_fs | B_f]   (the simulator's quasi-static flapping)
+///               P = τ_f [S_fs | B_f]          (the structure's: β̇ = −β/τ_f + S_fs x + B_f u)
+/// ```
+///
+/// per body state or control (simulator flap coordinates). A body row whose structure row
+/// has a flapping column only gets the part its flapping misses, `A_if·(Q − P)`; a row
+/// without one (yaw) gets the whole quasi-static flapping, `A_if·Q`. This is how the
+/// speed derivatives Xu, Lv, Mu, Nv come to their quasi-static values (the paper fixes
+/// them from trim) and how the yaw row takes the roll-flap moment.
+struct FoldedFlapping {
+    /// Simulator flap state names, `[beta1c, beta1s]`.
+    flaps: [&'static str; 2],
+    /// Q per column name (body states and controls): `[for beta1c, for beta1s]`.
+    simulator: BTreeMap<&'static str, [f64; 2]>,
+    /// P per column name.
+    structure: BTreeMap<&'static str, [f64; 2]>,
+    /// Body rows (simulator state names) whose structure row has each flapping column.
+    rows_with_flap: [Vec<&'static str>; 2],
+    /// A[row, flap] per body row.
+    flap_moment: BTreeMap<&'static str, [f64; 2]>,
+}
+
+impl FoldedFlapping {
+    fn new(
+        structure: &ModelStructure,
+        truth: &VehicleTruth,
+        flap_signs: &BTreeMap<String, f64>,
+        tau_f: f64,
+    ) -> anyhow::Result<FoldedFlapping> {
+        let flaps = ["beta1c", "beta1s"];
+        let structure_flaps = ["b1c", "b1s"];
+        let missing = || anyhow!("the linearization has no flapping states");
+        let a = |row: &str, column: &str| truth.a(row, column).ok_or_else(missing);
+        let a_ff = nalgebra::Matrix2::new(
+            a(flaps[0], flaps[0])?,
+            a(flaps[0], flaps[1])?,
+            a(flaps[1], flaps[0])?,
+            a(flaps[1], flaps[1])?,
+        );
+        let a_ff_inverse = a_ff
+            .try_inverse()
+            .ok_or_else(|| anyhow!("the flapping block of A is singular"))?;
+        let values = structure.values();
+        let state_index = |name: &str| structure.states.iter().position(|s| s == name);
+        // The structure's ∂β̇/∂x_j of flap row `flap`, in simulator coordinates.
+        let structure_coupling = |flap: usize, column: &str| -> f64 {
+            let (Some(row), Some(col)) = (state_index(structure_flaps[flap]), state_index(column))
+            else {
+                return 0.0;
+            };
+            let entry = |matrix: MatrixName, c: usize| {
+                structure
+                    .entries
+                    .iter()
+                    .find(|e| e.matrix == matrix && e.row == row && e.column == c)
+                    .map(|e| e.expression.evaluate(&values))
+            };
+            let mass = entry(MatrixName::M, row).unwrap_or(1.0);
+            let sign = flap_signs
+                .get(structure_flaps[flap])
+                .copied()
+                .unwrap_or(1.0);
+            // β_s = sign·β: β̇ = sign·β̇_s = sign·(F/M)·x_j.
+            sign * entry(MatrixName::F, col).unwrap_or(0.0) / mass
+        };
+        let mut simulator = BTreeMap::new();
+        let mut structure_flapping = BTreeMap::new();
+        for column in BODY_STATES.iter().chain(CONTROLS.iter()) {
+            let (forcing, modelled) = if BODY_STATES.contains(column) {
+                (
+                    nalgebra::Vector2::new(a(flaps[0], column)?, a(flaps[1], column)?),
+                    [structure_coupling(0, column), structure_coupling(1, column)],
+                )
+            } else {
+                let b = |flap: &str| truth.b(flap, column).ok_or_else(missing);
+                let forcing = nalgebra::Vector2::new(b(flaps[0])?, b(flaps[1])?);
+                // The structure's flap control terms are mapped from B exactly.
+                (forcing, [forcing[0], forcing[1]])
+            };
+            let quasi_static = -(a_ff_inverse * forcing);
+            simulator.insert(*column, [quasi_static[0], quasi_static[1]]);
+            structure_flapping.insert(*column, [tau_f * modelled[0], tau_f * modelled[1]]);
+        }
+        let mut rows_with_flap = [Vec::new(), Vec::new()];
+        let mut flap_moment = BTreeMap::new();
+        for row in BODY_STATES {
+            flap_moment.insert(row, [a(row, flaps[0])?, a(row, flaps[1])?]);
+            for (f, list) in rows_with_flap.iter_mut().enumerate() {
+                let has = match (state_index(row), state_index(structure_flaps[f])) {
+                    (Some(r), Some(c)) => structure
+                        .entries
+                        .iter()
+                        .any(|e| e.matrix == MatrixName::F && e.row == r && e.column == c),
+                    _ => false,
+                };
+                if has {
+                    list.push(row);
+                }
+            }
+        }
+        Ok(FoldedFlapping {
+            flaps,
+            simulator,
+            structure: structure_flapping,
+            rows_with_flap,
+            flap_moment,
+        })
+    }
+
+    /// The quasi-static flapping correction to body derivative `row`/`column`.
+    fn correction(&self, row: &str, column: &str) -> Option<f64> {
+        let moment = self.flap_moment.get(row)?;
+        let simulator = self.simulator.get(column)?;
+        let structure = self.structure.get(column)?;
+        let mut total = 0.0;
+        for f in 0..self.flaps.len() {
+            let modelled = if self.rows_with_flap[f].contains(&row) {
+                structure[f]
+            } else {
+                0.0
+            };
+            total += moment[f] * (simulator[f] - modelled);
+        }
+        Some(total)
+    }
+}
+
+/// Map the truth onto `structure`'s parameters (see the module documentation).
+pub fn structure_truth(
+    structure: &ModelStructure,
+    truth: &VehicleTruth,
+) -> anyhow::Result<StructureTruth> {
+    let lin = &truth.linearization;
+    let has = |state: &str| structure.states.iter().any(|s| s == state);
+    let hybrid = has("b1c") || has("b1s");
+    let mut flap_signs = BTreeMap::new();
+    // (structure state, simulator state, rate it couples to)
+    for (flap, simulator, rate) in [("b1c", "beta1c", "q"), ("b1s", "beta1s", "p")] {
+        if !has(flap) {
+            continue;
+        }
+        let simulator_coupling = truth
+            .a(simulator, rate)
+            .context("the linearization has no flapping states")?;
+        // Padfield's convention as a fallback when the structure writes no rate coupling:
+        // DESIGN's states are the negatives of the simulator's (bo105 README).
+        let sign = match structure_rate_coupling(structure, flap, rate) {
+            Some(structure_sign) => structure_sign * simulator_coupling.signum(),
+            None => -1.0,
+        };
+        flap_signs.insert(flap.to_string(), sign);
+    }
+    let tau_f = lin.tau_f_s;
+    let delay = truth.actuator_delay_s;
+    let folded = if hybrid {
+        Some(FoldedFlapping::new(structure, truth, &flap_signs, tau_f)?)
+    } else {
+        None
+    };
+
+    let value_of = |name: &str| -> Option<f64> {
+        match name {
+            "tau_f" => return Some(tau_f),
+            "tau_lat" | "tau_lon" | "tau_ped" | "tau_col" => return Some(delay),
+            "teq_lat" | "teq_lon" => return Some(delay + tau_f),
+            "teq_ped" | "teq_col" => return Some(delay),
+            _ => {}
+        }
+        // Flap-equation control terms: Mf_k (row b1c), Lf_k (row b1s).
+        for (prefix, flap, simulator) in [("Mf_", "b1c", "beta1c"), ("Lf_", "b1s", "beta1s")] {
+            if let Some(control) = name.strip_prefix(prefix) {
+                let sign = *flap_signs.get(flap)?;
+                return Some(tau_f * sign * truth.b(simulator, control)?);
+            }
+        }
+        let mut chars = name.chars();
+        let row = axis_state(chars.next()?)?;
+        let suffix = chars.as_str();
+        if hybrid {
+            let correction = folded.as_ref()?.correction(row, suffix);
+            if BODY_STATES.contains(&suffix) {
+                return Some(truth.a(row, suffix)? + correction?);
+            }
+            if CONTROLS.contains(&suffix) {
+                return Some(truth.b(row, suffix)? + correction?);
+            }
+            let simulator = match suffix {
+                "b1c" => "beta1c",
+                "b1s" => "beta1s",
+                _ => return None,
+            };
+            let sign = *flap_signs.get(suffix)?;
+            // F[row, b1c]·b1c = A[row, beta1c]·beta1c with b1c = sign·beta1c.
+            truth.a(row, simulator).map(|a| a / sign)
+        } else if BODY_STATES.contains(&suffix) || CONTROLS.contains(&suffix) {
+            lin.quasi_static.get(name).copied()
+        } else {
+            None
+        }
+    };
+
+    let mut values = BTreeMap::new();
+    let mut base_values = Vec::with_capacity(structure.parameters.len());
+    let mut unmapped = Vec::new();
+    for parameter in &structure.parameters {
+        match value_of(&parameter.name) {
+            Some(v) => {
+                values.insert(parameter.name.clone(), v);
+                base_values.push(v);
+            }
+            None => {
+                unmapped.push(parameter.name.clone());
+                base_values.push(0.0);
+            }
+        }
+    }
+    // Constrained parameters: their own truth when the mapping knows the name (e.g.
+    // Yb1s), else what their expression gives at the truth.
+    for derived in &structure.derived {
+        let v =
+            value_of(&derived.name).unwrap_or_else(|| derived.expression.evaluate(&base_values));
+        values.insert(derived.name.clone(), v);
+    }
+    let model = structure.model(&base_values)?;
+    Ok(StructureTruth {
+        values,
+        base_values,
+        unmapped,
+        flap_signs,
+        model,
+    })
+}
+
+/// Score a fit against the simulator's truth: every parameter with its truth value and
+/// error, and J per fitted pair of the identified model against the structure's truth
+/// model (the `truth` section of `model.json`).
+pub fn score_fit(result: &FitResult, truth: &VehicleTruth) -> anyhow::Result<TruthSection> {
+    let mapped = structure_truth(&result.structure, truth)?;
+    let parameters = result
+        .parameters
+        .iter()
+        .map(|p| {
+            let truth = mapped.values.get(&p.name).copied();
+            TruthParameter {
+                name: p.name.clone(),
+                value: p.value,
+                truth,
+                error_percent: truth
+                    .filter(|t| *t != 0.0)
+                    .map(|t| 100.0 * (p.value - t) / t.abs()),
+            }
+        })
+        .collect();
+    let comparison: ModelComparison = cost_between_models(
+        &mapped.model,
+        &result.model,
+        &result.bands(),
+        TRUTH_POINTS_PER_PAIR,
+    )?;
+    Ok(TruthSection {
+        vehicle: truth.vehicle.name().to_string(),
+        parameters,
+        pairs: comparison
+            .bands
+            .iter()
+            .zip(&comparison.costs)
+            .map(|(band, cost)| TruthPairCost {
+                input: band.input.clone(),
+                output: band.output.clone(),
+                range: band.range,
+                cost: *cost,
+            })
+            .collect(),
+        average_cost: comparison.average,
+        unmapped: mapped.unmapped,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn shipped(name: &str) -> ModelStructure {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../sysid/models")
+            .join(name);
+        ModelStructure::from_path(&path).unwrap()
+    }
+
+    /// Worst magnitude ratio error |(|T_a|/|T_b|) − 1| and worst phase difference [deg]
+    /// of T_a against T_b over 40 log-spaced frequencies of `band`.
+    fn worst_errors(a: &Model, b: &Model, output: &str, input: &str, band: [f64; 2]) -> (f64, f64) {
+        let (ai, ao) = (
+            a.control_index(input).unwrap(),
+            a.output_index(output).unwrap(),
+        );
+        let (bi, bo) = (
+            b.control_index(input).unwrap(),
+            b.output_index(output).unwrap(),
+        );
+        sysid::fit::cost::log_spaced(band[0], band[1], 40)
+            .into_iter()
+            .map(|w| {
+                let ta = a.frequency_response(ai, ao, w);
+                let tb = b.frequency_response(bi, bo, w);
+                let phase = sysid::fit::cost::wrap_degrees((ta / tb).arg().to_degrees());
+                ((ta.norm() / tb.norm() - 1.0).abs(), phase.abs())
+            })
+            .fold((0.0, 0.0), |(m, p), (mi, pi)| {
+                (f64::max(m, mi), f64::max(p, pi))
+            })
+    }
+
+    #[test]
+    fn hybrid_truth_reproduces_the_simulator_responses() {
+        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let structure = shipped("bo105-9dof-hybrid.toml");
+        let mapped = structure_truth(&structure, &truth).unwrap();
+        assert!(mapped.unmapped.is_empty(), "{:?}", mapped.unmapped);
+        // The shipped file writes τ_f β̇1c = −β1c − τ_f q; the simulator's disc lags the
+        // shaft with +q: the structure's flapping states are the negatives.
+        assert_eq!(mapped.flap_signs["b1c"], -1.0);
+        assert_eq!(mapped.flap_signs["b1s"], -1.0);
+        // Stable rotor: positive flapping moment derivatives in the structure's signs.
+        assert!(mapped.values["Lb1s"] > 100.0, "{}", mapped.values["Lb1s"]);
+        assert!(mapped.values["Mb1c"] > 20.0, "{}", mapped.values["Mb1c"]);
+        // Speed derivatives come out at their quasi-static values (folded flapping).
+        let quasi_static = &truth.linearization.quasi_static;
+        for name in ["Xu", "Mu", "Lv", "Nv", "Np", "Nlat"] {
+            let (ours, reference) = (mapped.values[name], quasi_static[name]);
+            assert!(
+                (ours - reference).abs() <= 0.05 * reference.abs(),
+                "{name}: {ours} vs {reference}"
+            );
+        }
+        // The truth model reproduces the simulator's own linear responses above the
+        // low-frequency coupled modes (which both structures simplify: no Lu, Mp, Lq, …).
+        let reference = truth.linear_model(&mapped.model.delays);
+        for (output, input) in [("p", "lat"), ("q", "lon")] {
+            let (magnitude, phase) =
+                worst_errors(&mapped.model, &reference, output, input, [2.0, 30.0]);
+            assert!(
+                magnitude < 0.1 && phase < 5.0,
+                "{output}/{input}: {:.1} %, {phase:.1} deg",
+                100.0 * magnitude
+            );
+        }
+        // With the wrong flapping signs the responses are far off: the test can fail.
+        let mut flipped = mapped.base_values.clone();
+        for name in ["Lb1s", "Mb1c", "Lf_lat", "Mf_lon"] {
+            let index = structure.parameter_index(name).unwrap();
+            flipped[index] = -flipped[index];
+        }
+        let wrong = structure.model(&flipped).unwrap();
+        let (magnitude, phase) = worst_errors(&wrong, &reference, "p", "lat", [2.0, 30.0]);
+        assert!(magnitude > 0.5 || phase > 45.0, "{magnitude} {phase}");
+    }
+
+    #[test]
+    fn six_dof_truth_is_the_quasi_static_derivatives() {
+        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let structure = shipped("bo105-6dof.toml");
+        let mapped = structure_truth(&structure, &truth).unwrap();
+        assert!(mapped.unmapped.is_empty(), "{:?}", mapped.unmapped);
+        assert!(mapped.flap_signs.is_empty());
+        let lin = &truth.linearization;
+        assert_eq!(mapped.values["Lp"], lin.quasi_static["Lp"]);
+        assert_eq!(mapped.values["Llat"], lin.quasi_static["Llat"]);
+        assert!((mapped.values["teq_lat"] - truth.actuator_delay_s - lin.tau_f_s).abs() < 1e-12);
+        // Between the low-frequency coupled modes and the rotor modes the quasi-steady
+        // model follows the full one: p/lat and q/lon, both undelayed, over 1.5–3 rad/s.
+        let mut undelayed = mapped.model.clone();
+        undelayed.delays = vec![0.0; 4];
+        let reference = truth.linear_model(&[0.0; 4]);
+        for (output, input) in [("p", "lat"), ("q", "lon")] {
+            let (magnitude, phase) =
+                worst_errors(&undelayed, &reference, output, input, [1.5, 3.0]);
+            assert!(
+                magnitude < 0.15 && phase < 8.0,
+                "{output}/{input}: {:.1} %, {phase:.1} deg",
+                100.0 * magnitude
+            );
+        }
+    }
+
+    #[test]
+    fn fit_to_the_truth_responses_recovers_the_truth_and_scores_zero() {
+        use sysid::fit::report::ScoredModelDocument;
+        use sysid::fit::structure::ParameterKind;
+        use sysid::fit::synthetic::{exact_frf_document, SyntheticGrid};
+        use sysid::fit::{fit, FitOptions, ModelDocument};
+
+        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let structure = shipped("bo105-6dof.toml");
+        let mapped = structure_truth(&structure, &truth).unwrap();
+        // Everything at its truth and fixed, except Lp and Llat, started 30 % off.
+        let mut start = structure.with_values(&mapped.base_values).unwrap();
+        for parameter in &mut start.parameters {
+            if parameter.name == "Lp" || parameter.name == "Llat" {
+                parameter.value *= 1.3;
+            } else {
+                parameter.kind = ParameterKind::Fixed;
+            }
+        }
+        let bands: Vec<sysid::fit::PairBand> = [("p", "lat"), ("q", "lon"), ("r", "ped")]
+            .iter()
+            .map(|(output, input)| sysid::fit::PairBand {
+                input: input.to_string(),
+                output: output.to_string(),
+                range: [0.5, 12.0],
+            })
+            .collect();
+        start.pairs.retain(|p| {
+            bands
+                .iter()
+                .any(|b| b.input == p.input && b.output == p.output)
+        });
+        let data = exact_frf_document(&mapped.model, &bands, SyntheticGrid::FitPoints(20));
+        let options = FitOptions {
+            max_starts: 2,
+            ..FitOptions::default()
+        };
+        let result = fit(&start, &data, &options).unwrap();
+        let section = score_fit(&result, &truth).unwrap();
+        assert_eq!(section.vehicle, "bo105");
+        for name in ["Lp", "Llat"] {
+            let row = section.parameters.iter().find(|p| p.name == name).unwrap();
+            assert!(row.error_percent.unwrap().abs() < 0.01, "{row:?}");
+        }
+        assert_eq!(section.pairs.len(), 3);
+        assert!(section.average_cost < 1e-6, "{}", section.average_cost);
+        // Both tables name the columns; model.json round-trips with and without truth.
+        let table = sysid::fit::report::parameter_table_with_truth(&result, &section);
+        assert!(
+            table.contains("truth") && table.contains("error %"),
+            "{table}"
+        );
+        assert!(section.cost_table().contains("J_ave"));
+        let document = ScoredModelDocument {
+            model: result.to_document(),
+            truth: Some(section.clone()),
+        };
+        let json = serde_json::to_string(&document).unwrap();
+        // (serde_json's default float parsing may differ in the last bit: compare closely.)
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300);
+        let back: ScoredModelDocument = serde_json::from_str(&json).unwrap();
+        let back_truth = back.truth.expect("truth section read back");
+        assert_eq!(back_truth.parameters.len(), section.parameters.len());
+        for (a, b) in back_truth.parameters.iter().zip(&section.parameters) {
+            assert_eq!(a.name, b.name);
+            assert!(close(a.value, b.value), "{a:?} {b:?}");
+            assert_eq!(a.truth.is_some(), b.truth.is_some());
+        }
+        assert_eq!(back_truth.pairs.len(), 3);
+        let plain: ModelDocument = serde_json::from_str(&json).unwrap();
+        assert_eq!(plain.parameters.len(), document.model.parameters.len());
+        assert_eq!(plain.structure, document.model.structure);
+        let without = serde_json::to_string(&document.model).unwrap();
+        assert!(!without.contains("\"truth\""));
+        let back: ScoredModelDocument = serde_json::from_str(&without).unwrap();
+        assert!(back.truth.is_none());
+    }
+
+    #[test]
+    fn a_perfect_fit_scores_zero_against_the_truth() {
+        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let structure = shipped("bo105-6dof.toml");
+        let mapped = structure_truth(&structure, &truth).unwrap();
+        let bands = vec![sysid::fit::PairBand {
+            input: "lat".into(),
+            output: "p".into(),
+            range: [0.5, 10.0],
+        }];
+        let same = cost_between_models(&mapped.model, &mapped.model, &bands, 20).unwrap();
+        assert!(same.average < 1e-12, "{}", same.average);
+        let mut off = mapped.model.clone();
+        off.g.scale_mut(1.5);
+        let worse = cost_between_models(&mapped.model, &off, &bands, 20).unwrap();
+        assert!(worse.average > 1.0, "{}", worse.average);
+    }
+}

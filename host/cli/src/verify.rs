@@ -1,0 +1,266 @@
+//! `sweephold verify`: simulate an identified model (`model.json`) on the inputs recorded
+//! in telemetry dumps and score its prediction of the recorded outputs with Theil's
+//! inequality coefficient (the time-domain check of CIFER's VERIFID; method in
+//! `sysid::fit::verify`).
+
+use std::fmt::Write as _;
+use std::fs;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context};
+use clap::Args;
+use sysid::fit::verify::{verify_record_in_segments, write_verification_plots, Verification};
+use sysid::fit::ModelDocument;
+use sysid::frf::load_dump;
+
+/// Arguments of `sweephold verify`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Inputs are the applied commands lat lon ped col, taken as perturbations \
+from their first sample; a constant bias per output is fitted by least squares. \
+TIC = rms(y - b - ŷ) / (rms(y - b) + rms(ŷ)): 0 perfect, 1 worst; <= 0.25-0.3 is the usual \
+acceptance guideline."
+)]
+pub struct VerifyArgs {
+    /// The identified model (`model.json` as `sweephold fit --out` writes it).
+    #[arg(long, value_name = "model.json")]
+    pub model: PathBuf,
+    /// Telemetry dumps to verify against (ideally records not used in the fit).
+    #[arg(value_name = "DUMP", required = true)]
+    pub dumps: Vec<PathBuf>,
+    /// Write one SVG per dump and output (measured vs predicted) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    /// Restart the simulation every SECONDS from the measured state (states named like
+    /// recorded outputs; others at 0). Without it the model runs open loop over the whole
+    /// record, which an unstable hover model cannot survive.
+    #[arg(long, value_name = "SECONDS")]
+    pub segment: Option<f64>,
+}
+
+/// Run `sweephold verify`.
+pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
+    let text = fs::read_to_string(&args.model)
+        .with_context(|| format!("cannot read {}", args.model.display()))?;
+    let document: ModelDocument = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a model.json", args.model.display()))?;
+    let model = document.model().ok_or_else(|| {
+        anyhow!(
+            "{}: the matrices do not match its states, controls and outputs",
+            args.model.display()
+        )
+    })?;
+    // Check every file before simulating anything.
+    for dump in &args.dumps {
+        if !dump.is_file() {
+            bail!("cannot read {}: no such file", dump.display());
+        }
+    }
+    let mut report = String::new();
+    let _ = writeln!(
+        report,
+        "model {} ({}), {} states, controls {}, delays {} s",
+        document.structure,
+        args.model.display(),
+        model.states.len(),
+        model.controls.join(" "),
+        model
+            .delays
+            .iter()
+            .map(|d| format!("{d:.4}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    let mut all_theil = Vec::new();
+    for dump in &args.dumps {
+        let record = load_dump(dump).map_err(|e| anyhow!("{e}"))?;
+        let verification =
+            verify_record_in_segments(&model, &record, args.segment).map_err(|e| {
+                // Record errors name the dump already; model errors get it in front.
+                let message = e.to_string();
+                if message.contains(&record.source) {
+                    anyhow!(message)
+                } else {
+                    anyhow!("{}: {message}", dump.display())
+                }
+            })?;
+        write_verification(&mut report, &verification);
+        all_theil.extend(verification.outputs.iter().map(|o| o.theil));
+        if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {
+            let files = write_verification_plots(&verification, dir)?;
+            let _ = writeln!(report, "wrote {} plots to {}", files.len(), dir.display());
+        }
+    }
+    if args.dumps.len() > 1 && !all_theil.is_empty() {
+        let _ = writeln!(
+            report,
+            "\nmean TIC over {} dumps: {:.4}",
+            args.dumps.len(),
+            all_theil.iter().sum::<f64>() / all_theil.len() as f64
+        );
+    }
+    print!("{report}");
+    Ok(())
+}
+
+/// The table of one record: per output TIC, RMS of error, measurement, prediction, bias.
+fn write_verification(out: &mut String, verification: &Verification) {
+    let _ = writeln!(
+        out,
+        "\n{}: {} samples at {} Hz ({:.1} s)",
+        verification.source,
+        verification.samples,
+        verification.sample_rate_hz,
+        verification.samples as f64 / verification.sample_rate_hz
+    );
+    if let Some(at) = verification.diverged_at_s {
+        let _ = writeln!(
+            out,
+            "the model diverged (overflow) at t = {at:.2} s: an unstable mode ran away; \
+             every output scores TIC 1 (try --segment)"
+        );
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "{:<8} {:>8} {:>12} {:>12} {:>12} {:>12}",
+        "output", "TIC", "rms error", "rms meas.", "rms pred.", "bias"
+    );
+    // A prediction that ran away without overflowing the state still overflows the sums.
+    let cell = |value: f64| {
+        if value.is_finite() && value.abs() < 1e9 {
+            format!("{value:.5}")
+        } else {
+            "-".to_string()
+        }
+    };
+    for score in &verification.outputs {
+        let _ = writeln!(
+            out,
+            "{:<8} {:>8.4} {:>12} {:>12} {:>12} {:>12}",
+            score.output,
+            score.theil,
+            cell(score.rms_error),
+            cell(score.rms_measured),
+            cell(score.rms_predicted),
+            cell(score.bias)
+        );
+    }
+    let _ = writeln!(out, "{:<8} {:>8.4}", "mean", verification.theil_mean);
+    if !verification.not_recorded.is_empty() {
+        let _ = writeln!(
+            out,
+            "not recorded (not compared): {}",
+            verification.not_recorded.join(" ")
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(model: PathBuf, dumps: Vec<PathBuf>) -> VerifyArgs {
+        VerifyArgs {
+            model,
+            dumps,
+            plots: None,
+            segment: None,
+        }
+    }
+
+    #[test]
+    fn error_paths_are_one_line_messages() {
+        let directory =
+            std::env::temp_dir().join(format!("sweephold-verify-{}", std::process::id()));
+        fs::create_dir_all(&directory).unwrap();
+        let missing = directory.join("missing.json");
+        let error = run(&args(missing, vec![directory.join("x.bin")])).unwrap_err();
+        assert!(format!("{error:#}").contains("cannot read"), "{error:#}");
+
+        let not_json = directory.join("bad.json");
+        fs::write(&not_json, "{").unwrap();
+        let error = run(&args(not_json, vec![directory.join("x.bin")])).unwrap_err();
+        assert!(
+            format!("{error:#}").contains("not a model.json"),
+            "{error:#}"
+        );
+
+        // A model document whose matrices do not fit its names.
+        let mut document = serde_json::json!({
+            "version": 1, "structure": "lag", "description": "",
+            "states": ["p"], "controls": ["lat"], "outputs": ["p"],
+            "matrices": {
+                "M": {"rows": 1, "cols": 1, "data": [1.0]},
+                "F": {"rows": 1, "cols": 1, "data": [-2.0]},
+                "G": {"rows": 1, "cols": 1, "data": [3.0]},
+                "H0": {"rows": 1, "cols": 1, "data": [1.0]},
+                "H1": {"rows": 1, "cols": 1, "data": [0.0]}
+            },
+            "delays": [0.0], "parameters": [], "pairs": [], "average_cost": 0.0,
+            "correlation": null, "starts": [], "minimum_confirmed": true, "reduction": []
+        });
+        let good = directory.join("model.json");
+        fs::write(&good, document.to_string()).unwrap();
+        document["matrices"]["F"]["rows"] = serde_json::json!(2);
+        let mismatched = directory.join("mismatched.json");
+        fs::write(&mismatched, document.to_string()).unwrap();
+        let error = run(&args(mismatched, vec![directory.join("x.bin")])).unwrap_err();
+        assert!(format!("{error:#}").contains("do not match"), "{error:#}");
+
+        // A missing dump is refused before anything is simulated.
+        let error = run(&args(good.clone(), vec![directory.join("x.bin")])).unwrap_err();
+        assert!(format!("{error:#}").contains("no such file"), "{error:#}");
+
+        // A synthetic dump (smooth made-up telemetry): the model runs on it and its
+        // mismatches are named.
+        use sweephold_protocol::{codec, synthetic, Frame};
+        let dump = directory.join("lat-1.bin");
+        let mut bytes = codec::encode_to_vec(&Frame::Header(synthetic::header()))
+            .unwrap()
+            .to_vec();
+        for tick in 0..2000 {
+            bytes.extend(
+                codec::encode_to_vec(&Frame::Sample(synthetic::sample(tick)))
+                    .unwrap()
+                    .to_vec(),
+            );
+        }
+        fs::write(&dump, bytes).unwrap();
+        run(&args(good.clone(), vec![dump.clone()])).unwrap();
+        let plots = directory.join("plots");
+        let with_plots = VerifyArgs {
+            plots: Some(plots.clone()),
+            segment: Some(2.0),
+            ..args(good.clone(), vec![dump.clone()])
+        };
+        run(&with_plots).unwrap();
+        assert!(plots.join("lat-1-p.svg").is_file());
+        document["matrices"]["F"]["rows"] = serde_json::json!(1);
+        document["controls"] = serde_json::json!(["cyc"]);
+        let other_control = directory.join("cyc.json");
+        fs::write(&other_control, document.to_string()).unwrap();
+        let error = run(&args(other_control, vec![dump.clone()])).unwrap_err();
+        let message = format!("{error:#}");
+        assert!(
+            message.contains("`cyc`") && message.contains("lat-1.bin"),
+            "{message}"
+        );
+        assert!(!message.contains('\n'), "{message}");
+        document["controls"] = serde_json::json!(["lat"]);
+        document["outputs"] = serde_json::json!(["roll_rate"]);
+        let other_output = directory.join("roll_rate.json");
+        fs::write(&other_output, document.to_string()).unwrap();
+        let error = run(&args(other_output, vec![dump])).unwrap_err();
+        assert!(format!("{error:#}").contains("roll_rate"), "{error:#}");
+
+        // A file that is not a dump.
+        let garbage = directory.join("garbage.bin");
+        fs::write(&garbage, [1u8, 2, 3, 0, 7, 7, 0]).unwrap();
+        let error = run(&args(good, vec![garbage])).unwrap_err();
+        let message = format!("{error:#}");
+        assert!(message.contains("garbage.bin"), "{message}");
+        assert!(!message.contains('\n'), "{message}");
+        fs::remove_dir_all(&directory).ok();
+    }
+}
