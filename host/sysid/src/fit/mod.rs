@@ -118,18 +118,20 @@ pub enum AccuracyFlag {
     },
 }
 
-/// One parameter of the fitted model.
-#[derive(Clone, Debug, PartialEq)]
+/// One parameter of the fitted model, as reported and as written in `model.json`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ParameterReport {
     /// Engineering name.
     pub name: String,
-    /// Value.
+    /// Value (SI, controls per unit stick fraction).
     pub value: f64,
     /// Free, fixed or constrained.
     pub status: ParameterStatus,
-    /// Cramér–Rao bound in % of |value| (free parameters only).
+    /// Cramér–Rao bound in % of |value| (free parameters only; null in `model.json`
+    /// when infinite).
     pub cramer_rao_percent: Option<f64>,
-    /// Insensitivity in % of |value| (free parameters only).
+    /// Insensitivity in % of |value| (free parameters only; null in `model.json` when
+    /// infinite).
     pub insensitivity_percent: Option<f64>,
     /// Guideline violations.
     pub flags: Vec<AccuracyFlag>,

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::model::{Model, RowMajor};
 use super::reduce::ReductionStep;
-use super::{AccuracyFlag, FitResult, PairFit, ParameterStatus, StartOutcome};
+use super::{AccuracyFlag, FitResult, PairFit, ParameterReport, ParameterStatus, StartOutcome};
 
 /// Version of the `model.json` layout.
 pub const MODEL_DOCUMENT_VERSION: u32 = 1;
@@ -31,23 +31,6 @@ pub struct ModelMatrices {
     /// H1, outputs × states.
     #[serde(rename = "H1")]
     pub h1: RowMajor,
-}
-
-/// One parameter in `model.json`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ParameterEntry {
-    /// Engineering name.
-    pub name: String,
-    /// Value (SI, controls per unit stick fraction).
-    pub value: f64,
-    /// free / fixed / constrained.
-    pub status: ParameterStatus,
-    /// Cramér–Rao bound in % of |value| (null unless free, or when infinite).
-    pub cramer_rao_percent: Option<f64>,
-    /// Insensitivity in % of |value| (null unless free, or when infinite).
-    pub insensitivity_percent: Option<f64>,
-    /// Guideline violations.
-    pub flags: Vec<AccuracyFlag>,
 }
 
 /// The correlation matrix of the free parameters.
@@ -79,7 +62,7 @@ pub struct ModelDocument {
     /// Delay per control [s], in `controls` order.
     pub delays: Vec<f64>,
     /// Base parameters in structure order, then constrained ones.
-    pub parameters: Vec<ParameterEntry>,
+    pub parameters: Vec<ParameterReport>,
     /// J per pair.
     pub pairs: Vec<PairFit>,
     /// Mean J over the pairs.
@@ -218,13 +201,10 @@ impl ModelDocument {
             parameters: result
                 .parameters
                 .iter()
-                .map(|p| ParameterEntry {
-                    name: p.name.clone(),
-                    value: p.value,
-                    status: p.status,
+                .map(|p| ParameterReport {
                     cramer_rao_percent: finite(p.cramer_rao_percent),
                     insensitivity_percent: finite(p.insensitivity_percent),
-                    flags: p.flags.clone(),
+                    ..p.clone()
                 })
                 .collect(),
             pairs: result.pairs.clone(),

@@ -173,11 +173,9 @@ pub fn start_from_quasi_steady(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::report::{
-        CorrelationMatrix, ModelMatrices, ParameterEntry, MODEL_DOCUMENT_VERSION,
-    };
+    use crate::fit::report::{CorrelationMatrix, ModelMatrices, MODEL_DOCUMENT_VERSION};
     use crate::fit::test_support::hybrid_structure;
-    use crate::fit::ParameterStatus;
+    use crate::fit::{ParameterReport, ParameterStatus};
 
     fn six_dof_document(parameters: &[(&str, f64)]) -> ModelDocument {
         let empty = crate::fit::model::RowMajor {
@@ -202,7 +200,7 @@ mod tests {
             delays: Vec::new(),
             parameters: parameters
                 .iter()
-                .map(|(name, value)| ParameterEntry {
+                .map(|(name, value)| ParameterReport {
                     name: name.to_string(),
                     value: *value,
                     status: ParameterStatus::Free,
