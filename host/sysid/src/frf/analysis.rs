@@ -206,12 +206,14 @@ pub(crate) fn prepare_group(
     let lo_used = lo.max(resolved);
     if lo_used >= hi {
         return Err(too_short(format!(
-            "its longest window ({longest:.1} s) resolves only down to {resolved:.2} rad/s, above the band top {hi} rad/s"
+            "its longest window ({longest:.1} s) resolves only down to {resolved:.2} rad/s, above the band top {} rad/s",
+            rounded(hi)
         )));
     }
     if lo_used > lo * (1.0 + 1e-9) {
         notes.push(format!(
-            "{axis} sweep: band starts at {lo_used:.3} rad/s instead of {lo} rad/s: the longest window ({longest:.1} s, half the record) resolves down to 4π/T"
+            "{axis} sweep: band starts at {lo_used:.3} rad/s instead of {} rad/s: the longest window ({longest:.1} s, half the record) resolves down to 4π/T",
+            rounded(lo)
         ));
     }
     let grid = log_grid(lo_used, hi, opts.points);
@@ -509,6 +511,12 @@ fn curves_from_spectra(prepared: &PreparedGroup, spectra: &[WindowSpectra]) -> V
         }
     }
     curves
+}
+
+/// A frequency for messages: 0.01 rather than the 0.009999999776482582 an f32 sweep band
+/// widens to.
+fn rounded(omega: f64) -> f64 {
+    (omega * 1e4).round() / 1e4
 }
 
 /// Magnitude, unwrapped phase, coherence, random error and valid range of composite
