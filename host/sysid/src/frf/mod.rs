@@ -196,11 +196,6 @@ impl std::fmt::Display for FrfError {
     }
 }
 
-impl std::error::Error for FrfError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            FrfError::Io { source, .. } => Some(source),
-            _ => None,
-        }
-    }
-}
+/// The I/O cause is part of the message already (`path: cause`), so no `source()`:
+/// error chains printed with `{:#}` would say it twice.
+impl std::error::Error for FrfError {}
