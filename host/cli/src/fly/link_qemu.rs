@@ -30,11 +30,10 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context};
-use sweephold_firmware::{Config, FlightController};
-use sweephold_protocol::codec::{encode_to_vec, DELIMITER};
-use sweephold_protocol::decoder::decode_frame;
-use sweephold_protocol::{ActuatorOut, ConfigureResult, Frame, LinkConfig, SensorIn, VehicleId};
+use sweephold_firmware::Config;
+use sweephold_protocol::{ActuatorOut, SensorIn};
 
+use super::frame_channel::{check_configure_answer, link_config, ByteWire, FrameChannel};
 use super::link::FlightControllerLink;
 
 /// The QEMU binary.
@@ -97,29 +96,6 @@ pub fn qemu_available() -> anyhow::Result<()> {
         }
         Err(e) => bail!("cannot run {QEMU}: {e}"),
     }
-}
-
-/// What the image can be told at run time: a configuration the Configure frame carries
-/// exactly, i.e. the vehicle's preset for the primary axis with another rate and test.
-fn link_config(config: &Config) -> anyhow::Result<LinkConfig> {
-    let mut preset = match config.vehicle {
-        VehicleId::Bo105 => Config::bo105_default(config.test.primary),
-        VehicleId::Trex700l => Config::trex700l_default(config.test.primary),
-    };
-    preset.rate_hz = config.rate_hz;
-    preset.test = config.test;
-    if preset != *config {
-        bail!(
-            "the QEMU link can only change the vehicle, rate and test of the image's preset; \
-             this configuration differs in other settings (gains, mixer, limits, trim \
-             capture): build an image with them"
-        );
-    }
-    Ok(LinkConfig {
-        vehicle: config.vehicle,
-        rate_hz: config.rate_hz,
-        test: config.test,
-    })
 }
 
 /// Extra QEMU arguments from `SWEEPHOLD_QEMU_ARGS` (split on white space), e.g.
@@ -194,7 +170,7 @@ impl QemuLink {
     /// The running session, booting QEMU if there is none.
     fn session(&mut self) -> anyhow::Result<&mut Session> {
         if self.session.is_none() {
-            self.session = Some(Session::start(
+            self.session = Some(start_session(
                 &self.image,
                 self.transport,
                 &self.extra_args,
@@ -316,181 +292,22 @@ fn make_fifos() -> anyhow::Result<Wire> {
 }
 
 /// One QEMU process running the image, and the byte stream to it.
-struct Session {
+struct QemuProcess {
     child: Child,
     wire: Wire,
-    /// Bytes received and not yet handed out (the start of a frame, or frames after the
-    /// one that closed the last exchange).
-    pending: Vec<u8>,
-    /// Where in `pending` the search for the next delimiter resumes.
-    scanned: usize,
     stderr: Arc<Mutex<Vec<u8>>>,
 }
 
-impl Session {
-    /// Boot `image` in QEMU and connect to its USART1. `extra_args` go to QEMU as they
-    /// are (e.g. `-icount shift=0`).
-    fn start(
-        image: &Path,
-        transport: QemuTransport,
-        extra_args: &[String],
-    ) -> anyhow::Result<Self> {
-        qemu_available()?;
-        if !image.is_file() {
-            bail!(
-                "flight-controller image {} not found: build it with `cargo fw`",
-                image.display()
-            );
-        }
-        let image = std::path::absolute(image)
-            .with_context(|| format!("cannot resolve {}", image.display()))?;
-        let mut command = Command::new(QEMU);
-        command
-            .args(["-M", "netduinoplus2", "-nographic", "-monitor", "none"])
-            .arg("-kernel")
-            .arg(&image);
-        let (listener, fifos) = match transport {
-            QemuTransport::Usart => {
-                let listener = TcpListener::bind("127.0.0.1:0")
-                    .context("cannot listen on 127.0.0.1 for QEMU")?;
-                let port = listener.local_addr()?.port();
-                listener.set_nonblocking(true)?;
-                // USART1 is the first serial port of the machine.
-                command
-                    .arg("-chardev")
-                    .arg(format!(
-                        "socket,id=usart1,host=127.0.0.1,port={port},server=off,nodelay=on"
-                    ))
-                    .args(["-serial", "chardev:usart1"]);
-                (Some(listener), None)
-            }
-            QemuTransport::Semihosting => {
-                let fifos = make_fifos()?;
-                if let Wire::Fifo { folder, .. } = &fifos {
-                    // The image opens the FIFOs by relative name.
-                    command.current_dir(folder);
-                }
-                command
-                    .args(["-serial", "null"])
-                    .args(["-semihosting-config", "enable=on,target=native"]);
-                for (address, word) in SEMIHOSTING_MAILBOX {
-                    command.arg("-device").arg(format!(
-                        "loader,addr={address:#x},data={word:#x},data-len=4"
-                    ));
-                }
-                (None, Some(fifos))
-            }
-        };
-        let mut child = command
-            .args(extra_args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .with_context(|| format!("cannot start {QEMU}"))?;
-        let stderr = Arc::new(Mutex::new(Vec::new()));
-        if let Some(mut pipe) = child.stderr.take() {
-            let keep = Arc::clone(&stderr);
-            std::thread::spawn(move || {
-                let mut chunk = [0u8; 512];
-                while let Ok(n @ 1..) = pipe.read(&mut chunk) {
-                    let mut kept = keep.lock().unwrap_or_else(|e| e.into_inner());
-                    kept.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
-                    let excess = kept.len().saturating_sub(STDERR_KEEP);
-                    kept.drain(..excess);
-                }
-            });
-        }
-        let wire = match (listener, fifos) {
-            (Some(listener), _) => Wire::Tcp(accept(&listener, &mut child, &stderr)?),
-            (None, Some(fifos)) => fifos,
-            (None, None) => bail!("no transport"),
-        };
-        let mut session = Session {
-            child,
-            wire,
-            pending: Vec::with_capacity(4096),
-            scanned: 0,
-            stderr,
-        };
-        // QEMU's USART drops what arrives before the image has enabled it, which would
-        // cut the first Configure. The image's first frame (its boot Header) comes
-        // after it is enabled: wait for it.
-        session.read_until(
-            CONFIGURE_TIMEOUT,
-            "boot frame (an image older than this host? rebuild it with `cargo fw`)",
-            |_| Some(true),
-            &mut Vec::new(),
-        )?;
-        Ok(session)
+/// The frame exchange with one QEMU.
+type Session = FrameChannel<QemuProcess>;
+
+impl ByteWire for QemuProcess {
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.wire.send(bytes)
     }
 
-    fn send(&mut self, frame: &Frame) -> anyhow::Result<()> {
-        let bytes = encode_to_vec(frame).map_err(|e| anyhow!("cannot encode {e:?}"))?;
-        self.wire
-            .send(bytes.as_bytes())
-            .map_err(|e| self.failure(&format!("sending to the image: {e}")))
-    }
-
-    /// Read until a frame for which `closes` returns `true` arrives; return the bytes of
-    /// every frame before it (the delimiters included, exactly as received) and that frame.
-    /// Frames for which `closes` returns `None` are dropped from the returned bytes.
-    fn read_until(
-        &mut self,
-        timeout: Duration,
-        what: &str,
-        mut closes: impl FnMut(&Frame) -> Option<bool>,
-        before: &mut Vec<u8>,
-    ) -> anyhow::Result<Frame> {
-        let deadline = Instant::now() + timeout;
-        let mut start = 0;
-        loop {
-            while let Some(offset) = self
-                .pending
-                .get(self.scanned..)
-                .and_then(|rest| rest.iter().position(|&b| b == DELIMITER))
-            {
-                let end = self.scanned + offset + 1;
-                self.scanned = end;
-                let body = self.pending.get(start..end - 1).unwrap_or(&[]);
-                let decoded = decode_frame(body);
-                match decoded.as_ref().ok().map(&mut closes) {
-                    Some(Some(true)) => {
-                        let frame = decoded.map_err(|e| anyhow!("{e:?}"))?;
-                        before.extend_from_slice(self.pending.get(..start).unwrap_or(&[]));
-                        self.pending.drain(..end);
-                        self.scanned = 0;
-                        return Ok(frame);
-                    }
-                    Some(None) => {
-                        // Not telemetry of this exchange: cut it out.
-                        self.pending.drain(start..end);
-                        self.scanned = start;
-                    }
-                    // Telemetry (or a corrupt frame, which the decoder of the dump
-                    // reports): keep it in place.
-                    Some(Some(false)) | None => start = end,
-                }
-            }
-            let now = Instant::now();
-            if now >= deadline {
-                return Err(self.failure(&format!(
-                    "no {what} from the image within {} s ({} bytes received meanwhile)",
-                    timeout.as_secs(),
-                    self.pending.len()
-                )));
-            }
-            let mut chunk = [0u8; 4096];
-            match self.wire.recv(&mut chunk, deadline - now) {
-                Ok(0) => return Err(self.failure("QEMU closed the connection")),
-                Ok(n) => self
-                    .pending
-                    .extend_from_slice(chunk.get(..n).unwrap_or(&[])),
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-                Err(e) if e.kind() == ErrorKind::Interrupted => {}
-                Err(e) => return Err(self.failure(&format!("reading from the image: {e}"))),
-            }
-        }
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> std::io::Result<usize> {
+        self.wire.recv(buf, timeout)
     }
 
     /// An error naming `what` went wrong, with QEMU's state and the end of its stderr.
@@ -509,6 +326,101 @@ impl Session {
     }
 }
 
+/// Boot `image` in QEMU and connect to its USART1. `extra_args` go to QEMU as they
+/// are (e.g. `-icount shift=0`).
+fn start_session(
+    image: &Path,
+    transport: QemuTransport,
+    extra_args: &[String],
+) -> anyhow::Result<Session> {
+    qemu_available()?;
+    if !image.is_file() {
+        bail!(
+            "flight-controller image {} not found: build it with `cargo fw`",
+            image.display()
+        );
+    }
+    let image = std::path::absolute(image)
+        .with_context(|| format!("cannot resolve {}", image.display()))?;
+    let mut command = Command::new(QEMU);
+    command
+        .args(["-M", "netduinoplus2", "-nographic", "-monitor", "none"])
+        .arg("-kernel")
+        .arg(&image);
+    let (listener, fifos) = match transport {
+        QemuTransport::Usart => {
+            let listener =
+                TcpListener::bind("127.0.0.1:0").context("cannot listen on 127.0.0.1 for QEMU")?;
+            let port = listener.local_addr()?.port();
+            listener.set_nonblocking(true)?;
+            // USART1 is the first serial port of the machine.
+            command
+                .arg("-chardev")
+                .arg(format!(
+                    "socket,id=usart1,host=127.0.0.1,port={port},server=off,nodelay=on"
+                ))
+                .args(["-serial", "chardev:usart1"]);
+            (Some(listener), None)
+        }
+        QemuTransport::Semihosting => {
+            let fifos = make_fifos()?;
+            if let Wire::Fifo { folder, .. } = &fifos {
+                // The image opens the FIFOs by relative name.
+                command.current_dir(folder);
+            }
+            command
+                .args(["-serial", "null"])
+                .args(["-semihosting-config", "enable=on,target=native"]);
+            for (address, word) in SEMIHOSTING_MAILBOX {
+                command.arg("-device").arg(format!(
+                    "loader,addr={address:#x},data={word:#x},data-len=4"
+                ));
+            }
+            (None, Some(fifos))
+        }
+    };
+    let mut child = command
+        .args(extra_args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .with_context(|| format!("cannot start {QEMU}"))?;
+    let stderr = Arc::new(Mutex::new(Vec::new()));
+    if let Some(mut pipe) = child.stderr.take() {
+        let keep = Arc::clone(&stderr);
+        std::thread::spawn(move || {
+            let mut chunk = [0u8; 512];
+            while let Ok(n @ 1..) = pipe.read(&mut chunk) {
+                let mut kept = keep.lock().unwrap_or_else(|e| e.into_inner());
+                kept.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
+                let excess = kept.len().saturating_sub(STDERR_KEEP);
+                kept.drain(..excess);
+            }
+        });
+    }
+    let wire = match (listener, fifos) {
+        (Some(listener), _) => Wire::Tcp(accept(&listener, &mut child, &stderr)?),
+        (None, Some(fifos)) => fifos,
+        (None, None) => bail!("no transport"),
+    };
+    let mut session = FrameChannel::new(QemuProcess {
+        child,
+        wire,
+        stderr,
+    });
+    // QEMU's USART drops what arrives before the image has enabled it, which would
+    // cut the first Configure. The image's first frame (its boot Header) comes
+    // after it is enabled: wait for it.
+    session.read_until(
+        CONFIGURE_TIMEOUT,
+        "boot frame (an image older than this host? rebuild it with `cargo fw`)",
+        |_| Some(true),
+        &mut Vec::new(),
+    )?;
+    Ok(session)
+}
+
 fn stderr_text(stderr: &Mutex<Vec<u8>>) -> String {
     let bytes = stderr.lock().unwrap_or_else(|e| e.into_inner());
     String::from_utf8_lossy(&bytes).trim().replace('\n', " | ")
@@ -523,20 +435,9 @@ impl FlightControllerLink for QemuLink {
         let request = link_config(config)?;
         let answer = self
             .session()
-            .and_then(|session| session.configure(request));
+            .and_then(|session| session.configure(request, CONFIGURE_TIMEOUT));
         let answer = self.keep_if_ok(answer)?;
-        if answer.accepted {
-            return Ok(());
-        }
-        let reason = FlightController::new(*config)
-            .err()
-            .map_or("a reason this host's firmware library does not see", |e| {
-                e.message()
-            });
-        bail!(
-            "the image refused the configuration (ConfigError #{}): {reason}",
-            answer.refusal
-        )
+        check_configure_answer(config, answer)
     }
 
     fn exchange(
@@ -547,62 +448,13 @@ impl FlightControllerLink for QemuLink {
         let mut stray = 0;
         let result = self
             .session()
-            .and_then(|session| session.exchange(input, telemetry, &mut stray));
+            .and_then(|session| session.exchange(input, telemetry, &mut stray, TICK_TIMEOUT));
         self.stray_answers += stray;
         self.keep_if_ok(result)
     }
 }
 
-impl Session {
-    /// Send `request` and wait for its answer.
-    fn configure(&mut self, request: LinkConfig) -> anyhow::Result<ConfigureResult> {
-        self.send(&Frame::Configure(request))?;
-        // Everything before the answer belongs to the previous configuration (boot
-        // Header, standalone Samples, the watchdog's own steps): discarded.
-        let mut discarded = Vec::new();
-        let answer = self.read_until(
-            CONFIGURE_TIMEOUT,
-            "ConfigureResult (an image older than protocol 1.1? rebuild it with `cargo fw`)",
-            |frame| Some(matches!(frame, Frame::ConfigureResult(_))),
-            &mut discarded,
-        )?;
-        match answer {
-            Frame::ConfigureResult(result) => Ok(result),
-            other => bail!("unexpected answer to Configure: {other:?}"),
-        }
-    }
-
-    /// One lockstep tick; ActuatorOut frames answering another seq are counted in `stray`.
-    fn exchange(
-        &mut self,
-        input: &SensorIn,
-        telemetry: &mut Vec<u8>,
-        stray: &mut u64,
-    ) -> anyhow::Result<ActuatorOut> {
-        self.send(&Frame::SensorIn(*input))?;
-        let seq = input.seq;
-        let answer = self.read_until(
-            TICK_TIMEOUT,
-            "ActuatorOut",
-            |frame| match frame {
-                Frame::ActuatorOut(out) if out.seq == seq => Some(true),
-                Frame::ActuatorOut(_) => {
-                    *stray += 1;
-                    None
-                }
-                Frame::ConfigureResult(_) => None,
-                _ => Some(false),
-            },
-            telemetry,
-        )?;
-        match answer {
-            Frame::ActuatorOut(out) => Ok(out),
-            other => bail!("unexpected frame closing the tick: {other:?}"),
-        }
-    }
-}
-
-impl Drop for Session {
+impl Drop for QemuProcess {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
@@ -653,26 +505,6 @@ fn accept(
 mod tests {
     use super::*;
     use sweephold_protocol::Axis;
-
-    #[test]
-    fn a_preset_with_another_test_travels_in_a_configure_frame() {
-        let mut config = Config::bo105_default(Axis::Lon);
-        config.rate_hz = 250;
-        config.test.seed = 77;
-        config.test.sweep.t_rec_s = 12.0;
-        let request = link_config(&config).expect("representable");
-        assert_eq!(request.vehicle, VehicleId::Bo105);
-        assert_eq!(request.rate_hz, 250);
-        assert_eq!(request.test, config.test);
-    }
-
-    #[test]
-    fn settings_outside_the_configure_frame_are_refused() {
-        let mut config = Config::trex700l_default(Axis::Lat);
-        config.trim_capture_s += 0.5;
-        let error = link_config(&config).expect_err("not representable");
-        assert!(error.to_string().contains("build an image"), "{error}");
-    }
 
     #[test]
     fn a_missing_image_is_named_with_the_command_that_builds_it() {

@@ -1,8 +1,10 @@
 //! `sweephold fly`: the paper's test campaign, flown on the host with the flight
 //! controller in the loop and the nonlinear simulator as the aircraft.
 
+pub mod frame_channel;
 pub mod link;
 pub mod link_qemu;
+pub mod link_serial;
 pub mod plan;
 pub mod record;
 pub mod summary;
@@ -164,9 +166,10 @@ pub struct FlyArgs {
     #[arg(short, long)]
     pub quiet: bool,
     /// Flight controller in the loop: `in-process` (the firmware library called
-    /// directly), `qemu` (the board image in qemu-system-arm, one per worker) or
-    /// `qemu-usart` (the same over its emulated USART: slow).
-    #[arg(long, value_enum, default_value_t = FcArg::InProcess)]
+    /// directly), `qemu` (the board image in qemu-system-arm, one per worker),
+    /// `qemu-usart` (the same over its emulated USART: slow) or `serial:PATH[@BAUD]`
+    /// (a real board on a serial port, default 460800 Bd; records flown one at a time).
+    #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_fc)]
     pub fc: FcArg,
     /// Board image for `--fc qemu` [default: target/thumbv7em-none-eabihf/firmware/sweephold-fc].
     #[arg(long, value_name = "PATH")]
@@ -174,7 +177,7 @@ pub struct FlyArgs {
 }
 
 /// Flight controller on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum FcArg {
     /// The firmware's flight logic called in-process.
     InProcess,
@@ -182,6 +185,24 @@ pub enum FcArg {
     Qemu,
     /// The same, frames over USART1 on a TCP socket (as on the board; ~200 ticks/s).
     QemuUsart,
+    /// A real board on a serial port (`serial:PATH[@BAUD]`).
+    Serial(link_serial::SerialPort),
+}
+
+/// Parse `--fc`: `in-process`, `qemu`, `qemu-usart` or `serial:PATH[@BAUD]`.
+pub fn parse_fc(text: &str) -> Result<FcArg, String> {
+    match text {
+        "in-process" => Ok(FcArg::InProcess),
+        "qemu" => Ok(FcArg::Qemu),
+        "qemu-usart" => Ok(FcArg::QemuUsart),
+        _ => match text.strip_prefix("serial:") {
+            Some(port) => link_serial::SerialPort::parse(port).map(FcArg::Serial),
+            None => Err(format!(
+                "unknown flight controller `{text}` (expected in-process, qemu, qemu-usart \
+                 or serial:PATH[@BAUD])"
+            )),
+        },
+    }
 }
 
 fn parse_axis(text: &str) -> Result<Axis, String> {
@@ -246,7 +267,7 @@ pub struct FlyOutcome {
 
 /// Run `sweephold fly`.
 pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
-    let outcome = match args.fc {
+    let outcome = match &args.fc {
         FcArg::InProcess => fly(args, &|| Box::new(InProcessLink::new()))?,
         FcArg::Qemu | FcArg::QemuUsart => {
             link_qemu::qemu_available()?;
@@ -264,6 +285,12 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 Box::new(link_qemu::QemuLink::new(&image, transport, &extra))
             })?
         }
+        // One port, one board: the records are flown one after the other.
+        FcArg::Serial(port) => fly_with_workers(
+            args,
+            &|| Box::new(link_serial::SerialLink::new(port.clone())),
+            1,
+        )?,
     };
     if !args.quiet {
         for run in &outcome.summary.runs {
@@ -296,6 +323,16 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
 pub fn fly(
     args: &FlyArgs,
     make_link: &(dyn Fn() -> Box<dyn FlightControllerLink> + Sync),
+) -> anyhow::Result<FlyOutcome> {
+    fly_with_workers(args, make_link, usize::MAX)
+}
+
+/// [`fly`] with at most `max_workers` worker threads (links): 1 for a link that cannot
+/// be shared, such as a board on a serial port.
+pub fn fly_with_workers(
+    args: &FlyArgs,
+    make_link: &(dyn Fn() -> Box<dyn FlightControllerLink> + Sync),
+    max_workers: usize,
 ) -> anyhow::Result<FlyOutcome> {
     args.check()?;
     let heli = args.vehicle.sim().helicopter();
@@ -350,6 +387,7 @@ pub fn fly(
     let workers = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(plans.len())
+        .min(max_workers)
         .max(1);
     std::thread::scope(|scope| {
         for _ in 0..workers {
