@@ -35,8 +35,9 @@ use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Context};
 use bo105::{linearize, trim, Linearization, SimOptions, Vehicle};
-use sysid::fit::report::{TruthPairCost, TruthParameter, TruthSection};
+use sysid::fit::report::{TruthParameter, TruthSection};
 use sysid::fit::structure::MatrixName;
+use sysid::fit::PairFit;
 use sysid::fit::{cost_between_models, FitResult, Model, ModelComparison, ModelStructure};
 
 /// Fit points per pair when an identified model is scored against the truth (n_ω).
@@ -448,7 +449,7 @@ pub fn score_fit(result: &FitResult, truth: &VehicleTruth) -> anyhow::Result<Tru
             .bands
             .iter()
             .zip(&comparison.costs)
-            .map(|(band, cost)| TruthPairCost {
+            .map(|(band, cost)| PairFit {
                 input: band.input.clone(),
                 output: band.output.clone(),
                 range: band.range,

@@ -108,19 +108,6 @@ pub struct TruthParameter {
     pub error_percent: Option<f64>,
 }
 
-/// J of the identified model against the truth model on one fitted pair.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TruthPairCost {
-    /// Control name.
-    pub input: String,
-    /// Output name.
-    pub output: String,
-    /// Range [rad/s] (the fitted one).
-    pub range: [f64; 2],
-    /// J (the DERIVID cost with the truth model as data, coherence 1).
-    pub cost: f64,
-}
-
 /// The `truth` section of `model.json`: the fit scored against a simulator.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TruthSection {
@@ -129,7 +116,7 @@ pub struct TruthSection {
     /// Every parameter of the fit with its truth and error.
     pub parameters: Vec<TruthParameter>,
     /// J against the truth model per fitted pair.
-    pub pairs: Vec<TruthPairCost>,
+    pub pairs: Vec<PairFit>,
     /// Mean of the pair costs.
     pub average_cost: f64,
     /// Structure parameters the truth mapping does not know (held at 0 in the truth model).
@@ -143,33 +130,7 @@ impl TruthSection {
     pub fn cost_table(&self) -> String {
         let mut out = String::new();
         let _ = writeln!(out, "J against the truth model ({}):", self.vehicle);
-        let _ = writeln!(
-            out,
-            "{:<12} {:>17} {:>10}",
-            "pair", "range [rad/s]", "J truth"
-        );
-        for pair in &self.pairs {
-            let _ = writeln!(
-                out,
-                "{:<12} {:>8.3}-{:<8.3} {:>10.3}",
-                format!("{}/{}", pair.output, pair.input),
-                pair.range[0],
-                pair.range[1],
-                pair.cost
-            );
-        }
-        let _ = writeln!(
-            out,
-            "{:<12} {:>17} {:>10.3}",
-            "J_ave", "", self.average_cost
-        );
-        if !self.unmapped.is_empty() {
-            let _ = writeln!(
-                out,
-                "no truth for: {} (held at 0 in the truth model)",
-                self.unmapped.join(" ")
-            );
-        }
+        write_pair_costs(&mut out, "J truth", &self.pairs, self.average_cost);
         out
     }
 }
@@ -333,8 +294,18 @@ fn parameter_rows(result: &FitResult, truth: Option<&TruthSection>) -> String {
 /// The cost table: output/input, range and J per pair, then J_ave.
 pub fn cost_table(result: &FitResult) -> String {
     let mut out = String::new();
-    let _ = writeln!(out, "{:<12} {:>17} {:>10}", "pair", "range [rad/s]", "J");
-    for pair in &result.pairs {
+    write_pair_costs(&mut out, "J", &result.pairs, result.average_cost);
+    out
+}
+
+/// Rows `output/input  lo-hi  J` under a header naming the cost column, then J_ave.
+fn write_pair_costs(out: &mut String, cost_column: &str, pairs: &[PairFit], average: f64) {
+    let _ = writeln!(
+        out,
+        "{:<12} {:>17} {:>10}",
+        "pair", "range [rad/s]", cost_column
+    );
+    for pair in pairs {
         let _ = writeln!(
             out,
             "{:<12} {:>8.3}-{:<8.3} {:>10.3}",
@@ -344,12 +315,7 @@ pub fn cost_table(result: &FitResult) -> String {
             pair.cost
         );
     }
-    let _ = writeln!(
-        out,
-        "{:<12} {:>17} {:>10.3}",
-        "J_ave", "", result.average_cost
-    );
-    out
+    let _ = writeln!(out, "{:<12} {:>17} {:>10.3}", "J_ave", "", average);
 }
 
 /// The reduction steps, one line each.
