@@ -10,17 +10,20 @@
 //!   `X|Y|Z|L|M|N` + `u|v|w|p|q|r|lat|lon|ped|col` is the simulator's quasi-static
 //!   derivative of that name (flapping residualized, L and N primed — the entries of ṗ, ṙ).
 //! - **Structures with flapping states `b1c`, `b1s`** (the 9-DOF hybrid): body derivatives
-//!   are entries of the full A and B (`Xw = A[u, w]`, `Lb1s = s_s·A[p, beta1s]`, …), with
-//!   the structure's flapping states `b1c = s_c·beta1c`, `b1s = s_s·beta1s`. The signs are
-//!   derived from the structure's own flap equations: its row
-//!   `M[b1c,b1c] β̇ = F[b1c,b1c] β + F[b1c,q] q + …` has the rate coupling
-//!   `F[b1c,q]/M[b1c,b1c]` (−1 for `τ_f β̇1c = −β1c − τ_f q`); the disc lags the shaft in the
-//!   simulator with `∂β̇1c/∂q = A[beta1c, q]` (+1.05 in Padfield's convention), so
-//!   `s_c = sign(F[b1c,q]/M[b1c,b1c]) · sign(A[beta1c,q])` (−1 for the shipped file), and
-//!   likewise `s_s` with p. Then `tau_f` is the simulator's flap time constant,
-//!   `Mf_k = τ_f·s_c·B[beta1c, k]` and `Lf_k = τ_f·s_s·B[beta1s, k]` (the structure
-//!   multiplies the flap equation by τ_f), and a body row's flapping column is
-//!   `F[row, b1c] = A[row, beta1c]/s_c`.
+//!   are entries of the full A and B (`Xw = A[u, w]`, `Lb1s = A[p, beta1s]/s_s`, …), with
+//!   the structure's flapping states `b1c = s_c·beta1c`, `b1s = s_s·beta1s`. The flapping
+//!   is not measured, so its scale is the structure's choice, and the file makes it through
+//!   the rate coupling: its row `M[b1c,b1c] ḃ1c = F[b1c,b1c] b1c + F[b1c,q] q + …` has
+//!   `F[b1c,q]/M[b1c,b1c]` (−1 for `τ_f ḃ1c = −b1c − τ_f q`), the simulator's disc has
+//!   `∂β̇1c/∂q = A[beta1c, q]` (+1.05 in Padfield's convention), so
+//!   `s_c = (F[b1c,q]/M[b1c,b1c]) / A[beta1c,q]` (−0.956 for the shipped file), and
+//!   likewise `s_s` with p. A fit cannot tell a model from the same one with its flapping
+//!   rescaled; this is the member of that family the structure's rate coupling picks. Then
+//!   `tau_f` is the simulator's flap time constant, every parameter standing alone in a
+//!   flap row is `M[f,f]·s_f·(A or B)[β_f, ·]` (e.g. `Mf_k = τ_f·s_c·B[beta1c, k]`,
+//!   `Kcs = τ_f·s_c·A[beta1c, beta1s]/s_s`), and a body row's flapping column is
+//!   `F[row, b1c] = A[row, beta1c]/s_c`. What the structure lacks (the simulator's L_p,
+//!   M_q, …) is folded quasi-statically into the body derivatives it has.
 //! - **Delays**: A and B exclude the servos. Their second-order lag (ω_n, ζ) acts like a
 //!   delay of `2ζ/ω_n` (the low-frequency phase of `ω_n²/(s² + 2ζω_n s + ω_n²)`) plus the
 //!   transport delay; `tau_lat … tau_col` take that. The 6-DOF equivalent delays
@@ -93,30 +96,39 @@ impl VehicleTruth {
         Some(self.linearization.b[self.state(row)?][self.control(control)?])
     }
 
-    /// The full linearization as a [`Model`] on the rigid-body outputs
-    /// `u v w p q r phi theta` (each measuring its state; no feed-through), with `delays`
-    /// per control: the reference the truth mapping is checked against.
+    /// The full linearization as a [`Model`] on the simulator's outputs
+    /// `u v w p q r ax ay az phi theta`, with `delays` per control: the reference the truth
+    /// mapping is checked against. `y = C x + D u` is written as `H0 x + H1 ẋ`: the
+    /// specific forces are `ẋ_u + (C[ax,·] − A[u,·]) x` (and likewise for ay, az), which
+    /// carries D = B[u,·] without a feed-through matrix.
     pub fn linear_model(&self, delays: &[f64]) -> Model {
         let lin = &self.linearization;
         let states: Vec<String> = lin.states.iter().map(|s| s.to_string()).collect();
         let controls: Vec<String> = lin.controls.iter().map(|s| s.to_string()).collect();
-        let outputs: Vec<String> = ["u", "v", "w", "p", "q", "r", "phi", "theta"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
-        let mut model = Model::zeros(states, controls, outputs.clone());
-        for i in 0..lin.states.len() {
+        let outputs: Vec<String> = lin.outputs.iter().map(|s| s.to_string()).collect();
+        let n = lin.states.len();
+        let mut model = Model::zeros(states, controls, outputs);
+        for i in 0..n {
             model.m[(i, i)] = 1.0;
-            for j in 0..lin.states.len() {
+            for j in 0..n {
                 model.f[(i, j)] = lin.a[i][j];
             }
             for j in 0..lin.controls.len() {
                 model.g[(i, j)] = lin.b[i][j];
             }
         }
-        for (row, name) in outputs.iter().enumerate() {
-            if let Some(state) = self.state(name) {
-                model.h0[(row, state)] = 1.0;
+        for (row, name) in lin.outputs.iter().enumerate() {
+            let velocity = match *name {
+                "ax" => self.state("u"),
+                "ay" => self.state("v"),
+                "az" => self.state("w"),
+                _ => None,
+            };
+            for j in 0..n {
+                model.h0[(row, j)] = lin.c[row][j] - velocity.map_or(0.0, |v| lin.a[v][j]);
+            }
+            if let Some(v) = velocity {
+                model.h1[(row, v)] = 1.0;
             }
         }
         for (k, delay) in delays.iter().enumerate().take(model.delays.len()) {
@@ -135,7 +147,7 @@ pub struct StructureTruth {
     pub base_values: Vec<f64>,
     /// Base parameters the mapping does not know (held at 0 in `model`).
     pub unmapped: Vec<String>,
-    /// Flapping-state signs (structure state = sign · simulator state), when the
+    /// Flapping-state scales (structure state = scale · simulator state), when the
     /// structure has `b1c` / `b1s`.
     pub flap_signs: BTreeMap<String, f64>,
     /// The structure's model at the truth values.
@@ -159,7 +171,7 @@ const BODY_STATES: [&str; 6] = ["u", "v", "w", "p", "q", "r"];
 const CONTROLS: [&str; 4] = ["lat", "lon", "ped", "col"];
 
 /// Sign of `coefficient of rate column / coefficient of the own column of M` in the
-/// structure's flap row `flap`, i.e. the sign of the structure's ∂β̇/∂(rate).
+/// structure's flap row `flap`, i.e. the structure's ∂ḃ/∂(rate) (−1 for `τ_f ḃ1c = … − τ_f q`).
 fn structure_rate_coupling(structure: &ModelStructure, flap: &str, rate: &str) -> Option<f64> {
     let row = structure.states.iter().position(|s| s == flap)?;
     let column = structure.states.iter().position(|s| s == rate)?;
@@ -175,7 +187,7 @@ fn structure_rate_coupling(structure: &ModelStructure, flap: &str, rate: &str) -
     // M defaults to the identity.
     let mass = entry(MatrixName::M, row).unwrap_or(1.0);
     let ratio = coupling / mass;
-    (ratio != 0.0 && ratio.is_finite()).then(|| ratio.signum())
+    (ratio != 0.0 && ratio.is_finite()).then_some(ratio)
 }
 
 /// The simulator's flapping responds to more than the structure's flap equations carry
@@ -206,11 +218,13 @@ struct FoldedFlapping {
 }
 
 impl FoldedFlapping {
+    /// `values`: base-parameter values with the flap-row parameters at their truth (the
+    /// structure's flap equations are evaluated there).
     fn new(
         structure: &ModelStructure,
         truth: &VehicleTruth,
         flap_signs: &BTreeMap<String, f64>,
-        tau_f: f64,
+        values: &[f64],
     ) -> anyhow::Result<FoldedFlapping> {
         let flaps = ["beta1c", "beta1s"];
         let structure_flaps = ["b1c", "b1s"];
@@ -225,28 +239,54 @@ impl FoldedFlapping {
         let a_ff_inverse = a_ff
             .try_inverse()
             .ok_or_else(|| anyhow!("the flapping block of A is singular"))?;
-        let values = structure.values();
         let state_index = |name: &str| structure.states.iter().position(|s| s == name);
+        let sign = |flap: usize| {
+            flap_signs
+                .get(structure_flaps[flap])
+                .copied()
+                .unwrap_or(1.0)
+        };
+        let entry = |matrix: MatrixName, row: usize, column: usize| {
+            structure
+                .entries
+                .iter()
+                .find(|e| e.matrix == matrix && e.row == row && e.column == column)
+                .map(|e| e.expression.evaluate(values))
+        };
+        // The structure's flap rows in simulator coordinates (b = S β, S = diag(s_c, s_s)):
+        // β̇_f = Σ_g F[f,g]/M[f,f]·s_g/s_f β_g + F[f,j]/(M[f,f]·s_f) x_j.
+        let mut structure_block = nalgebra::Matrix2::zeros();
+        for f in 0..2 {
+            for g in 0..2 {
+                if let (Some(row), Some(col)) = (
+                    state_index(structure_flaps[f]),
+                    state_index(structure_flaps[g]),
+                ) {
+                    let mass = entry(MatrixName::M, row, row).unwrap_or(1.0);
+                    structure_block[(f, g)] =
+                        entry(MatrixName::F, row, col).unwrap_or(0.0) / mass * sign(g) / sign(f);
+                }
+            }
+        }
+        // Without a flap state of its own the structure cannot hold that flapping: its
+        // quasi-static part is then all folded (the block entry stays −1/τ_f-free at 0, so
+        // use the simulator's to keep the inverse defined).
+        for f in 0..2 {
+            if state_index(structure_flaps[f]).is_none() {
+                structure_block[(f, f)] = a_ff[(f, f)];
+            }
+        }
+        let structure_block_inverse = structure_block
+            .try_inverse()
+            .ok_or_else(|| anyhow!("the structure's flapping block is singular at the truth"))?;
         // The structure's ∂β̇/∂x_j of flap row `flap`, in simulator coordinates.
         let structure_coupling = |flap: usize, column: &str| -> f64 {
             let (Some(row), Some(col)) = (state_index(structure_flaps[flap]), state_index(column))
             else {
                 return 0.0;
             };
-            let entry = |matrix: MatrixName, c: usize| {
-                structure
-                    .entries
-                    .iter()
-                    .find(|e| e.matrix == matrix && e.row == row && e.column == c)
-                    .map(|e| e.expression.evaluate(&values))
-            };
-            let mass = entry(MatrixName::M, row).unwrap_or(1.0);
-            let sign = flap_signs
-                .get(structure_flaps[flap])
-                .copied()
-                .unwrap_or(1.0);
-            // β_s = sign·β: β̇ = sign·β̇_s = sign·(F/M)·x_j.
-            sign * entry(MatrixName::F, col).unwrap_or(0.0) / mass
+            let mass = entry(MatrixName::M, row, row).unwrap_or(1.0);
+            entry(MatrixName::F, row, col).unwrap_or(0.0) / mass / sign(flap)
         };
         let mut simulator = BTreeMap::new();
         let mut structure_flapping = BTreeMap::new();
@@ -254,17 +294,25 @@ impl FoldedFlapping {
             let (forcing, modelled) = if BODY_STATES.contains(column) {
                 (
                     nalgebra::Vector2::new(a(flaps[0], column)?, a(flaps[1], column)?),
-                    [structure_coupling(0, column), structure_coupling(1, column)],
+                    nalgebra::Vector2::new(
+                        structure_coupling(0, column),
+                        structure_coupling(1, column),
+                    ),
                 )
             } else {
                 let b = |flap: &str| truth.b(flap, column).ok_or_else(missing);
                 let forcing = nalgebra::Vector2::new(b(flaps[0])?, b(flaps[1])?);
                 // The structure's flap control terms are mapped from B exactly.
-                (forcing, [forcing[0], forcing[1]])
+                (forcing, forcing)
             };
+            // Quasi-static flapping β = −A_ff⁻¹ (forcing), for the simulator and the structure.
             let quasi_static = -(a_ff_inverse * forcing);
+            let structure_quasi_static = -(structure_block_inverse * modelled);
             simulator.insert(*column, [quasi_static[0], quasi_static[1]]);
-            structure_flapping.insert(*column, [tau_f * modelled[0], tau_f * modelled[1]]);
+            structure_flapping.insert(
+                *column,
+                [structure_quasi_static[0], structure_quasi_static[1]],
+            );
         }
         let mut rows_with_flap = [Vec::new(), Vec::new()];
         let mut flap_moment = BTreeMap::new();
@@ -310,6 +358,77 @@ impl FoldedFlapping {
     }
 }
 
+/// Truth values of the parameters that stand alone (`c·θ`) in an entry of a flap row of F
+/// or G — the structure's flap equations `M[f,f]·ḃ_f = F[f,·]·x + G[f,·]·u`. With
+/// `b_f = s_f·β_f` the simulator's `β̇_f = A[β_f,·]·x + B[β_f,·]·u` reads
+/// `F[f,j] = M[f,f]·s_f·A[β_f, j]/s_j` (`s_j` the scale of column j when it is a flap
+/// state, else 1) and `G[f,k] = M[f,f]·s_f·B[β_f,k]`. `tau_f` itself is the flap time constant
+/// (it also sits in the rate coupling `−τ_f q`, where the simulator's 1.05 is not 1).
+fn flap_row_parameters(
+    structure: &ModelStructure,
+    truth: &VehicleTruth,
+    flap_signs: &BTreeMap<String, f64>,
+    tau_f: f64,
+) -> BTreeMap<String, f64> {
+    let simulator_name = |state: &str| match state {
+        "b1c" => Some("beta1c"),
+        "b1s" => Some("beta1s"),
+        _ => None,
+    };
+    let mut values = structure.values();
+    if let Some(index) = structure.parameter_index("tau_f") {
+        values[index] = tau_f;
+    }
+    let mut out = BTreeMap::new();
+    for entry in &structure.entries {
+        let Some(row_name) = structure.states.get(entry.row) else {
+            continue;
+        };
+        let (Some(simulator_row), Some(&row_sign)) =
+            (simulator_name(row_name), flap_signs.get(row_name.as_str()))
+        else {
+            continue;
+        };
+        let [(index, coefficient)] = entry.expression.terms[..] else {
+            continue;
+        };
+        if entry.expression.constant != 0.0 || coefficient == 0.0 {
+            continue;
+        }
+        let name = &structure.parameters[index].name;
+        if name == "tau_f" {
+            continue;
+        }
+        let mass = structure
+            .entries
+            .iter()
+            .find(|e| e.matrix == MatrixName::M && e.row == entry.row && e.column == entry.row)
+            .map_or(1.0, |e| e.expression.evaluate(&values));
+        let simulator_entry = match entry.matrix {
+            MatrixName::F => {
+                let Some(column) = structure.states.get(entry.column) else {
+                    continue;
+                };
+                match simulator_name(column) {
+                    Some(flap) => flap_signs
+                        .get(column.as_str())
+                        .and_then(|s| truth.a(simulator_row, flap).map(|a| a / s)),
+                    None => truth.a(simulator_row, column),
+                }
+            }
+            MatrixName::G => structure
+                .controls
+                .get(entry.column)
+                .and_then(|control| truth.b(simulator_row, control)),
+            _ => None,
+        };
+        if let Some(a) = simulator_entry {
+            out.insert(name.clone(), mass * row_sign * a / coefficient);
+        }
+    }
+    out
+}
+
 /// Map the truth onto `structure`'s parameters (see the module documentation).
 pub fn structure_truth(
     structure: &ModelStructure,
@@ -329,16 +448,36 @@ pub fn structure_truth(
             .context("the linearization has no flapping states")?;
         // Padfield's convention as a fallback when the structure writes no rate coupling:
         // DESIGN's states are the negatives of the simulator's (bo105 README).
+        // The flapping states are not measured, so their scale is the structure's choice:
+        // it fixes the rate coupling (−1 per rad/s in the shipped file, where the
+        // simulator's disc has 1.05). b = s·β with s = (structure coupling)/(simulator's)
+        // makes the two rate couplings equal; every other flap-row entry and every body
+        // column of the flapping then follows with that scale.
         let sign = match structure_rate_coupling(structure, flap, rate) {
-            Some(structure_sign) => structure_sign * simulator_coupling.signum(),
+            Some(structure_coupling) => structure_coupling / simulator_coupling,
             None => -1.0,
         };
         flap_signs.insert(flap.to_string(), sign);
     }
     let tau_f = lin.tau_f_s;
     let delay = truth.actuator_delay_s;
+    let flap_rows = if hybrid {
+        flap_row_parameters(structure, truth, &flap_signs, tau_f)
+    } else {
+        BTreeMap::new()
+    };
     let folded = if hybrid {
-        Some(FoldedFlapping::new(structure, truth, &flap_signs, tau_f)?)
+        // The structure's flap equations at their truth (other parameters cannot appear
+        // there alone, and keep their start values).
+        let mut values = structure.values();
+        for (index, parameter) in structure.parameters.iter().enumerate() {
+            if parameter.name == "tau_f" {
+                values[index] = tau_f;
+            } else if let Some(v) = flap_rows.get(&parameter.name) {
+                values[index] = *v;
+            }
+        }
+        Some(FoldedFlapping::new(structure, truth, &flap_signs, &values)?)
     } else {
         None
     };
@@ -351,12 +490,9 @@ pub fn structure_truth(
             "teq_ped" | "teq_col" => return Some(delay),
             _ => {}
         }
-        // Flap-equation control terms: Mf_k (row b1c), Lf_k (row b1s).
-        for (prefix, flap, simulator) in [("Mf_", "b1c", "beta1c"), ("Lf_", "b1s", "beta1s")] {
-            if let Some(control) = name.strip_prefix(prefix) {
-                let sign = *flap_signs.get(flap)?;
-                return Some(tau_f * sign * truth.b(simulator, control)?);
-            }
+        // Parameters of the flap equations (Mf_k, Lf_k, couplings).
+        if let Some(v) = flap_rows.get(name) {
+            return Some(*v);
         }
         let mut chars = name.chars();
         let row = axis_state(chars.next()?)?;
@@ -505,28 +641,25 @@ mod tests {
         assert!(mapped.unmapped.is_empty(), "{:?}", mapped.unmapped);
         // The shipped file writes τ_f β̇1c = −β1c − τ_f q; the simulator's disc lags the
         // shaft with +q: the structure's flapping states are the negatives.
-        assert_eq!(mapped.flap_signs["b1c"], -1.0);
-        assert_eq!(mapped.flap_signs["b1s"], -1.0);
+        // The scale matches the rate couplings: −1 in the file, +1.05 in the simulator.
+        for (flap, rate, simulator) in [("b1c", "q", "beta1c"), ("b1s", "p", "beta1s")] {
+            let coupling = truth.a(simulator, rate).unwrap();
+            assert!((mapped.flap_signs[flap] * coupling + 1.0).abs() < 1e-12);
+            assert!((1.0..1.1).contains(&coupling), "{coupling}");
+        }
         // Stable rotor: positive flapping moment derivatives in the structure's signs.
         assert!(mapped.values["Lb1s"] > 100.0, "{}", mapped.values["Lb1s"]);
         assert!(mapped.values["Mb1c"] > 20.0, "{}", mapped.values["Mb1c"]);
-        // Speed derivatives come out at their quasi-static values (folded flapping).
-        let quasi_static = &truth.linearization.quasi_static;
-        for name in ["Xu", "Mu", "Lv", "Nv", "Np", "Nlat"] {
-            let (ours, reference) = (mapped.values[name], quasi_static[name]);
-            assert!(
-                (ours - reference).abs() <= 0.05 * reference.abs(),
-                "{name}: {ours} vs {reference}"
-            );
-        }
-        // The truth model reproduces the simulator's own linear responses above the
-        // low-frequency coupled modes (which both structures simplify: no Lu, Mp, Lq, …).
+        // The truth model reproduces the simulator's own on-axis linear responses above
+        // the coupled low-frequency modes. The direct mapping leaves out what the structure
+        // has no entry for (L_p, M_q and the 1.05 of the rate coupling, L_u, …), so it is
+        // not exact: 5–7 % in magnitude at worst (measured 6.0 % p/lat, 5.5 % q/lon).
         let reference = truth.linear_model(&mapped.model.delays);
-        for (output, input) in [("p", "lat"), ("q", "lon")] {
+        for (output, input) in [("p", "lat"), ("q", "lon"), ("r", "ped"), ("az", "col")] {
             let (magnitude, phase) =
-                worst_errors(&mapped.model, &reference, output, input, [2.0, 30.0]);
+                worst_errors(&mapped.model, &reference, output, input, [1.0, 30.0]);
             assert!(
-                magnitude < 0.1 && phase < 5.0,
+                magnitude < 0.07 && phase < 3.5,
                 "{output}/{input}: {:.1} %, {phase:.1} deg",
                 100.0 * magnitude
             );
@@ -565,6 +698,93 @@ mod tests {
                 magnitude < 0.15 && phase < 8.0,
                 "{output}/{input}: {:.1} %, {phase:.1} deg",
                 100.0 * magnitude
+            );
+        }
+    }
+
+    /// The key parameters of the issue's bar: rotor, heave and yaw control, flap controls.
+    const KEY_PARAMETERS: [&str; 9] = [
+        "tau_f", "Lb1s", "Mb1c", "Zcol", "Nped", "Mf_lat", "Mf_lon", "Lf_lat", "Lf_lon",
+    ];
+
+    #[test]
+    fn hybrid_structure_fitted_to_the_simulator_linear_responses_recovers_the_key_parameters() {
+        // Structure adequacy: exact responses of the full linearization (flapping with all
+        // its couplings, servo delay) on the paper's Table 1 ranges, fitted from the mapped
+        // truth: where the best fit lies is a property of the structure, not of the
+        // optimizer's starts. A structure that misses the simulator's physics fails here
+        // (the paper's flap equations alone: J_ave 87, τ_f −7 %, M_b1c +27 %, Lf_lat −22 %).
+        use sysid::fit::synthetic::{exact_frf_document, paper_table1_range, SyntheticGrid};
+        use sysid::fit::{fit, FitOptions, PairBand};
+        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let structure = shipped("bo105-9dof-hybrid.toml");
+        let mapped = structure_truth(&structure, &truth).unwrap();
+        let delay = truth.actuator_delay_s;
+        let reference = truth.linear_model(&[delay; 4]);
+        // The pairs a default campaign fits (the others carry no coherent response: their
+        // exact responses are near zero and their dB meaningless), on Table 1's ranges.
+        let fitted = [
+            ("p", "lat"),
+            ("p", "lon"),
+            ("p", "ped"),
+            ("q", "lat"),
+            ("q", "lon"),
+            ("r", "lat"),
+            ("r", "ped"),
+            ("r", "col"),
+            ("ax", "lon"),
+            ("ax", "col"),
+            ("ay", "lat"),
+            ("ay", "ped"),
+            ("az", "col"),
+            ("u", "lon"),
+            ("v", "lon"),
+            ("w", "col"),
+        ];
+        let bands: Vec<PairBand> = fitted
+            .iter()
+            .map(|(output, input)| PairBand {
+                input: input.to_string(),
+                output: output.to_string(),
+                range: paper_table1_range(output, input).unwrap(),
+            })
+            .collect();
+        let mut structure = structure;
+        structure
+            .pairs
+            .retain(|pair| fitted.contains(&(pair.output.as_str(), pair.input.as_str())));
+        let data = exact_frf_document(&reference, &bands, SyntheticGrid::FitPoints(20));
+        let options = FitOptions {
+            max_starts: 3,
+            ..FitOptions::default()
+        };
+        let start = structure.with_values(&mapped.base_values).unwrap();
+        let result = fit(&start, &data, &options).unwrap();
+        let errors: Vec<(&str, f64)> = KEY_PARAMETERS
+            .iter()
+            .map(|name| {
+                let (fitted, expected) = (result.parameter(name).unwrap(), mapped.values[*name]);
+                (*name, 100.0 * (fitted - expected) / expected.abs())
+            })
+            .collect();
+        eprintln!("J_ave {:.2}, errors % {errors:.1?}", result.average_cost);
+        assert!(result.average_cost < 10.0, "J_ave {}", result.average_cost);
+        for (name, error) in errors {
+            assert!(error.abs() < 6.0, "{name}: {error:.1} %");
+        }
+    }
+
+    #[test]
+    fn synthetic_reference_is_the_mapped_simulator_truth() {
+        // `sysid`'s BO105_HYBRID_REFERENCE (tests and the fit benchmark) must not drift from
+        // the simulator: it is this mapping, rounded.
+        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let mapped = structure_truth(&shipped("bo105-9dof-hybrid.toml"), &truth).unwrap();
+        for (name, value) in sysid::fit::synthetic::BO105_HYBRID_REFERENCE {
+            let expected = mapped.values[name];
+            assert!(
+                (value - expected).abs() <= 1e-3 * expected.abs(),
+                "{name}: reference {value}, mapping {expected}"
             );
         }
     }

@@ -1,7 +1,10 @@
 //! Start values of a hybrid (rotor-flapping) fit from a quasi-steady 6-DOF fit, paper
 //! Eq. 26–27, generalised to the sign convention of the structure file.
 //!
-//! 1. Every free parameter whose name the 6-DOF model also has starts at that value.
+//! 1. Every free parameter whose name the 6-DOF model also has starts at that value —
+//!    except a speed derivative (`Xu`, `Lv`, …) when the hybrid's flap rows depend on that
+//!    speed: the 6-DOF value then holds the rotor's share too, which the hybrid carries
+//!    through its flapping, so the body term keeps the file's start.
 //! 2. The rotor moment derivatives come from the quasi-steady damping. A flapping row
 //!    `τ_f β̇ = −β + c·ω_body + Σ f_k δ_k` settles to β_ss = (c·ω + Σ f_k δ_k)/1, so a body
 //!    moment L_β·β contributes L_β·c·ω (the 6-DOF damping) and L_β·f_k·δ_k (its control
@@ -66,6 +69,31 @@ const ROTOR_MAPPINGS: [RotorMapping; 2] = [
     },
 ];
 
+/// Whether `name` is a body speed derivative (`X|Y|Z|L|M|N` + `u|v|w`) whose speed also
+/// drives one of the hybrid's flapping rows (`b1c`, `b1s`).
+fn speed_derivative_carried_by_flapping(hybrid: &ModelStructure, name: &str) -> bool {
+    let mut chars = name.chars();
+    let (Some(axis), Some(speed), None) = (chars.next(), chars.next(), chars.next()) else {
+        return false;
+    };
+    if !"XYZLMN".contains(axis) || !"uvw".contains(speed) {
+        return false;
+    }
+    let index = |state: &str| hybrid.states.iter().position(|s| s == state);
+    let Some(speed_index) = index(&speed.to_string()) else {
+        return false;
+    };
+    ["b1c", "b1s"]
+        .iter()
+        .filter_map(|flap| index(flap))
+        .any(|flap| {
+            hybrid
+                .entries
+                .iter()
+                .any(|e| e.matrix == MatrixName::F && e.row == flap && e.column == speed_index)
+        })
+}
+
 /// The hybrid structure with start values taken from a 6-DOF result, and notes saying
 /// which value came from where.
 pub fn start_from_quasi_steady(
@@ -82,6 +110,9 @@ pub fn start_from_quasi_steady(
 
     for (index, parameter) in hybrid.parameters.iter().enumerate() {
         if parameter.kind != ParameterKind::Free {
+            continue;
+        }
+        if speed_derivative_carried_by_flapping(hybrid, &parameter.name) {
             continue;
         }
         if let Some(value) = six_dof.parameter(&parameter.name) {
@@ -229,7 +260,7 @@ mod tests {
             ("Llat", 140.0),
             ("Mlon", -48.0),
             ("Zw", -0.33),
-            ("Xu", 5.0), // fixed in the hybrid: must not be copied
+            ("Xu", 5.0), // the hybrid's flapping depends on u: must not be copied
         ]);
         let (started, notes) = start_from_quasi_steady(&hybrid, &six).unwrap();
         let value = |name: &str| started.parameter_value(name, &started.values()).unwrap();
