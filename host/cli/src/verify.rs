@@ -11,7 +11,7 @@ use anyhow::{anyhow, bail, Context};
 use clap::Args;
 use sysid::fit::verify::{verify_record_in_segments, write_verification_plots, Verification};
 use sysid::fit::ModelDocument;
-use sysid::frf::load_dump;
+use sysid::frf::load_test_dump;
 
 /// Arguments of `sweephold verify`.
 #[derive(Args, Debug)]
@@ -25,7 +25,8 @@ pub struct VerifyArgs {
     /// The identified model (`model.json` as `sweephold fit --out` writes it).
     #[arg(long, value_name = "model.json")]
     pub model: PathBuf,
-    /// Telemetry dumps to verify against (ideally records not used in the fit).
+    /// Telemetry dumps to verify against (ideally records not used in the fit): any test
+    /// the firmware flies — doublet, 3-2-1-1 or sweep (`sweephold fly --input doublet`).
     #[arg(value_name = "DUMP", required = true)]
     pub dumps: Vec<PathBuf>,
     /// Write one SVG per dump and output (measured vs predicted) into this folder.
@@ -73,7 +74,7 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
     );
     let mut all_theil = Vec::new();
     for dump in &args.dumps {
-        let record = load_dump(dump).map_err(|e| anyhow!("{e}"))?;
+        let record = load_test_dump(dump).map_err(|e| anyhow!("{e}"))?;
         let verification =
             verify_record_in_segments(&model, &record, args.segment).map_err(|e| {
                 // Record errors name the dump already; model errors get it in front.

@@ -28,12 +28,31 @@ const MAX_MISSING_FRACTION: f64 = 0.1;
 
 /// Load the excitation record of a telemetry dump file.
 pub fn load_dump(path: impl AsRef<Path>) -> Result<Record, FrfError> {
+    load_dump_with(path, Excitation::Sweep)
+}
+
+/// Like [`load_dump`], but the test may be any excitation (sweep, doublet, 3-2-1-1): the
+/// records time-domain verification replays.
+pub fn load_test_dump(path: impl AsRef<Path>) -> Result<Record, FrfError> {
+    load_dump_with(path, Excitation::Any)
+}
+
+/// Which tests a loader accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Excitation {
+    /// Frequency sweeps only (frequency responses need one).
+    Sweep,
+    /// Any input the firmware flies.
+    Any,
+}
+
+fn load_dump_with(path: impl AsRef<Path>, excitation: Excitation) -> Result<Record, FrfError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|source| FrfError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    load_dump_bytes(&bytes, &path.display().to_string())
+    load_dump_bytes_with(&bytes, &path.display().to_string(), excitation)
 }
 
 fn is_excitation(phase: Phase) -> bool {
@@ -58,6 +77,14 @@ pub const SETTLE_S: f64 = 2.0;
 
 /// Load the excitation record from the bytes of a dump; `source` names it in messages.
 pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, FrfError> {
+    load_dump_bytes_with(bytes, source, Excitation::Sweep)
+}
+
+fn load_dump_bytes_with(
+    bytes: &[u8],
+    source: &str,
+    excitation: Excitation,
+) -> Result<Record, FrfError> {
     let mut decoder = Decoder::new();
     // Samples per test: a new segment starts at every Header.
     let mut segments: Vec<(Option<Header>, Vec<Sample>)> = vec![(None, Vec::new())];
@@ -104,7 +131,7 @@ pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, FrfError> {
     let header = record_header.ok_or_else(|| FrfError::NoHeader {
         path: source.into(),
     })?;
-    record_from_samples(&header, all, source)
+    record_from_samples_with(&header, all, source, excitation)
 }
 
 /// The excitation record of one test from its Header and its Samples in stream order
@@ -115,6 +142,25 @@ pub fn record_from_samples(
     header: &Header,
     all: &[Sample],
     source: &str,
+) -> Result<Record, FrfError> {
+    record_from_samples_with(header, all, source, Excitation::Sweep)
+}
+
+/// Like [`record_from_samples`] for any excitation (doublet, 3-2-1-1 or sweep): the
+/// records time-domain verification replays.
+pub fn test_record_from_samples(
+    header: &Header,
+    all: &[Sample],
+    source: &str,
+) -> Result<Record, FrfError> {
+    record_from_samples_with(header, all, source, Excitation::Any)
+}
+
+fn record_from_samples_with(
+    header: &Header,
+    all: &[Sample],
+    source: &str,
+    excitation: Excitation,
 ) -> Result<Record, FrfError> {
     let Some(first) = all.iter().position(|s| is_excitation(s.phase)) else {
         return Err(FrfError::NoSweep {
@@ -140,7 +186,7 @@ pub fn record_from_samples(
         .count();
     let samples = &all[first - before..=last + after];
     let test = header.test;
-    if test.input != InputKind::Sweep {
+    if excitation == Excitation::Sweep && test.input != InputKind::Sweep {
         return Err(FrfError::NoSweep {
             path: source.into(),
             detail: format!("the test is a {:?}, not a sweep", test.input),
@@ -328,5 +374,10 @@ mod tests {
         };
         let err = load_dump_bytes(&dump_bytes(&doublet), "d.dump").unwrap_err();
         assert!(err.to_string().contains("not a sweep"), "{err}");
+        // Verification replays any excitation: the same doublet loads there, whole.
+        let bytes = dump_bytes(&doublet);
+        let swept = load_dump_bytes_with(&bytes, "d.dump", Excitation::Any).unwrap();
+        let sweep = load_dump_bytes(&dump_bytes(&DumpSpec::default()), "s.dump").unwrap();
+        assert_eq!(swept.len(), sweep.len());
     }
 }

@@ -59,7 +59,9 @@ pub use coherence::{
     welch_independent_averages,
 };
 pub use csv::{load_csv, CsvColumns};
-pub use dump::{load_dump, load_dump_bytes, record_from_samples};
+pub use dump::{
+    load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
+};
 pub use options::FrfOptions;
 pub use plots::write_plots;
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
