@@ -14,7 +14,9 @@ use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
 };
-use sysid::fit::{fit, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure};
+use sysid::fit::{
+    fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
+};
 
 /// Arguments of `sweephold fit`.
 #[derive(Args, Debug)]
@@ -40,7 +42,8 @@ pub struct FitArgs {
     /// Seed of the perturbed restarts (same seed, same result).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Take start values from a quasi-steady 6-DOF `model.json` (paper Eq. 26–27).
+    /// Take start values from a quasi-steady 6-DOF `model.json` (paper Eq. 26–27); the
+    /// structure file's own start values are tried too, and the lower J_ave is kept.
     #[arg(long, value_name = "model6.json")]
     pub start_from: Option<PathBuf>,
     /// Most optimizer starts (stops earlier once a minimum is found twice).
@@ -65,13 +68,14 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             args.frf.display()
         )
     })?;
-    let mut structure = ModelStructure::from_path(&args.model)?;
+    let structure = ModelStructure::from_path(&args.model)?;
     if args.points < 2 {
         bail!("--points must be at least 2");
     }
 
     // Everything goes to one report printed at the end (see `emit`).
     let mut report = String::new();
+    let mut starts = Vec::new();
     if let Some(path) = &args.start_from {
         let text =
             fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -92,8 +96,15 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             );
         }
         let _ = writeln!(report);
-        structure = started;
+        starts.push((
+            format!("{} ({})", path.display(), previous.structure),
+            started,
+        ));
     }
+    starts.push((
+        format!("{} (the file's start values)", args.model.display()),
+        structure,
+    ));
 
     let options = FitOptions {
         points_per_pair: args.points,
@@ -102,7 +113,22 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         reduce: args.reduce,
         ..FitOptions::default()
     };
-    let result = fit(&structure, &data, &options)?;
+    // With --start-from, the file's own starts are the fallback: the lower J_ave wins.
+    let (result, outcomes) = fit_from_alternative_starts(&starts, &data, &options)?;
+    if outcomes.len() > 1 {
+        let _ = writeln!(report, "start sets (lowest J_ave kept, then reduced):");
+        for outcome in &outcomes {
+            match &outcome.average_cost {
+                Ok(cost) => {
+                    let _ = writeln!(report, "  J_ave {cost:>12.4}  {}", outcome.label);
+                }
+                Err(error) => {
+                    let _ = writeln!(report, "  failed: {error}  {}", outcome.label);
+                }
+            }
+        }
+        let _ = writeln!(report);
+    }
 
     let truth = match args.truth {
         Some(vehicle) => Some(crate::truth::score_fit(

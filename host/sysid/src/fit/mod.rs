@@ -242,6 +242,73 @@ pub fn fit(
     Ok(result)
 }
 
+/// The cost a start set reached in [`fit_from_alternative_starts`], before reduction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StartSetOutcome {
+    /// What the caller called this start set (e.g. "6-DOF model", "structure file").
+    pub label: String,
+    /// J_ave of its best start, or the error that stopped it.
+    pub average_cost: Result<f64, String>,
+}
+
+/// Fit the same structure from several sets of start values (each a copy of the structure
+/// with its own values, e.g. from a 6-DOF fit and from the file), keep the lowest J_ave,
+/// and only then reduce it. A 6-DOF fit can land in a degenerate minimum (its roll
+/// damping and control power both huge, their ratio right) whose Eq. 26–27 starts are
+/// useless; the file's generic starts are the fallback. Each set still gets the usual
+/// perturbed restarts. Errors only when every set fails (the first set's error).
+pub fn fit_from_alternative_starts(
+    starts: &[(String, ModelStructure)],
+    data: &FrfDocument,
+    options: &FitOptions,
+) -> Result<(FitResult, Vec<StartSetOutcome>), FitError> {
+    let Some((_, first)) = starts.first() else {
+        return Err(FitError::NoPairs);
+    };
+    let (usable, skipped) = usable_pairs(first, data, options.min_auto_range_ratio);
+    if usable.pairs.is_empty() && !first.pairs.is_empty() {
+        return Err(FitError::NoUsablePairs {
+            skipped: skipped.len(),
+        });
+    }
+    let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
+    let mut best: Option<FitResult> = None;
+    let mut first_error = None;
+    let mut outcomes = Vec::with_capacity(starts.len());
+    for (label, structure) in starts {
+        let (usable, _) = usable_pairs(structure, data, options.min_auto_range_ratio);
+        match fit_on_grids(&usable, &grids, options) {
+            Ok(result) => {
+                outcomes.push(StartSetOutcome {
+                    label: label.clone(),
+                    average_cost: Ok(result.average_cost),
+                });
+                if best
+                    .as_ref()
+                    .is_none_or(|b| result.average_cost < b.average_cost)
+                {
+                    best = Some(result);
+                }
+            }
+            Err(error) => {
+                outcomes.push(StartSetOutcome {
+                    label: label.clone(),
+                    average_cost: Err(error.to_string()),
+                });
+                first_error.get_or_insert(error);
+            }
+        }
+    }
+    let Some(mut result) = best else {
+        return Err(first_error.unwrap_or(FitError::NoPairs));
+    };
+    if options.reduce {
+        result = reduce::reduce(result, &grids, options)?;
+    }
+    result.skipped_pairs = skipped;
+    Ok((result, outcomes))
+}
+
 /// A pair of the structure left out of the fit, and why.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SkippedPair {
@@ -572,6 +639,41 @@ mod tests {
         // Constrained Yb1s follows Xb1c.
         let xb1c = result.parameter("Xb1c").unwrap();
         assert_eq!(result.parameter("Yb1s").unwrap(), -xb1c);
+    }
+
+    #[test]
+    fn alternative_starts_keep_the_lower_cost() {
+        let structure = first_order_structure();
+        let truth = structure.values();
+        let document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 20);
+        // A hopeless start set (the lag's gain with the wrong sign, pinned by one start and
+        // few iterations) beside a good one: the good one wins whichever comes first.
+        let options = FitOptions {
+            max_starts: 1,
+            max_iterations: 3,
+            ..FitOptions::default()
+        };
+        let hopeless = structure.with_values(&[-50.0, -300.0, 0.09]).unwrap();
+        let good = structure.with_values(&[-1.2, 3.3, 0.02]).unwrap();
+        for order in [[0, 1], [1, 0]] {
+            let sets = [("hopeless", &hopeless), ("good", &good)];
+            let starts: Vec<(String, ModelStructure)> = order
+                .iter()
+                .map(|&k| (sets[k].0.to_string(), sets[k].1.clone()))
+                .collect();
+            let (result, outcomes) =
+                fit_from_alternative_starts(&starts, &document, &options).unwrap();
+            assert_eq!(outcomes.len(), 2);
+            let cost = |label: &str| {
+                outcomes
+                    .iter()
+                    .find(|o| o.label == label)
+                    .and_then(|o| o.average_cost.clone().ok())
+                    .unwrap()
+            };
+            assert!(cost("good") < cost("hopeless"), "{outcomes:?}");
+            assert_eq!(result.average_cost, cost("good"));
+        }
     }
 
     #[test]
