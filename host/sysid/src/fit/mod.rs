@@ -102,8 +102,12 @@ pub enum ParameterStatus {
 }
 
 /// A warning on an identified parameter (guidelines of the paper and Tischler & Remple).
+/// In JSON: `{"flag": "cramer_rao"}`, `{"flag": "insensitive"}`,
+/// `{"flag": "correlated", "with": "Lp", "correlation": 0.93}` — read and written through
+/// [`FlagRecord`], not serde's internal tagging, whose buffering cannot hold serde_json's
+/// arbitrary-precision numbers (switched on by another crate of the build).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(tag = "flag", rename_all = "snake_case")]
+#[serde(into = "FlagRecord", try_from = "FlagRecord")]
 pub enum AccuracyFlag {
     /// Cramér–Rao bound above the limit (20 %).
     CramerRao,
@@ -116,6 +120,54 @@ pub enum AccuracyFlag {
         /// The correlation coefficient.
         correlation: f64,
     },
+}
+
+/// The JSON form of an [`AccuracyFlag`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FlagRecord {
+    /// `cramer_rao`, `insensitive` or `correlated`.
+    pub flag: String,
+    /// The other parameter (`correlated` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub with: Option<String>,
+    /// The correlation coefficient (`correlated` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correlation: Option<f64>,
+}
+
+impl From<AccuracyFlag> for FlagRecord {
+    fn from(flag: AccuracyFlag) -> FlagRecord {
+        let (name, with, correlation) = match flag {
+            AccuracyFlag::CramerRao => ("cramer_rao", None, None),
+            AccuracyFlag::Insensitive => ("insensitive", None, None),
+            AccuracyFlag::Correlated { with, correlation } => {
+                ("correlated", Some(with), Some(correlation))
+            }
+        };
+        FlagRecord {
+            flag: name.to_string(),
+            with,
+            correlation,
+        }
+    }
+}
+
+impl TryFrom<FlagRecord> for AccuracyFlag {
+    type Error = String;
+
+    fn try_from(record: FlagRecord) -> Result<AccuracyFlag, String> {
+        match (record.flag.as_str(), record.with, record.correlation) {
+            ("cramer_rao", _, _) => Ok(AccuracyFlag::CramerRao),
+            ("insensitive", _, _) => Ok(AccuracyFlag::Insensitive),
+            ("correlated", Some(with), Some(correlation)) => {
+                Ok(AccuracyFlag::Correlated { with, correlation })
+            }
+            ("correlated", _, _) => {
+                Err("a `correlated` flag needs `with` and `correlation`".into())
+            }
+            (other, _, _) => Err(format!("unknown accuracy flag `{other}`")),
+        }
+    }
 }
 
 /// One parameter of the fitted model, as reported and as written in `model.json`.

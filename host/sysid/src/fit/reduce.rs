@@ -68,6 +68,12 @@ pub fn reduce(
 ) -> Result<FitResult, FitError> {
     let mut current = initial;
     let mut steps = Vec::new();
+    // A refit starts at the previous minimum with one parameter zeroed: one start from
+    // there and one perturbed restart to confirm it, not the whole restart budget.
+    let refit_options = FitOptions {
+        max_starts: options.max_starts.min(2),
+        ..options.clone()
+    };
     while let Some((name, reason)) = worst_parameter(&current, options) {
         let mut smaller = current.structure.clone();
         let Some(index) = smaller.parameter_index(&name) else {
@@ -81,7 +87,7 @@ pub fn reduce(
         smaller.parameters[index].lower = None;
         smaller.parameters[index].upper = None;
         let before = current.average_cost;
-        let refit = match fit_on_grids(&smaller, grids, options) {
+        let refit = match fit_on_grids(&smaller, grids, &refit_options) {
             Ok(refit) => refit,
             // A smaller model that cannot be evaluated (e.g. a pole moved onto the jω
             // axis) is not an improvement.

@@ -85,7 +85,12 @@ pub struct ModelDocument {
 /// (`sweephold fit --truth`). A [`ModelDocument`] reads such a file too (it ignores the
 /// extra key); the section is kept apart so that existing code building a
 /// `ModelDocument` is unaffected.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Deserialization goes through a `serde_json::Value` rather than `#[serde(flatten)]`:
+/// flatten buffers the numbers in serde's internal `Content`, which cannot hold
+/// serde_json's arbitrary-precision numbers — a feature another crate of the same build
+/// (defmt-decoder) switches on for everyone.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ScoredModelDocument {
     /// The model document.
     #[serde(flatten)]
@@ -93,6 +98,19 @@ pub struct ScoredModelDocument {
     /// Scoring against a simulator's truth; absent without `--truth`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth: Option<TruthSection>,
+}
+
+impl<'de> Deserialize<'de> for ScoredModelDocument {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut value = serde_json::Value::deserialize(deserializer)?;
+        let truth = match value.as_object_mut().and_then(|map| map.remove("truth")) {
+            None | Some(serde_json::Value::Null) => None,
+            Some(section) => Some(serde_json::from_value(section).map_err(D::Error::custom)?),
+        };
+        let model = serde_json::from_value(value).map_err(D::Error::custom)?;
+        Ok(ScoredModelDocument { model, truth })
+    }
 }
 
 /// One parameter compared with the value the simulator's linearization implies.
@@ -367,5 +385,67 @@ mod tests {
         assert!(table.contains("tau") && table.contains("CR %"));
         let costs = cost_table(&result);
         assert!(costs.contains("x/u") && costs.contains("J_ave"));
+    }
+
+    #[test]
+    fn scored_document_with_flags_round_trips_under_arbitrary_precision() {
+        // This test crate builds serde_json with `arbitrary_precision` (dev-dependency),
+        // as the `sweephold` binary does: flatten and internal tagging broke there.
+        let structure = first_order_structure();
+        let data = synthetic_document(
+            &structure.model(&structure.values()).unwrap(),
+            &structure,
+            20,
+        );
+        let result = fit(&structure, &data, &FitOptions::default()).unwrap();
+        let mut model = result.to_document();
+        model.parameters[0].flags = vec![
+            AccuracyFlag::CramerRao,
+            AccuracyFlag::Insensitive,
+            AccuracyFlag::Correlated {
+                with: "b".into(),
+                correlation: -0.93,
+            },
+        ];
+        let truth = TruthSection {
+            vehicle: "bo105".into(),
+            parameters: vec![TruthParameter {
+                name: "a".into(),
+                value: -1.0,
+                truth: Some(-1.1),
+                error_percent: Some(9.09),
+            }],
+            pairs: Vec::new(),
+            average_cost: 0.5,
+            unmapped: Vec::new(),
+        };
+        for truth in [Some(truth), None] {
+            let document = ScoredModelDocument {
+                model: model.clone(),
+                truth,
+            };
+            let json = serde_json::to_string_pretty(&document).unwrap();
+            assert!(json.contains(r#""flag": "correlated""#), "{json}");
+            // serde_json's default float parser may miss by one ulp (no `float_roundtrip`),
+            // so numbers are compared to 1e-14, everything else exactly.
+            let close = |a: &ModelDocument, b: &ModelDocument| {
+                a.parameters.iter().zip(&b.parameters).all(|(x, y)| {
+                    x.name == y.name
+                        && x.flags == y.flags
+                        && (x.value - y.value).abs() <= 1e-14 * y.value.abs()
+                        && x.cramer_rao_percent
+                            .zip(y.cramer_rao_percent)
+                            .is_none_or(|(x, y)| (x - y).abs() <= 1e-14 * y.abs())
+                }) && a.model().is_some()
+                    && a.structure == b.structure
+            };
+            let back: ScoredModelDocument = serde_json::from_str(&json).unwrap();
+            assert!(close(&back.model, &model));
+            assert_eq!(back.truth, document.truth);
+            let plain: ModelDocument = serde_json::from_str(&json).unwrap();
+            assert!(close(&plain, &model));
+        }
+        let unknown = r#"{"flag": "bogus"}"#;
+        assert!(serde_json::from_str::<AccuracyFlag>(unknown).is_err());
     }
 }
