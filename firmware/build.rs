@@ -10,4 +10,11 @@ fn main() {
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={}", memory.display());
     println!("cargo:rerun-if-changed=build.rs");
+    // defmt keeps only `error!` lines unless DEFMT_LOG says otherwise. The image's log
+    // (phase changes, hold engage/release, aborts, link state) is `info!`/`debug!`: make
+    // `debug` this package's default; an explicit DEFMT_LOG still wins.
+    println!("cargo:rerun-if-env-changed=DEFMT_LOG");
+    if env::var_os("DEFMT_LOG").is_none() {
+        println!("cargo:rustc-env=DEFMT_LOG=debug");
+    }
 }

@@ -1,5 +1,5 @@
 //! `sweephold fly --fc qemu`: the board image in QEMU flies the same record as the
-//! firmware library in-process, byte for byte.
+//! firmware library in-process, byte for byte, and its defmt log comes back decoded.
 //!
 //! Needs `qemu-system-arm` and the image (`cargo fw`; or the path in `SWEEPHOLD_FC_ELF`),
 //! built after the last change to `firmware/src` and `shared/src`. Without them the test
@@ -138,7 +138,7 @@ fn compare(image: &std::path::Path, transport: QemuTransport, campaign: &[&str])
     };
     let started = std::time::Instant::now();
     let flown = sweephold::fly::fly(&args(&qemu_dir, name), &|| {
-        Box::new(QemuLink::new(image, transport, &[]))
+        Box::new(QemuLink::new(image, transport, &[]).with_log_folder(qemu_dir.path()))
     })
     .expect("the campaign flies in QEMU");
     let wall_s = started.elapsed().as_secs_f64();
@@ -176,6 +176,95 @@ fn compare(image: &std::path::Path, transport: QemuTransport, campaign: &[&str])
          every dump byte-identical to the in-process one",
         ticks / wall_s
     );
+    if transport == QemuTransport::Semihosting {
+        check_logs(&flown.dumps);
+    }
+}
+
+/// Over semihosting every record has its decoded defmt log beside its dump: the
+/// Configure that set it up, each phase of the sequencer from arming to Done and the
+/// hold engaging and releasing, each line stamped with the loop tick and the level.
+fn check_logs(dumps: &[PathBuf]) {
+    for dump in dumps {
+        let path = dump.with_extension("log");
+        let text = std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("{}: no log ({e})", path.display()));
+        for expected in [
+            "INFO  configured by the host: bo105, 200 Hz",
+            "phase Idle -> Armed",
+            "phase Armed -> TrimCapture",
+            "trim captured",
+            "phase TrimCapture -> FadeIn",
+            "phase FadeIn -> Sweep",
+            "phase Sweep -> FadeOut",
+            "phase FadeOut -> Done",
+            // Conditional attitude hold at work (deterministic: lockstep, fixed seed).
+            "DEBUG tick ",
+            "hold engaged on",
+            "hold released on",
+        ] {
+            assert!(
+                text.lines().any(|line| line.contains(expected)),
+                "{}: no line with {expected:?} in\n{text}",
+                path.display()
+            );
+        }
+        assert!(!text.contains("malformed"), "{}:\n{text}", path.display());
+        // The time stamp is the tick of the Sample the line belongs to.
+        let done = text
+            .lines()
+            .find(|line| line.contains("-> Done"))
+            .unwrap_or_default();
+        let stamp: u32 = done
+            .split_whitespace()
+            .next()
+            .unwrap_or("")
+            .parse()
+            .unwrap();
+        assert!(done.contains(&format!("tick {stamp}:")), "{done}");
+    }
+}
+
+/// An aborted record's log says why: the pilot moves the stick during the sweep.
+#[test]
+fn qemu_logs_an_abort() {
+    let Some(image) = image_or_skip("qemu_logs_an_abort") else {
+        return;
+    };
+    let dir = Scratch::new("qemu-abort");
+    let args = fly_args(&[
+        "--axes",
+        "lat",
+        "--t-rec",
+        "10",
+        "--seed",
+        "7",
+        "--pilot-override",
+        "8",
+        "--fc",
+        "qemu",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let flown = sweephold::fly::fly(&args, &|| {
+        Box::new(QemuLink::new(&image, QemuTransport::Semihosting, &[]).with_log_folder(dir.path()))
+    })
+    .expect("the campaign flies in QEMU");
+    assert!(
+        flown.summary.runs.iter().all(|run| run.aborted),
+        "both records abort"
+    );
+    for dump in &flown.dumps {
+        let path = dump.with_extension("log");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.lines()
+                .any(|line| line.contains("WARN") && line.contains("abort: PilotOverride")),
+            "{}: no abort line in\n{text}",
+            path.display()
+        );
+        assert!(text.contains("-> Aborted"), "{}:\n{text}", path.display());
+    }
 }
 
 /// A configuration the flight logic refuses is refused by the image too, named by the
@@ -189,7 +278,9 @@ fn qemu_refuses_a_bad_configuration_and_keeps_flying() {
     use sweephold::fly::VehicleArg;
     use sweephold_protocol::{Axis, SensorIn};
 
-    let mut link = QemuLink::new(&image, QemuTransport::Semihosting, &[]);
+    let logs = Scratch::new("qemu-refusal");
+    let mut link =
+        QemuLink::new(&image, QemuTransport::Semihosting, &[]).with_log_folder(logs.path());
     let mut bad = VehicleArg::Bo105.firmware_config(Axis::Ped);
     bad.rate_hz = 20;
     let error = link.begin_record(&bad).expect_err("rate 20 Hz is refused");
@@ -212,4 +303,12 @@ fn qemu_refuses_a_bad_configuration_and_keeps_flying() {
         matches!(frames.as_slice(), [Frame::Sample(sample)] if sample.tick == 0),
         "the first tick's telemetry is its Sample alone: {frames:?}"
     );
+    link.end_record("ped-1.bin").expect("the log is written");
+    let log = std::fs::read_to_string(logs.path().join("ped-1.log")).unwrap();
+    for expected in [
+        "WARN  configuration refused: tick rate outside 50-1000 Hz",
+        "INFO  configured by the host: bo105, 200 Hz",
+    ] {
+        assert!(log.contains(expected), "no {expected:?} in\n{log}");
+    }
 }

@@ -252,14 +252,35 @@ impl AttitudeController {
 
     /// One control step: the output for this tick, then the integrator update.
     pub fn update(&mut self, gains: &AxisGains, error: f32, rate: f32, dt: f32) -> f32 {
+        self.update_with_decay(gains, error, rate, dt, Self::transfer_decay(gains, dt))
+    }
+
+    /// e^{−dt/τ_b}, the per-tick factor of the bumpless-transfer term (0 without one). A
+    /// decay rate needs no libm precision: micromath's fast exp (≈1e-3 relative) does.
+    pub fn transfer_decay(gains: &AxisGains, dt: f32) -> f32 {
+        if gains.bumpless_time_s > 0.0 {
+            micromath::F32Ext::exp(-dt / gains.bumpless_time_s)
+        } else {
+            0.0
+        }
+    }
+
+    /// [`update`](Self::update) with the transfer decay computed once for the
+    /// configuration ([`transfer_decay`](Self::transfer_decay)), not every tick.
+    pub fn update_with_decay(
+        &mut self,
+        gains: &AxisGains,
+        error: f32,
+        rate: f32,
+        dt: f32,
+        transfer_decay: f32,
+    ) -> f32 {
         let unsaturated =
             Self::proportional_and_damping(gains, error, rate) + self.integral + self.transfer;
         let output = clamp_finite(unsaturated, gains.output_limit);
-        // B ← B·e^{−dt/τ_b}: continuous at engagement, gone after a few τ_b. A decay rate
-        // needs no libm precision: micromath's fast exp (≈1e-3 relative) does.
+        // B ← B·e^{−dt/τ_b}: continuous at engagement, gone after a few τ_b.
         self.transfer = if gains.bumpless_time_s > 0.0 {
-            let decay = micromath::F32Ext::exp(-dt / gains.bumpless_time_s);
-            clamp_finite(self.transfer * decay, MAX_TRANSFER)
+            clamp_finite(self.transfer * transfer_decay, MAX_TRANSFER)
         } else {
             0.0
         };
@@ -280,10 +301,16 @@ impl AttitudeController {
 /// through public functions that cannot assume a validated configuration.
 pub(crate) fn clamp_finite(value: f32, limit: f32) -> f32 {
     let limit = if limit.is_nan() { 0.0 } else { limit.abs() };
+    // Comparisons, not `max`/`min` (fmaxf/fminf calls on the Cortex-M4); same result
+    // for the non-NaN value and limit here.
     if value.is_nan() {
         0.0
+    } else if value < -limit {
+        -limit
+    } else if value > limit {
+        limit
     } else {
-        value.max(-limit).min(limit)
+        value
     }
 }
 

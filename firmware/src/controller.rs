@@ -47,14 +47,13 @@
 //! — in every phase, so a missing tick shows up as a gap in `Sample::tick`.
 
 use sweephold_protocol::{
-    encode, AbortReason, ActuatorOut, Axis, Controls, Event, ExcitationMode, FirmwareVersion,
-    Frame, Header, HoldState, Measurements, Phase, Sample, SensorIn, MAX_FRAME_LEN,
-    PROTOCOL_VERSION,
+    AbortReason, ActuatorOut, Axis, Controls, Event, ExcitationMode, FirmwareVersion, Frame,
+    Header, HoldState, Measurements, Phase, Sample, SensorIn, PROTOCOL_VERSION,
 };
 
 use crate::attitude_hold::{AttitudeController, AxisGains};
 use crate::config::{Config, ConfigError, HoldReference};
-use crate::excitation::{Excitation, ExcitationSample};
+use crate::excitation::{Excitation, ExcitationSample, ExcitationTicker};
 use crate::hold::{next_hold_state, HoldThresholds};
 use crate::mixer::mix;
 use crate::noise::OffAxisNoise;
@@ -129,11 +128,31 @@ impl HeldAxis {
     };
 }
 
+/// Per-tick factors of one held axis, fixed by the configuration (computed once: the
+/// exponentials are too slow for every tick).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct AxisDecay {
+    /// e^{−dt/τ_r} of the release fade ([`fade_factor`]).
+    release: f32,
+    /// e^{−dt/τ_b} of the bumpless-transfer term.
+    transfer: f32,
+}
+
+impl AxisDecay {
+    fn new(gains: &AxisGains, dt_s: f32) -> Self {
+        AxisDecay {
+            release: fade_factor(gains.release_time_s, dt_s),
+            transfer: AttitudeController::transfer_decay(gains, dt_s),
+        }
+    }
+}
+
 /// Everything one held axis needs from this tick's measurements.
 #[derive(Clone, Copy, Debug)]
 struct AxisInput {
     axis: Axis,
     gains: AxisGains,
+    decay: AxisDecay,
     /// The angle the hold thresholds apply to \[rad\] (see [`HoldReference`]).
     hold_angle: f32,
     /// Attitude deviation from trim, the controller's error \[rad\].
@@ -169,14 +188,16 @@ impl TickParts {
 pub struct FlightController {
     config: Config,
     header: Header,
-    excitation: Excitation,
+    /// The excitation at this loop's ticks (no `f64` on the tick path).
+    excitation: ExcitationTicker,
     /// The noise generator as configured; copied at each test start so that every test
     /// with the same seed gets the same noise.
     noise_at_start: OffAxisNoise,
     noise: OffAxisNoise,
     thresholds: HoldThresholds,
-    rate_hz: f64,
     dt_s: f32,
+    /// Per-tick decay factors of lat, lon, ped.
+    decays: [AxisDecay; 3],
     trim_capture_ticks: u32,
     phase: Phase,
     tick: u32,
@@ -218,12 +239,16 @@ impl FlightController {
                 rate_hz: config.rate_hz,
                 test: config.test,
             },
-            excitation: Excitation::from_test(&config.test),
+            excitation: Excitation::from_test(&config.test).ticker(config.rate_hz),
             noise_at_start: noise,
             noise,
             thresholds: config.hold_thresholds(),
-            rate_hz: f64::from(config.rate_hz),
             dt_s,
+            decays: [
+                AxisDecay::new(&config.gains.lat, dt_s),
+                AxisDecay::new(&config.gains.lon, dt_s),
+                AxisDecay::new(&config.gains.ped, dt_s),
+            ],
             trim_capture_ticks,
             phase: Phase::Idle,
             tick: 0,
@@ -415,9 +440,9 @@ impl FlightController {
         tick: u32,
         sink: &mut impl FrameSink,
     ) -> TickParts {
-        // t = n / rate from an integer count: no accumulated rounding over a long record.
-        let t = f64::from(self.excitation_tick) / self.rate_hz;
-        let sample = self.excitation.sample(t);
+        // Tick n of the excitation, t = n / rate: an integer count, no accumulated
+        // rounding over a long record.
+        let sample = self.excitation.sample(self.excitation_tick);
         let Some(phase) = sample.segment.phase() else {
             self.release_all(tick, sink);
             self.set_phase(Phase::Done, tick, sink);
@@ -437,10 +462,12 @@ impl FlightController {
             HoldReference::Level => (0.0, 0.0),
             HoldReference::Trim => (trim.phi, trim.theta),
         };
+        let [decay_lat, decay_lon, decay_ped] = self.decays;
         let inputs = [
             AxisInput {
                 axis: Axis::Lat,
                 gains: gains.lat,
+                decay: decay_lat,
                 hold_angle: meas.phi - phi_ref,
                 deviation: meas.phi - trim.phi,
                 rate: meas.p,
@@ -449,6 +476,7 @@ impl FlightController {
             AxisInput {
                 axis: Axis::Lon,
                 gains: gains.lon,
+                decay: decay_lon,
                 hold_angle: meas.theta - theta_ref,
                 deviation: meas.theta - trim.theta,
                 rate: meas.q,
@@ -457,6 +485,7 @@ impl FlightController {
             AxisInput {
                 axis: Axis::Ped,
                 gains: gains.ped,
+                decay: decay_ped,
                 hold_angle: wrap_pi(meas.psi - trim.psi),
                 deviation: wrap_pi(meas.psi - trim.psi),
                 rate: meas.r,
@@ -571,7 +600,7 @@ fn step_axis(
                         // axis at once, i.e. cross-control coherence.
                         held.release_carry = held.last_perturbation - sweep - noise;
                     }
-                    held.release_carry *= fade_factor(gains.release_time_s, dt_s);
+                    held.release_carry *= input.decay.release;
                     let carry = held.release_carry;
                     (HoldState::Released, sweep + noise + carry, sweep, noise)
                 }
@@ -581,9 +610,13 @@ fn step_axis(
                         held.controller
                             .engage(gains, input.deviation, input.rate, last);
                     }
-                    let output = held
-                        .controller
-                        .update(gains, input.deviation, input.rate, dt_s);
+                    let output = held.controller.update_with_decay(
+                        gains,
+                        input.deviation,
+                        input.rate,
+                        dt_s,
+                        input.decay.transfer,
+                    );
                     (HoldState::Engaged, output, 0.0, 0.0)
                 }
                 HoldState::Frozen => (HoldState::Frozen, held.last_perturbation, 0.0, 0.0),
@@ -597,9 +630,13 @@ fn step_axis(
                 held.controller
                     .engage(gains, input.deviation, input.rate, last);
             }
-            let output = held
-                .controller
-                .update(gains, input.deviation, input.rate, dt_s);
+            let output = held.controller.update_with_decay(
+                gains,
+                input.deviation,
+                input.rate,
+                dt_s,
+                input.decay.transfer,
+            );
             (HoldState::Engaged, output + sweep + noise, sweep, noise)
         }
     };
@@ -634,10 +671,8 @@ fn is_guarded(phase: Phase) -> bool {
 /// with a `MAX_FRAME_LEN` buffer; if it ever did, the frame is dropped (and shows up as
 /// a gap) rather than stopping the control loop.
 fn emit(sink: &mut impl FrameSink, frame: &Frame) {
-    let mut buffer = [0u8; MAX_FRAME_LEN];
-    match encode(frame, &mut buffer) {
-        Ok(length) => sink.write_frame(buffer.get(..length).unwrap_or(&[])),
-        Err(_) => error!("telemetry frame encoding failed"),
+    if sink.send_frame(frame).is_err() {
+        error!("telemetry frame encoding failed");
     }
 }
 

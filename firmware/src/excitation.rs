@@ -3,8 +3,8 @@
 
 use sweephold_protocol::{InputKind, Phase, TestConfig};
 
-use crate::pulse::{PulsePattern, PulseSignal};
-use crate::sweep::SweepSignal;
+use crate::pulse::{PulsePattern, PulseSignal, PulseTicker};
+use crate::sweep::{SweepSignal, SweepTicker};
 
 /// Which part of the excitation a time falls in; maps one to one onto the sequencer's
 /// FadeIn / Sweep / FadeOut phases.
@@ -105,6 +105,37 @@ impl Excitation {
         match self {
             Excitation::Sweep(sweep) => sweep.duration_s(),
             Excitation::Pulse(pulse) => pulse.duration_s(),
+        }
+    }
+}
+
+/// The configured excitation at the loop's ticks, without `f64` on the tick path (see
+/// [`SweepTicker`] and [`PulseTicker`]); same samples as [`Excitation::sample`] at
+/// t = n/rate (the sweep's to `f32` rounding).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExcitationTicker {
+    /// Exponential sweep.
+    Sweep(SweepTicker),
+    /// Doublet or 3-2-1-1.
+    Pulse(PulseTicker),
+}
+
+impl Excitation {
+    /// This excitation sampled at `rate_hz` (construction uses `f64`).
+    pub fn ticker(&self, rate_hz: u16) -> ExcitationTicker {
+        match self {
+            Excitation::Sweep(sweep) => ExcitationTicker::Sweep(sweep.ticker(rate_hz)),
+            Excitation::Pulse(pulse) => ExcitationTicker::Pulse(pulse.ticker(rate_hz)),
+        }
+    }
+}
+
+impl ExcitationTicker {
+    /// The excitation at tick `n` since it started (t = n/rate). Cheapest in order.
+    pub fn sample(&mut self, n: u32) -> ExcitationSample {
+        match self {
+            ExcitationTicker::Sweep(sweep) => sweep.sample(n),
+            ExcitationTicker::Pulse(pulse) => pulse.sample(n),
         }
     }
 }

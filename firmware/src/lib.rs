@@ -27,7 +27,9 @@
 //! The tick path has no `unwrap`, `expect`, panicking index or `unsafe`, runs in bounded
 //! time and turns NaN or infinite inputs into an abort and finite, clamped outputs.
 //!
-//! Modules, one concept each: [`sweep`] (the sweep and its closed-form phase),
+//! Modules, one concept each: [`sweep`] (the sweep, its closed-form phase and its
+//! `f64`-free tick evaluation), [`turns`] (angles as fixed-point fractions of a turn and
+//! their `f32` sine),
 //! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
@@ -60,6 +62,7 @@ pub mod safety;
 pub mod sink;
 pub mod sweep;
 pub mod trim;
+pub mod turns;
 
 pub use attitude_hold::{AxisGains, Gains};
 pub use config::{paper_test, Config, ConfigError, HoldReference};

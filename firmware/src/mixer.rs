@@ -63,10 +63,22 @@ impl ServoConfig {
         } else {
             sign * self.throw_us * height
         };
-        let raw = libm::roundf(f32::from(self.centre_us) + offset);
-        // max-then-min rather than `f32::clamp`, which panics on reversed bounds (an
-        // unvalidated config); `as` saturates, so the cast is always in range.
-        raw.max(f32::from(self.min_us)).min(f32::from(self.max_us)) as u16
+        let raw = f32::from(self.centre_us) + offset;
+        // Clamp, then round to the nearest µs. max-then-min rather than `f32::clamp`,
+        // which panics on reversed bounds (an unvalidated config), and written as
+        // comparisons: on the Cortex-M4 `max`/`min` are fmaxf/fminf calls. NaN fails
+        // `>=` and becomes the minimum. Clamping first is the same as rounding first
+        // (the bounds are integers and rounding is monotonic), and it leaves a value in
+        // [0, 65 535], where x + ½ is exact in f32 and truncating it rounds half away
+        // from zero like `roundf`, without the libm call. `as` saturates.
+        let (min, max) = (f32::from(self.min_us), f32::from(self.max_us));
+        let at_least_min = if raw >= min { raw } else { min };
+        let clamped = if at_least_min <= max {
+            at_least_min
+        } else {
+            max
+        };
+        (clamped + 0.5) as u16
     }
 }
 
@@ -236,7 +248,38 @@ mod tests {
         assert_eq!(low[0], 1100);
     }
 
+    /// The libm formulation the comparison version replaced: round, then clamp.
+    fn pulse_by_roundf(servo: &ServoConfig, height: f32) -> u16 {
+        let sign = if servo.reversed { -1.0 } else { 1.0 };
+        let offset = if height.is_nan() {
+            0.0
+        } else {
+            sign * servo.throw_us * height
+        };
+        let raw = libm::roundf(f32::from(servo.centre_us) + offset);
+        raw.max(f32::from(servo.min_us))
+            .min(f32::from(servo.max_us)) as u16
+    }
+
     proptest! {
+        /// Clamp-then-round without libm gives the same pulse as round-then-clamp, ties
+        /// (x.5) and reversed limits included.
+        #[test]
+        fn pulse_matches_round_then_clamp(
+            height in proptest::num::f32::ANY,
+            tie in -2000i32..2000,
+            min_us in 0u16..3000,
+            max_us in 0u16..3000,
+            throw_us in 0.0f32..1000.0,
+        ) {
+            let servo = ServoConfig { min_us, max_us, throw_us, ..ServoConfig::STANDARD };
+            prop_assert_eq!(servo.pulse_us(height), pulse_by_roundf(&servo, height));
+            let unit = ServoConfig { min_us, max_us, throw_us: 1.0, ..ServoConfig::STANDARD };
+            for h in [tie as f32 + 0.5, tie as f32 - 0.5, tie as f32 + 0.499_999_97] {
+                prop_assert_eq!(unit.pulse_us(h), pulse_by_roundf(&unit, h));
+            }
+        }
+
         #[test]
         fn any_command_stays_within_every_servo_limit(
             lat in proptest::num::f32::ANY,

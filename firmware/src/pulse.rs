@@ -10,6 +10,7 @@
 //! steady trim before the pulses, free response after them).
 
 use crate::excitation::{ExcitationSample, Segment};
+use crate::sweep::first_tick_at_or_after;
 
 /// One step of a multistep: sign and length in base widths.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -126,9 +127,102 @@ impl PulseSignal {
     }
 }
 
+/// Most steps in a pattern.
+const MAX_STEPS: usize = 4;
+
+/// A [`PulseSignal`] at the loop's ticks t = n/rate: its segment and step boundaries as
+/// tick numbers, found once with the same `f64` comparisons [`PulseSignal::sample`] makes
+/// at t = n/rate, so both give the same sample at every tick, with integer comparisons
+/// only on the tick path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PulseTicker {
+    /// First tick of the pulses, of the quiet tail, and past the end.
+    pulses_start: u32,
+    tail_start: u32,
+    finished: u32,
+    /// First tick past each step, and the step's value; unused entries end at 0.
+    step_ends: [u32; MAX_STEPS],
+    step_values: [f32; MAX_STEPS],
+}
+
+impl PulseSignal {
+    /// The tick boundaries of this signal for a loop at `rate_hz` (construction, `f64`).
+    pub fn ticker(&self, rate_hz: u16) -> PulseTicker {
+        let rate = f64::from(rate_hz.max(1));
+        let pulses_end = self.quiet_s + self.pulses_s();
+        let mut step_ends = [0; MAX_STEPS];
+        let mut step_values = [0.0; MAX_STEPS];
+        let mut step_end = self.quiet_s;
+        for ((step, end), value) in self
+            .pattern
+            .steps()
+            .iter()
+            .zip(step_ends.iter_mut())
+            .zip(step_values.iter_mut())
+        {
+            step_end += f64::from(step.widths) * self.width_s;
+            *end = first_tick_at_or_after(step_end, rate);
+            *value = f32::from(step.sign) * self.amplitude;
+        }
+        PulseTicker {
+            pulses_start: first_tick_at_or_after(self.quiet_s, rate),
+            tail_start: first_tick_at_or_after(pulses_end, rate),
+            finished: first_tick_at_or_after(pulses_end + self.quiet_s, rate),
+            step_ends,
+            step_values,
+        }
+    }
+}
+
+impl PulseTicker {
+    /// The excitation at tick `n` (t = n/rate since it started).
+    pub fn sample(&self, n: u32) -> ExcitationSample {
+        let segment = if n < self.pulses_start {
+            Segment::LeadIn
+        } else if n < self.tail_start {
+            Segment::Main
+        } else if n < self.finished {
+            Segment::Tail
+        } else {
+            return ExcitationSample::FINISHED;
+        };
+        let mut value = 0.0;
+        if segment == Segment::Main {
+            for (&end, &step_value) in self.step_ends.iter().zip(&self.step_values) {
+                if n < end {
+                    value = step_value;
+                    break;
+                }
+            }
+        }
+        ExcitationSample {
+            segment,
+            value,
+            omega: 0.0,
+            envelope: 1.0,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Tick path and time path agree at every tick, both patterns, awkward rates.
+    #[test]
+    fn ticker_matches_the_time_based_signal_at_every_tick() {
+        for pattern in [PulsePattern::Doublet, PulsePattern::ThreeTwoOneOne] {
+            for (rate, width, quiet) in [(200u16, 0.5, 2.0), (333, 0.33, 1.7), (50, 0.2, 0.0)] {
+                let signal = PulseSignal::new(pattern, 0.1, width, quiet);
+                let ticker = signal.ticker(rate);
+                let end = (signal.duration_s() * f64::from(rate)) as u32 + 3;
+                for n in 0..end {
+                    let t = f64::from(n) / f64::from(rate);
+                    assert_eq!(ticker.sample(n), signal.sample(t), "{pattern:?} tick {n}");
+                }
+            }
+        }
+    }
 
     fn values(signal: &PulseSignal, rate: f64) -> Vec<f32> {
         let n = (signal.duration_s() * rate).round() as u32;

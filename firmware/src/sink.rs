@@ -6,17 +6,35 @@
 //! mutable reference to a sink, and, with the `std` feature (or in tests),
 //! `std::vec::Vec<u8>`. The host loop implements the trait for its own types.
 
+use sweephold_protocol::codec::EncodeError;
+use sweephold_protocol::{encode, Frame, MAX_FRAME_LEN};
+
 /// Receiver of encoded frames.
 pub trait FrameSink {
     /// Take one complete encoded frame. A sink that cannot take it all should drop the
     /// whole frame rather than a part (the decoder resynchronises either way, but a
     /// dropped frame is counted as a tick gap, a torn one as a corrupt frame).
     fn write_frame(&mut self, bytes: &[u8]);
+
+    /// Encode `frame` and take it ([`write_frame`](Self::write_frame)). The default
+    /// encodes into a fresh stack buffer; a sink that keeps a scratch buffer of its own
+    /// overrides this to encode there and skip zeroing a frame's worth of stack every
+    /// time (it is in the per-tick budget of the board).
+    fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {
+        let mut buffer = [0u8; MAX_FRAME_LEN];
+        let length = encode(frame, &mut buffer)?;
+        self.write_frame(buffer.get(..length).unwrap_or(&[]));
+        Ok(())
+    }
 }
 
 impl<S: FrameSink + ?Sized> FrameSink for &mut S {
     fn write_frame(&mut self, bytes: &[u8]) {
         (**self).write_frame(bytes);
+    }
+
+    fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {
+        (**self).send_frame(frame)
     }
 }
 

@@ -16,18 +16,23 @@ mod board;
 #[path = "../board/dividers.rs"]
 mod dividers;
 
+/// Host unit tests of the board's byte ring.
+#[cfg(all(test, not(target_os = "none")))]
+#[path = "../board/ring.rs"]
+mod ring;
+
 #[cfg(target_os = "none")]
 mod image {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
-    use defmt_rtt as _;
 
     use crate::board;
 
-    // Log lines carry the loop tick they were written in.
-    defmt::timestamp!("{=u32}", board::ticker::elapsed());
+    // Log lines carry the loop tick they were written in (the `tick` of the Sample).
+    defmt::timestamp!("{=u32}", board::log::tick());
 
     #[entry]
     fn main() -> ! {
+        board::log::init();
         defmt::info!(
             "sweephold-fc {=str}, protocol {=u16}.{=u16}",
             env!("CARGO_PKG_VERSION"),

@@ -1,6 +1,7 @@
 //! The frame link over USART1: telemetry and ActuatorOut frames out, SensorIn frames in.
 
 use sweephold_firmware::FrameSink;
+use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{encode, Decoder, Frame, FrameError, MAX_FRAME_LEN};
 
 use super::usart::{UsartRx, UsartTx};
@@ -8,18 +9,24 @@ use super::usart::{UsartRx, UsartTx};
 /// Bytes taken from the receive ring per decoder pass.
 const RX_CHUNK: usize = 64;
 
+/// Scratch space for one encoded frame, kept by the loop so that encoding a frame does
+/// not zero a fresh stack buffer every time.
+pub type FrameScratch = [u8; MAX_FRAME_LEN];
+
 /// [`FrameSink`] over the transmit ring. Non-blocking: a frame that does not fit is
 /// dropped whole and counted ([`UsartTx::dropped_frames`]), so a slow or absent reader
 /// never stretches a tick. (The library's `IoSink` over the blocking
-/// `embedded_io::Write` of [`UsartTx`] would wait for room instead.)
+/// `embedded_io::Write` of [`UsartTx`] would wait for room instead.) Frames are encoded
+/// into the loop's scratch buffer and copied into the ring once.
 pub struct Telemetry<'a> {
     tx: &'a mut UsartTx,
+    scratch: &'a mut FrameScratch,
 }
 
 impl<'a> Telemetry<'a> {
-    /// A sink over `tx` for one tick.
-    pub fn new(tx: &'a mut UsartTx) -> Self {
-        Telemetry { tx }
+    /// A sink over `tx` for one tick, encoding in `scratch`.
+    pub fn new(tx: &'a mut UsartTx, scratch: &'a mut FrameScratch) -> Self {
+        Telemetry { tx, scratch }
     }
 }
 
@@ -27,25 +34,38 @@ impl FrameSink for Telemetry<'_> {
     fn write_frame(&mut self, bytes: &[u8]) {
         self.tx.queue_frame(bytes);
     }
+
+    fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {
+        // A frame that does not fit is dropped and counted by the ring, as with
+        // `write_frame`; encoding itself cannot fail for the protocol's types.
+        self.tx.queue_encoded(frame, self.scratch);
+        Ok(())
+    }
 }
 
-/// Encode `frame` and queue it; `false` when it was dropped (ring full) or could not be
-/// encoded (impossible for the protocol's own types with a `MAX_FRAME_LEN` buffer).
-pub fn send(tx: &mut UsartTx, frame: &Frame) -> bool {
-    let mut wire = [0u8; MAX_FRAME_LEN];
-    match encode(frame, &mut wire) {
-        Ok(len) => wire.get(..len).is_some_and(|bytes| tx.queue_frame(bytes)),
+/// Encode `frame` (in `scratch`) and queue it; `false` when it was dropped (ring full)
+/// or could not be encoded (impossible for the protocol's own types with a
+/// `MAX_FRAME_LEN` buffer).
+pub fn send(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) -> bool {
+    match encode(frame, scratch) {
+        Ok(len) => scratch
+            .get(..len)
+            .is_some_and(|bytes| tx.queue_frame(bytes)),
         Err(_) => false,
     }
 }
 
-/// Encode `frame` and queue it through the blocking [`embedded_io::Write`] of
-/// [`UsartTx`]: waits for room in the ring (at most the time the line needs to drain it,
-/// ~22 ms for 1 KiB at 460 800 Bd) instead of dropping the frame.
-pub fn send_waiting(tx: &mut UsartTx, frame: &Frame) {
-    let mut wire = [0u8; MAX_FRAME_LEN];
-    if let Ok(len) = encode(frame, &mut wire) {
-        if let Some(bytes) = wire.get(..len) {
+/// Encode `frame` (in `scratch`) and queue it through the blocking
+/// [`embedded_io::Write`] of [`UsartTx`]: waits for room in the ring (at most the time
+/// the line needs to drain it, ~22 ms for 1 KiB at 460 800 Bd) instead of dropping the
+/// frame.
+pub fn send_waiting(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) {
+    // Straight into the ring when there is room (the usual case), else wait for it.
+    if tx.encode_in_place(frame).is_some() {
+        return;
+    }
+    if let Ok(len) = encode(frame, scratch) {
+        if let Some(bytes) = scratch.get(..len) {
             // Infallible, and `write` never returns Ok(0) for a non-empty buffer.
             let _ = embedded_io::Write::write_all(tx, bytes);
         }

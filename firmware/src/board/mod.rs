@@ -9,7 +9,7 @@
 //! | servo 3 (swash)     | TIM3 CH3   | PB0 (AF2)             |
 //! | servo 4 (tail)      | TIM3 CH4   | PB1 (AF2)             |
 //! | loop tick           | TIM2       | —                     |
-//! | logs (defmt)        | RTT        | SWD                   |
+//! | logs (defmt)        | RTT        | SWD (QEMU: semihosting file, see [`log`]) |
 //!
 //! Register access goes through [`regs`] only (no PAC); the drivers above it are safe
 //! code. See `firmware/README.md` for wiring, flashing and the QEMU boot check.
@@ -18,8 +18,10 @@ pub mod clocks;
 pub mod dividers;
 pub mod gpio;
 pub mod link;
+pub mod log;
 pub mod nvic;
 pub mod regs;
+pub mod ring;
 pub mod runner;
 pub mod semihosting;
 pub mod servo;

@@ -33,7 +33,9 @@ use sweephold_protocol::{
 
 use super::clocks::{self, ClockSource, Clocks};
 use super::dividers;
-use super::link::{self, Inbound, Telemetry};
+use super::link::{self, FrameScratch, Inbound, Telemetry};
+use super::log;
+use super::nvic::{self, Irq};
 use super::semihosting;
 use super::servo::{self, ServoChannel, Servos};
 use super::ticker::Ticker;
@@ -170,6 +172,8 @@ pub struct Runner {
     status_period_ticks: u32,
     ticks_since_status: u32,
     stats: LoopStats,
+    /// Where frames are encoded before they go into the transmit ring.
+    scratch: FrameScratch,
 }
 
 impl Runner {
@@ -184,13 +188,14 @@ impl Runner {
             status_period_ticks: STATUS_PERIOD_S * rate_hz,
             ticks_since_status: 0,
             stats: LoopStats::default(),
+            scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
         }
     }
 
     /// Send the Header of the configured test.
     fn announce(&mut self) {
         let header = self.fc.header();
-        if !link::send(&mut self.tx, &Frame::Header(header)) {
+        if !link::send(&mut self.tx, &mut self.scratch, &Frame::Header(header)) {
             defmt::warn!("header frame dropped");
         }
     }
@@ -199,9 +204,14 @@ impl Runner {
     /// ActuatorOut. Telemetry that finds the ring full is dropped, but the answer waits
     /// for room: in lockstep the host cannot go on without it.
     fn step(&mut self, reply_to: Option<u32>) {
-        // The tick number this step carries (its Sample's `tick`).
+        // The tick number this step carries (its Sample's `tick`), also the time stamp
+        // of the log lines the step writes.
         let tick = self.fc.tick();
-        let output = self.fc.step(&self.input, &mut Telemetry::new(&mut self.tx));
+        log::set_tick(tick);
+        let output = self.fc.step(
+            &self.input,
+            &mut Telemetry::new(&mut self.tx, &mut self.scratch),
+        );
         // Infallible: the channels write compare registers.
         let _ = self.servos.apply(output.servo_us);
         self.stats.steps = self.stats.steps.wrapping_add(1);
@@ -212,7 +222,7 @@ impl Runner {
                 command: output.command,
                 servo_us: output.servo_us,
             };
-            link::send_waiting(&mut self.tx, &Frame::ActuatorOut(answer));
+            link::send_waiting(&mut self.tx, &mut self.scratch, &Frame::ActuatorOut(answer));
         }
     }
 
@@ -257,6 +267,8 @@ impl Runner {
         let result = match FlightController::new(link_config(request)) {
             Ok(fc) => {
                 self.fc = fc;
+                // A new test starts at tick 0: so do its log lines.
+                log::set_tick(self.fc.tick());
                 let neutral =
                     sweephold_firmware::mix(&self.fc.config().mixer, &Controls::default());
                 servo::set_failsafe(neutral);
@@ -283,7 +295,11 @@ impl Runner {
             }
         };
         self.mode = Mode::InTheLoop { silent_ticks: 0 };
-        link::send_waiting(&mut self.tx, &Frame::ConfigureResult(result));
+        link::send_waiting(
+            &mut self.tx,
+            &mut self.scratch,
+            &Frame::ConfigureResult(result),
+        );
     }
 
     /// A frame (or a decoding error) from the host.
@@ -352,6 +368,7 @@ pub fn run() -> ! {
     if clocks.source == ClockSource::NoRcc && semihosting::requested() {
         run_semihosting(runner);
     }
+    log::to_rtt_only();
 
     let mut inbound = Inbound::new(rx);
     loop {
@@ -376,6 +393,9 @@ pub fn run() -> ! {
 /// steps: the read blocks); when it goes away (end of file) QEMU is asked to exit.
 fn run_semihosting(mut runner: Runner) -> ! {
     usart::capture();
+    // The host is the clock: the loop timer's interrupt would only land in the middle of
+    // ticks (and, in QEMU, at host-speed-dependent places).
+    nvic::disable(Irq::Tim2);
     let (Some(input), Some(output)) = (
         semihosting::open(b"sweephold-in\0", false),
         semihosting::open(b"sweephold-out\0", true),
@@ -383,6 +403,9 @@ fn run_semihosting(mut runner: Runner) -> ! {
         defmt::error!("semihosting FIFOs missing");
         semihosting::exit()
     };
+    if !log::to_semihosting() {
+        defmt::warn!("no sweephold-log file on the host: defmt stays on RTT");
+    }
     defmt::info!("frame link over semihosting");
     // The boot Header went to the USART before the switch: this one tells the host the
     // link is up.

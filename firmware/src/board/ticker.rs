@@ -15,8 +15,6 @@ use super::regs::TIM2;
 
 /// Ticks signalled by the timer and not yet taken by the loop.
 static DUE: AtomicU32 = AtomicU32::new(0);
-/// Ticks signalled since the timer started (defmt timestamps).
-static ELAPSED: AtomicU32 = AtomicU32::new(0);
 
 const CR1_CEN: u32 = 1 << 0;
 const CR1_URS: u32 = 1 << 2;
@@ -63,17 +61,11 @@ impl Ticker {
     }
 }
 
-/// Ticks since the timer started; the defmt timestamp.
-pub fn elapsed() -> u32 {
-    ELAPSED.load(Ordering::Relaxed)
-}
-
 /// TIM2 interrupt: acknowledge the update and count it.
 pub fn on_interrupt() {
     if TIM2.sr.read() & SR_UIF != 0 {
         // rc_w0: writing 0 clears UIF, writing 1 elsewhere leaves the other flags alone.
         TIM2.sr.write(!SR_UIF);
         DUE.fetch_add(1, Ordering::AcqRel);
-        ELAPSED.fetch_add(1, Ordering::Relaxed);
     }
 }

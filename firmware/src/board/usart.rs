@@ -15,8 +15,10 @@ use core::cell::RefCell;
 use core::convert::Infallible;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
+use sweephold_protocol::{encode, Frame, MAX_FRAME_LEN};
+
+use super::ring::ByteRing;
 use cortex_m::interrupt::{self, CriticalSection, Mutex};
-use heapless::Deque;
 
 use super::clocks::{ClockGate, Clocks};
 use super::dividers::{self, DividerError};
@@ -48,8 +50,8 @@ const CR1_RXNEIE: u32 = 1 << 5;
 const CR1_TXEIE: u32 = 1 << 7;
 const CR1_UE: u32 = 1 << 13;
 
-static TX: Mutex<RefCell<Deque<u8, TX_CAPACITY>>> = Mutex::new(RefCell::new(Deque::new()));
-static RX: Mutex<RefCell<Deque<u8, RX_CAPACITY>>> = Mutex::new(RefCell::new(Deque::new()));
+static TX: Mutex<RefCell<ByteRing<TX_CAPACITY>>> = Mutex::new(RefCell::new(ByteRing::new()));
+static RX: Mutex<RefCell<ByteRing<RX_CAPACITY>>> = Mutex::new(RefCell::new(ByteRing::new()));
 /// Received bytes lost: hardware overruns plus bytes that found the ring full.
 static RX_LOST: AtomicU32 = AtomicU32::new(0);
 
@@ -83,7 +85,7 @@ fn pump(cs: &CriticalSection) {
     }
     let mut ring = TX.borrow(cs).borrow_mut();
     while usart1::SR.read() & SR_TXE != 0 {
-        match ring.pop_front() {
+        match ring.pop() {
             Some(byte) => usart1::DR.write(u32::from(byte)),
             None => break,
         }
@@ -107,18 +109,7 @@ pub fn capture() {
 
 /// Move queued bytes (at most `buf.len()`) into `buf`; returns how many.
 pub fn take_captured(buf: &mut [u8]) -> usize {
-    interrupt::free(|cs| {
-        let mut ring = TX.borrow(cs).borrow_mut();
-        let mut count = 0;
-        for slot in buf.iter_mut() {
-            match ring.pop_front() {
-                Some(byte) => *slot = byte,
-                None => break,
-            }
-            count += 1;
-        }
-        count
-    })
+    interrupt::free(|cs| TX.borrow(cs).borrow_mut().pop_slice(buf))
 }
 
 /// USART1 interrupt: move a received byte into the ring, feed the transmitter.
@@ -130,7 +121,7 @@ pub fn on_interrupt() {
         if status & SR_ORE != 0 {
             RX_LOST.fetch_add(1, Ordering::Relaxed);
         }
-        let pushed = interrupt::free(|cs| RX.borrow(cs).borrow_mut().push_back(byte).is_ok());
+        let pushed = interrupt::free(|cs| RX.borrow(cs).borrow_mut().push(byte));
         if !pushed {
             RX_LOST.fetch_add(1, Ordering::Relaxed);
         }
@@ -156,18 +147,57 @@ impl UsartTx {
         let queued = interrupt::free(|cs| {
             let fits = {
                 let mut ring = TX.borrow(cs).borrow_mut();
-                let fits = TX_CAPACITY - ring.len() >= frame.len();
+                let fits = ring.room() >= frame.len();
                 if fits {
-                    for &byte in frame {
-                        // Cannot fail: the room was checked above.
-                        let _ = ring.push_back(byte);
-                    }
+                    ring.push_slice(frame);
                 }
                 fits
             };
             pump(cs);
             fits
         });
+        if !queued {
+            self.dropped_frames = self.dropped_frames.wrapping_add(1);
+        }
+        queued
+    }
+
+    /// Encode `frame` straight into the ring when a frame's worth of room is free there
+    /// in one piece (no copy; the usual case: the ring starts over at its beginning
+    /// whenever it drains). `None` when that room is not there (nothing done), else
+    /// whether the frame was encoded (it always is, for the protocol's types).
+    pub fn encode_in_place(&mut self, frame: &Frame) -> Option<bool> {
+        let mut encoded = false;
+        let in_place = interrupt::free(|cs| {
+            let in_place = TX
+                .borrow(cs)
+                .borrow_mut()
+                .fill_contiguous(MAX_FRAME_LEN, |space| {
+                    let written = encode(frame, space).ok();
+                    encoded = written.is_some();
+                    written
+                });
+            if in_place {
+                pump(cs);
+            }
+            in_place
+        });
+        in_place.then_some(encoded)
+    }
+
+    /// Queue `frame` without waiting: encoded in place ([`encode_in_place`]) or, when
+    /// the room for that is missing, in `scratch` and queued whole if it fits
+    /// ([`queue_frame`](Self::queue_frame)). `false` when dropped (counted).
+    ///
+    /// [`encode_in_place`]: Self::encode_in_place
+    pub fn queue_encoded(&mut self, frame: &Frame, scratch: &mut [u8; MAX_FRAME_LEN]) -> bool {
+        let queued = match self.encode_in_place(frame) {
+            Some(encoded) => encoded,
+            None => match encode(frame, scratch) {
+                Ok(len) => return self.queue_frame(scratch.get(..len).unwrap_or(&[])),
+                Err(_) => false,
+            },
+        };
         if !queued {
             self.dropped_frames = self.dropped_frames.wrapping_add(1);
         }
@@ -197,15 +227,7 @@ impl embedded_io::Write for UsartTx {
         }
         loop {
             let written = interrupt::free(|cs| {
-                let written = {
-                    let mut ring = TX.borrow(cs).borrow_mut();
-                    let room = TX_CAPACITY - ring.len();
-                    let count = room.min(buf.len());
-                    for &byte in buf.iter().take(count) {
-                        let _ = ring.push_back(byte);
-                    }
-                    count
-                };
+                let written = { TX.borrow(cs).borrow_mut().push_slice(buf) };
                 pump(cs);
                 written
             });
@@ -237,20 +259,7 @@ pub struct UsartRx {
 impl UsartRx {
     /// Move the bytes received so far into `buf`; returns how many.
     pub fn read_available(&mut self, buf: &mut [u8]) -> usize {
-        interrupt::free(|cs| {
-            let mut ring = RX.borrow(cs).borrow_mut();
-            let mut count = 0;
-            for slot in buf.iter_mut() {
-                match ring.pop_front() {
-                    Some(byte) => {
-                        *slot = byte;
-                        count += 1;
-                    }
-                    None => break,
-                }
-            }
-            count
-        })
+        interrupt::free(|cs| RX.borrow(cs).borrow_mut().pop_slice(buf))
     }
 
     /// Bytes are waiting.

@@ -25,6 +25,14 @@ pub trait FlightControllerLink {
         input: &SensorIn,
         telemetry: &mut Vec<u8>,
     ) -> anyhow::Result<ActuatorOut>;
+
+    /// The record begun last is over (flown, aborted or failed); its dump is
+    /// `dump_name` (e.g. `lat-1.bin`). A link that captures the flight controller's log
+    /// writes it beside the dump here. Default: nothing.
+    fn end_record(&mut self, dump_name: &str) -> anyhow::Result<()> {
+        let _ = dump_name;
+        Ok(())
+    }
 }
 
 /// The firmware's flight logic called in-process.

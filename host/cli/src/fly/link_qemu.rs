@@ -15,6 +15,13 @@
 //! host is the server: it listens on an ephemeral port of 127.0.0.1 first and QEMU
 //! connects as a client, so no other program can take the port in between.
 //!
+//! **Logs**: over semihosting the image's defmt log comes through a third FIFO,
+//! `sweephold-log` (firmware `board/log.rs`); the link collects it while the record
+//! flies and, at the end of each record, decodes it against the ELF
+//! ([`super::defmt_log`]) into `DIR/<record>.log` (`lat-1.log` beside `lat-1.bin`), one
+//! line per message with the loop tick and the level. Over the USART transport the
+//! image logs to RTT only (no log file).
+//!
 //! QEMU is killed when the link is dropped — at the end of the run, on an error, and when
 //! the thread unwinds — and a failed record boots a fresh one for the next. On Ctrl-C the
 //! terminal's SIGINT reaches QEMU too (same foreground process group), which terminates
@@ -33,6 +40,7 @@ use anyhow::{anyhow, bail, Context};
 use sweephold_firmware::Config;
 use sweephold_protocol::{ActuatorOut, SensorIn};
 
+use super::defmt_log::{write_log, DefmtTable};
 use super::frame_channel::{check_configure_answer, link_config, ByteWire, FrameChannel};
 use super::link::FlightControllerLink;
 
@@ -142,6 +150,12 @@ pub struct QemuLink {
     session: Option<Session>,
     /// ActuatorOut frames that answered no outstanding SensorIn (dropped), all sessions.
     stray_answers: u64,
+    /// Where the decoded defmt log of each record goes (`None`: not kept).
+    log_folder: Option<PathBuf>,
+    /// The image's defmt table, read at the first record that needs it.
+    defmt_table: Option<DefmtTable>,
+    /// Raw defmt bytes of the record being flown.
+    log_bytes: Vec<u8>,
 }
 
 impl QemuLink {
@@ -154,6 +168,23 @@ impl QemuLink {
             extra_args: extra_args.to_vec(),
             session: None,
             stray_answers: 0,
+            log_folder: None,
+            defmt_table: None,
+            log_bytes: Vec::new(),
+        }
+    }
+
+    /// Also write each record's decoded defmt log to `folder/<record>.log` (semihosting
+    /// transport only).
+    pub fn with_log_folder(mut self, folder: &Path) -> Self {
+        self.log_folder = Some(folder.to_path_buf());
+        self
+    }
+
+    /// Move what the image has logged so far into `log_bytes`.
+    fn drain_log(&mut self) {
+        if let Some(session) = self.session.as_mut() {
+            session.wire_mut().wire.read_log(&mut self.log_bytes);
         }
     }
 
@@ -184,6 +215,8 @@ impl QemuLink {
     /// Keep the session after `result` only if it is `Ok`: a failed exchange leaves the
     /// stream at an unknown point, and the next record starts from a fresh boot.
     fn keep_if_ok<T>(&mut self, result: anyhow::Result<T>) -> anyhow::Result<T> {
+        // Whatever the image logged up to here belongs to this record, failed or not.
+        self.drain_log();
         if result.is_err() {
             self.session = None;
         }
@@ -200,6 +233,8 @@ enum Wire {
     Fifo {
         to_image: std::fs::File,
         from_image: std::fs::File,
+        /// The image's defmt frames (`sweephold-log`), read without blocking.
+        log: std::fs::File,
         folder: PathBuf,
     },
 }
@@ -238,6 +273,17 @@ impl Wire {
         }
     }
 
+    /// Append the defmt bytes waiting in the log FIFO to `bytes` (nothing for TCP).
+    fn read_log(&mut self, bytes: &mut Vec<u8>) {
+        if let Wire::Fifo { log, .. } = self {
+            let mut chunk = [0u8; 4096];
+            // Non-blocking: stops at WouldBlock (empty) or an error.
+            while let Ok(n @ 1..) = log.read(&mut chunk) {
+                bytes.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
+            }
+        }
+    }
+
     fn shutdown(&mut self) {
         match self {
             Wire::Tcp(stream) => {
@@ -250,8 +296,8 @@ impl Wire {
     }
 }
 
-/// A fresh scratch folder with the two FIFOs the image opens (`sweephold-in`,
-/// `sweephold-out`), both opened read-write.
+/// A fresh scratch folder with the three FIFOs the image opens (`sweephold-in`,
+/// `sweephold-out`, `sweephold-log`), all opened read-write, the log one non-blocking.
 fn make_fifos() -> anyhow::Result<Wire> {
     use std::sync::atomic::{AtomicU32, Ordering};
     static COUNT: AtomicU32 = AtomicU32::new(0);
@@ -264,7 +310,7 @@ fn make_fifos() -> anyhow::Result<Wire> {
     std::fs::create_dir_all(&folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
     let mut files = Vec::new();
-    for name in ["sweephold-in", "sweephold-out"] {
+    for name in ["sweephold-in", "sweephold-out", "sweephold-log"] {
         let path = folder.join(name);
         let c_path = std::ffi::CString::new(path.as_os_str().as_encoded_bytes())
             .map_err(|_| anyhow!("NUL in {}", path.display()))?;
@@ -274,19 +320,29 @@ fn make_fifos() -> anyhow::Result<Wire> {
             let _ = std::fs::remove_dir_all(&folder);
             return Err(error).with_context(|| format!("mkfifo {}", path.display()));
         }
-        // Read-write: Linux opens a FIFO so without waiting for the other end.
+        // Read-write: Linux opens a FIFO so without waiting for the other end. The log is
+        // drained between ticks, so its reads must not wait.
+        use std::os::unix::fs::OpenOptionsExt;
+        let flags = if name == "sweephold-log" {
+            libc::O_NONBLOCK
+        } else {
+            0
+        };
         let file = std::fs::OpenOptions::new()
             .read(true)
             .write(true)
+            .custom_flags(flags)
             .open(&path)
             .with_context(|| format!("cannot open {}", path.display()))?;
         files.push(file);
     }
+    let log = files.pop().ok_or_else(|| anyhow!("FIFO missing"))?;
     let from_image = files.pop().ok_or_else(|| anyhow!("FIFO missing"))?;
     let to_image = files.pop().ok_or_else(|| anyhow!("FIFO missing"))?;
     Ok(Wire::Fifo {
         to_image,
         from_image,
+        log,
         folder,
     })
 }
@@ -452,6 +508,32 @@ impl FlightControllerLink for QemuLink {
         self.stray_answers += stray;
         self.keep_if_ok(result)
     }
+
+    fn end_record(&mut self, dump_name: &str) -> anyhow::Result<()> {
+        self.drain_log();
+        let bytes = std::mem::take(&mut self.log_bytes);
+        let Some(folder) = &self.log_folder else {
+            return Ok(());
+        };
+        if self.transport != QemuTransport::Semihosting {
+            return Ok(());
+        }
+        let path = folder.join(Path::new(dump_name).with_extension("log"));
+        if self.defmt_table.is_none() {
+            match DefmtTable::from_elf(&self.image) {
+                Ok(table) => self.defmt_table = Some(table),
+                // The record itself is fine: say in its log why there is no text.
+                Err(error) => {
+                    return std::fs::write(&path, format!("(no defmt log: {error:#})\n"))
+                        .with_context(|| format!("cannot write {}", path.display()));
+                }
+            }
+        }
+        let Some(table) = &self.defmt_table else {
+            return Ok(());
+        };
+        write_log(&path, &table.decode(&bytes))
+    }
 }
 
 impl Drop for QemuProcess {
@@ -505,6 +587,31 @@ fn accept(
 mod tests {
     use super::*;
     use sweephold_protocol::Axis;
+
+    /// A record's log is written even when the image's defmt table cannot be read: it
+    /// says why instead of failing the record.
+    #[test]
+    fn an_unreadable_defmt_table_is_explained_in_the_log() {
+        let dir = std::env::temp_dir().join(format!("sweephold-qemu-log-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut link = QemuLink::new(
+            Path::new("/nonexistent/sweephold-fc"),
+            QemuTransport::Semihosting,
+            &[],
+        )
+        .with_log_folder(&dir);
+        link.end_record("lat-1.bin").expect("the log is written");
+        let text = std::fs::read_to_string(dir.join("lat-1.log")).unwrap();
+        assert!(
+            text.starts_with("(no defmt log: cannot read /nonexistent/sweephold-fc"),
+            "{text}"
+        );
+        // Without a log folder nothing is written and nothing fails.
+        let mut quiet = QemuLink::new(Path::new("/nonexistent"), QemuTransport::Semihosting, &[]);
+        quiet.end_record("lat-2.bin").expect("no folder, no log");
+        assert!(!dir.join("lat-2.log").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn a_missing_image_is_named_with_the_command_that_builds_it() {

@@ -1,6 +1,7 @@
 //! `sweephold fly`: the paper's test campaign, flown on the host with the flight
 //! controller in the loop and the nonlinear simulator as the aircraft.
 
+pub mod defmt_log;
 pub mod frame_channel;
 pub mod link;
 pub mod link_qemu;
@@ -117,7 +118,9 @@ impl VehicleArg {
 #[command(
     after_help = "Each record is written as DIR/<axis>-<n>.bin (the telemetry exactly as the \
 flight controller streamed it: read it with `sweephold decode` or `sweephold frf`), plus \
-DIR/summary.json (layout in the README). The same seed gives byte-identical dumps."
+DIR/summary.json (layout in the README). The same seed gives byte-identical dumps. With \
+`--fc qemu` each record also gets DIR/<axis>-<n>.log: the image's defmt log decoded against \
+its ELF, one line per message (loop tick, level, text)."
 )]
 pub struct FlyArgs {
     /// Aircraft simulated.
@@ -166,9 +169,10 @@ pub struct FlyArgs {
     #[arg(short, long)]
     pub quiet: bool,
     /// Flight controller in the loop: `in-process` (the firmware library called
-    /// directly), `qemu` (the board image in qemu-system-arm, one per worker),
-    /// `qemu-usart` (the same over its emulated USART: slow) or `serial:PATH[@BAUD]`
-    /// (a real board on a serial port, default 460800 Bd; records flown one at a time).
+    /// directly), `qemu` (the board image in qemu-system-arm, one per worker; its defmt
+    /// log is decoded into OUT/<record>.log), `qemu-usart` (the same over its emulated
+    /// USART: slow, no log) or `serial:PATH[@BAUD]` (a real board on a serial port,
+    /// default 460800 Bd; records flown one at a time).
     #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_fc)]
     pub fc: FcArg,
     /// Board image for `--fc qemu` [default: target/thumbv7em-none-eabihf/firmware/sweephold-fc].
@@ -282,7 +286,9 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 link_qemu::QemuTransport::Usart
             };
             fly(args, &|| {
-                Box::new(link_qemu::QemuLink::new(&image, transport, &extra))
+                Box::new(
+                    link_qemu::QemuLink::new(&image, transport, &extra).with_log_folder(&args.out),
+                )
             })?
         }
         // One port, one board: the records are flown one after the other.
@@ -420,8 +426,12 @@ pub fn fly_with_workers(
                         &disturbances,
                         max_s,
                         |t| bar.set_position(t as u64),
-                    )
-                    .and_then(|flown| finish_record(args, plan, &config, flown));
+                    );
+                    // The link's own record of it (the image's log), even for a failed one.
+                    let logged = link.end_record(&plan.file_name());
+                    let result = result
+                        .and_then(|flown| logged.map(|()| flown))
+                        .and_then(|flown| finish_record(args, plan, &config, flown));
                     bar.finish_and_clear();
                     results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(result);
                 }

@@ -1,0 +1,205 @@
+//! A fixed-size byte ring that moves slices, not bytes.
+//!
+//! The USART's transmit ring takes a whole frame (~130 bytes) per call and the semihosting
+//! link drains it in blocks: copying with at most two `copy_from_slice` per call (the
+//! part before the wrap and the part after) costs a memcpy instead of a bounds-checked
+//! push per byte (heapless `Deque::push_back` in a loop: ~16 instructions a byte).
+//! Indices stay in [0, N) and the stored length in [0, N]; every access goes through
+//! `get`/`get_mut`, so nothing can panic.
+
+/// Ring of `N` bytes (`N` > 0).
+pub struct ByteRing<const N: usize> {
+    bytes: [u8; N],
+    /// Index of the oldest byte.
+    head: usize,
+    /// Bytes stored.
+    len: usize,
+}
+
+impl<const N: usize> ByteRing<N> {
+    /// An empty ring.
+    pub const fn new() -> Self {
+        ByteRing {
+            bytes: [0; N],
+            head: 0,
+            len: 0,
+        }
+    }
+
+    /// Nothing stored.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Room left.
+    pub fn room(&self) -> usize {
+        N - self.len
+    }
+
+    /// Append as much of `data` as fits; returns how many bytes were taken.
+    pub fn push_slice(&mut self, data: &[u8]) -> usize {
+        let count = data.len().min(self.room());
+        let tail = (self.head + self.len) % N;
+        // [tail, N) first, then [0, …) after the wrap.
+        let first = count.min(N - tail);
+        let (before_wrap, after_wrap) = data.split_at(first.min(data.len()));
+        let after_wrap = after_wrap.get(..count - first).unwrap_or(&[]);
+        if let Some(slot) = self.bytes.get_mut(tail..tail + first) {
+            slot.copy_from_slice(before_wrap);
+        }
+        if let Some(slot) = self.bytes.get_mut(..after_wrap.len()) {
+            slot.copy_from_slice(after_wrap);
+        }
+        self.len += count;
+        count
+    }
+
+    /// Move the oldest bytes into `out` (at most `out.len()`); returns how many.
+    pub fn pop_slice(&mut self, out: &mut [u8]) -> usize {
+        let count = out.len().min(self.len);
+        let first = count.min(N - self.head);
+        let (before_wrap, after_wrap) = out.split_at_mut(first.min(out.len()));
+        if let Some(stored) = self.bytes.get(self.head..self.head + first) {
+            before_wrap.copy_from_slice(stored);
+        }
+        let rest = count - first;
+        if let (Some(slot), Some(stored)) = (after_wrap.get_mut(..rest), self.bytes.get(..rest)) {
+            slot.copy_from_slice(stored);
+        }
+        self.len -= count;
+        // An empty ring starts over at 0: the next frame then finds the whole array free
+        // in one piece (see `fill_contiguous`).
+        self.head = if self.len == 0 {
+            0
+        } else {
+            (self.head + count) % N
+        };
+        count
+    }
+
+    /// Let `fill` write up to `at_least` bytes straight into the ring, when that much
+    /// room is free in one piece after the newest byte; it returns how many it wrote
+    /// (kept) or `None` (nothing kept). `false` when the room was not there (`fill` not
+    /// called): the caller copies instead. This saves the copy of a frame that is
+    /// encoded where it will be sent from.
+    pub fn fill_contiguous(
+        &mut self,
+        at_least: usize,
+        fill: impl FnOnce(&mut [u8]) -> Option<usize>,
+    ) -> bool {
+        let tail = (self.head + self.len) % N;
+        // Free bytes in one piece: up to the end of the array, or up to the head once
+        // the stored bytes wrap.
+        let end = if tail >= self.head && self.len < N {
+            N
+        } else {
+            self.head
+        };
+        let Some(space) = self
+            .bytes
+            .get_mut(tail..end)
+            .filter(|s| s.len() >= at_least)
+        else {
+            return false;
+        };
+        let room = space.len();
+        if let Some(written) = fill(space) {
+            self.len += written.min(room);
+        }
+        true
+    }
+
+    /// Take the oldest byte.
+    pub fn pop(&mut self) -> Option<u8> {
+        let mut byte = [0u8];
+        (self.pop_slice(&mut byte) == 1).then_some(byte[0])
+    }
+
+    /// Append one byte; `false` when full.
+    pub fn push(&mut self, byte: u8) -> bool {
+        self.push_slice(&[byte]) == 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ByteRing;
+    use std::collections::VecDeque;
+
+    /// Against `VecDeque` through many wraps with pushes and pops of every size.
+    #[test]
+    fn behaves_like_a_queue_across_wraps() {
+        let mut ring: ByteRing<16> = ByteRing::new();
+        let mut model: VecDeque<u8> = VecDeque::new();
+        let mut next = 0u8;
+        let mut x = 0x9E37_79B9u32;
+        for _ in 0..5000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let size = (x % 20) as usize;
+            if x & 0x100 != 0 {
+                let data: Vec<u8> = (0..size).map(|i| next.wrapping_add(i as u8)).collect();
+                let taken = ring.push_slice(&data);
+                assert_eq!(taken, size.min(16 - model.len()));
+                model.extend(&data[..taken]);
+                next = next.wrapping_add(taken as u8);
+            } else {
+                let mut out = vec![0u8; size];
+                let count = ring.pop_slice(&mut out);
+                let expected: Vec<u8> = model.drain(..size.min(model.len())).collect();
+                assert_eq!(&out[..count], &expected[..]);
+            }
+            assert_eq!(16 - ring.room(), model.len());
+            assert_eq!(ring.is_empty(), model.is_empty());
+        }
+    }
+
+    #[test]
+    fn fills_in_place_only_where_there_is_room_in_one_piece() {
+        let mut ring: ByteRing<8> = ByteRing::new();
+        assert!(ring.fill_contiguous(8, |space| {
+            assert_eq!(space.len(), 8);
+            space[..3].copy_from_slice(&[1, 2, 3]);
+            Some(3)
+        }));
+        // 5 free in one piece after the three.
+        assert!(!ring.fill_contiguous(6, |_| unreachable!()));
+        assert!(ring.fill_contiguous(5, |space| {
+            space[0] = 4;
+            Some(1)
+        }));
+        let mut out = [0u8; 2];
+        assert_eq!(ring.pop_slice(&mut out), 2);
+        // Stored 3, 4 at 2..4; free in one piece: 4..8.
+        assert!(ring.fill_contiguous(4, |space| {
+            assert_eq!(space.len(), 4);
+            space.copy_from_slice(&[5, 6, 7, 8]);
+            Some(4)
+        }));
+        // Now wrapped free space is 0..2 only.
+        assert!(ring.fill_contiguous(2, |space| {
+            assert_eq!(space.len(), 2);
+            None
+        }));
+        let mut all = [0u8; 8];
+        assert_eq!(ring.pop_slice(&mut all), 6);
+        assert_eq!(&all[..6], &[3, 4, 5, 6, 7, 8]);
+        // Emptied: starts over with the whole array.
+        assert!(ring.fill_contiguous(8, |_| None));
+    }
+
+    #[test]
+    fn single_bytes_and_full_ring() {
+        let mut ring: ByteRing<3> = ByteRing::new();
+        assert!(ring.push(1) && ring.push(2) && ring.push(3));
+        assert!(!ring.push(4));
+        assert_eq!(ring.room(), 0);
+        assert_eq!(ring.pop(), Some(1));
+        assert!(ring.push(4));
+        assert_eq!(
+            [ring.pop(), ring.pop(), ring.pop(), ring.pop()],
+            [Some(2), Some(3), Some(4), None]
+        );
+    }
+}
