@@ -3,10 +3,12 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod campaign;
 pub mod decode;
 pub mod fit;
 pub mod fly;
 pub mod frf;
+pub mod report;
 pub mod sim;
 pub mod table;
 pub mod truth;
@@ -15,7 +17,14 @@ pub mod verify;
 /// Identify helicopter dynamics from automated frequency sweeps flown under conditional
 /// attitude hold (Jung, Shim & Kim).
 #[derive(Parser, Debug)]
-#[command(name = "sweephold", version, about, long_about = None)]
+#[command(
+    name = "sweephold",
+    version,
+    about,
+    long_about = None,
+    after_help = "Without arguments, `sweephold` runs `sweephold campaign` on the defaults \
+(Bo-105, out/campaign) and prints where the report is."
+)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -25,6 +34,9 @@ pub struct Cli {
 /// The verbs of `sweephold`.
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// The whole job: fly the three modes, identify, verify, score against the truth,
+    /// and write summary.json and report.html.
+    Campaign(campaign::CampaignArgs),
     /// Decode telemetry dumps into CSV or JSON lines (one row per Sample).
     Decode(decode::DecodeArgs),
     /// Fit a state-space model structure to frequency responses (CIFER DERIVID-like).
@@ -33,6 +45,8 @@ pub enum Command {
     Fly(fly::FlyArgs),
     /// Frequency responses (Chirp-Z, multi-window, MISO, composite) from dumps or CSV.
     Frf(frf::FrfArgs),
+    /// Regenerate report.html of a campaign folder from its files.
+    Report(report::ReportArgs),
     /// Trim and linearize the simulated helicopters (bo105, trex700l).
     Sim(sim::SimArgs),
     /// Simulate an identified model on recorded inputs and score it (Theil's inequality coefficient).
@@ -42,10 +56,12 @@ pub enum Command {
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Campaign(args) => campaign::run(&args),
         Command::Decode(args) => decode::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Fly(args) => fly::run(&args),
         Command::Frf(args) => frf::run(&args),
+        Command::Report(args) => report::run(&args),
         Command::Sim(args) => sim::run(&args),
         Command::Verify(args) => verify::run(&args),
     }

@@ -1,10 +1,15 @@
-//! `sweephold`: see `sweephold --help`.
+//! `sweephold`: see `sweephold --help`. Without arguments: `sweephold campaign`.
 use std::process::ExitCode;
 
 use clap::Parser;
 
 fn main() -> ExitCode {
-    let cli = sweephold::Cli::parse();
+    // No arguments: the main job on its defaults.
+    let cli = if std::env::args_os().len() <= 1 {
+        sweephold::Cli::parse_from(["sweephold", "campaign"])
+    } else {
+        sweephold::Cli::parse()
+    };
     match sweephold::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {

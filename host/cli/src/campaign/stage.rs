@@ -1,0 +1,149 @@
+//! The stages of a campaign, their names (the keys of `timings_s` and of errors) and the
+//! per-stage progress line on stderr.
+
+use std::fmt;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// One step of `sweephold campaign`, in the order they run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Stage {
+    /// Create the output folder.
+    Setup,
+    /// Fly the default sweep records in conditional-attitude-hold mode (the fit data).
+    FlyCah,
+    /// Fly the same records with the hold always on (the paper's correlated case).
+    FlyStandard,
+    /// Fly the same records with the hold always on plus off-axis noise.
+    FlyNoise,
+    /// Fly the held-out doublets (another seed) for the verification.
+    FlyVerification,
+    /// Frequency responses of the `cah` records.
+    Frf,
+    /// Quasi-steady 6-DOF fit (start values of the hybrid).
+    Fit6Dof,
+    /// 9-DOF hybrid fit with reduction.
+    Fit9Dof,
+    /// Scoring against the simulator's linearization.
+    Truth,
+    /// Time-domain verification on the held-out doublets.
+    Verify,
+    /// `report.html`.
+    Report,
+}
+
+impl Stage {
+    /// The stage's name in `summary.json` (`timings_s` keys, `error.stage`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Setup => "setup",
+            Stage::FlyCah => "fly_cah",
+            Stage::FlyStandard => "fly_standard",
+            Stage::FlyNoise => "fly_noise",
+            Stage::FlyVerification => "fly_verification",
+            Stage::Frf => "frf",
+            Stage::Fit6Dof => "fit_6dof",
+            Stage::Fit9Dof => "fit_9dof",
+            Stage::Truth => "truth",
+            Stage::Verify => "verify",
+            Stage::Report => "report",
+        }
+    }
+
+    /// What the stage does, for the progress line.
+    pub fn description(self) -> &'static str {
+        match self {
+            Stage::Setup => "output folder",
+            Stage::FlyCah => "flying the sweeps, conditional attitude hold",
+            Stage::FlyStandard => "flying the sweeps, standard attitude hold",
+            Stage::FlyNoise => "flying the sweeps, hold plus off-axis noise",
+            Stage::FlyVerification => "flying the held-out doublets",
+            Stage::Frf => "frequency responses of the cah records",
+            Stage::Fit6Dof => "6-DOF quasi-steady fit (start values)",
+            Stage::Fit9Dof => "9-DOF hybrid fit with reduction",
+            Stage::Truth => "scoring against the simulator's truth",
+            Stage::Verify => "verification on the doublets",
+            Stage::Report => "report.html",
+        }
+    }
+}
+
+impl fmt::Display for Stage {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The progress display of one stage: a spinner while it runs when stderr is a terminal
+/// (indicatif hides itself otherwise), then one line with its wall time unless quiet.
+pub struct StageProgress {
+    stage: Stage,
+    spinner: ProgressBar,
+    started: Instant,
+    quiet: bool,
+}
+
+impl StageProgress {
+    /// Start showing `stage`.
+    pub fn start(stage: Stage, quiet: bool) -> Self {
+        let target = if quiet {
+            ProgressDrawTarget::hidden()
+        } else {
+            ProgressDrawTarget::stderr()
+        };
+        let spinner = ProgressBar::with_draw_target(None, target);
+        spinner.set_style(
+            ProgressStyle::with_template("{spinner} {prefix:<16} {msg} {elapsed}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        spinner.set_prefix(stage.name());
+        spinner.set_message(stage.description());
+        spinner.enable_steady_tick(Duration::from_millis(120));
+        StageProgress {
+            stage,
+            spinner,
+            started: Instant::now(),
+            quiet,
+        }
+    }
+
+    /// Stop the spinner and print the stage's outcome; returns its wall time [s].
+    pub fn finish(self, outcome: &str) -> f64 {
+        let seconds = self.started.elapsed().as_secs_f64();
+        self.spinner.finish_and_clear();
+        if !self.quiet {
+            eprintln!("{:<16} {:>6.2} s  {}", self.stage.name(), seconds, outcome);
+        }
+        seconds
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_names_are_unique_snake_case() {
+        let stages = [
+            Stage::Setup,
+            Stage::FlyCah,
+            Stage::FlyStandard,
+            Stage::FlyNoise,
+            Stage::FlyVerification,
+            Stage::Frf,
+            Stage::Fit6Dof,
+            Stage::Fit9Dof,
+            Stage::Truth,
+            Stage::Verify,
+            Stage::Report,
+        ];
+        let mut names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
+        assert!(names.iter().all(|n| n
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')));
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), stages.len());
+    }
+}

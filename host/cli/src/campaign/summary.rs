@@ -1,0 +1,231 @@
+//! `summary.json` of `sweephold campaign` (layout documented in the README's campaign
+//! section; later checks read these names). Every section is null until its stage has
+//! completed, so a campaign stopped by an error still writes what it has.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::fly::summary::FlySummary;
+
+/// Peak |φ| and |θ| over all the records of one mode [deg].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PeakAttitudeDeg {
+    /// Peak |φ| [deg] (absolute attitude, trim included).
+    pub phi: f64,
+    /// Peak |θ| [deg] (absolute attitude, trim included).
+    pub theta: f64,
+}
+
+/// The flights of one excitation mode.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModeSummary {
+    /// Average lat–lon cross-control coherence of the lateral sweep records; null when
+    /// no lateral record completed.
+    pub cross_coherence_lat_lon: Option<f64>,
+    /// Peak attitudes over all the records of the mode.
+    pub max_abs_deg: PeakAttitudeDeg,
+    /// Number of records the firmware aborted.
+    pub aborts: usize,
+    /// Number of records flown.
+    pub records: usize,
+    /// Folder of the dumps and of `fly`'s own summary.json, relative to the campaign's.
+    pub folder: String,
+}
+
+impl ModeSummary {
+    /// The mode's figures from `fly`'s summary of its records written into `folder`.
+    pub fn from_fly(summary: &FlySummary, folder: &str) -> Self {
+        let peak = |value: fn(&crate::fly::summary::MaxAbsDeg) -> f64| {
+            summary
+                .runs
+                .iter()
+                .map(|run| value(&run.max_abs_deg))
+                .fold(0.0, f64::max)
+        };
+        ModeSummary {
+            cross_coherence_lat_lon: summary.mean_cross_coherence("lat", "lon"),
+            max_abs_deg: PeakAttitudeDeg {
+                phi: peak(|m| m.phi),
+                theta: peak(|m| m.theta),
+            },
+            aborts: summary.runs.iter().filter(|run| run.aborted).count(),
+            records: summary.runs.len(),
+            folder: folder.to_string(),
+        }
+    }
+}
+
+/// The three modes, each null until flown.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Modes {
+    /// Conditional attitude hold (the paper's method; the fit data).
+    pub cah: Option<ModeSummary>,
+    /// Hold always on (the correlated case the paper warns about).
+    pub standard: Option<ModeSummary>,
+    /// Hold always on plus off-axis noise (Tischler's method).
+    pub noise: Option<ModeSummary>,
+}
+
+/// One fitted pair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairSummary {
+    /// Output name.
+    pub output: String,
+    /// Control name.
+    pub input: String,
+    /// Cost J of the pair.
+    pub cost: f64,
+    /// Fit range [rad/s].
+    pub range: [f64; 2],
+    /// J of the identified model against the truth model over the same range (null
+    /// without a truth scoring).
+    pub truth_cost: Option<f64>,
+}
+
+/// One parameter of the final model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParameterSummary {
+    /// Name.
+    pub name: String,
+    /// Identified value.
+    pub value: f64,
+    /// `free`, `fixed` or `constrained`.
+    pub status: String,
+    /// Cramér–Rao bound in % of |value|; null when fixed or infinite.
+    pub cr_percent: Option<f64>,
+    /// Insensitivity in % of |value|; null when fixed or infinite.
+    pub insensitivity_percent: Option<f64>,
+    /// The simulator's value; null when the truth mapping does not know it.
+    pub truth: Option<f64>,
+    /// 100·(value − truth)/|truth|; null without a non-zero truth.
+    pub error_percent: Option<f64>,
+    /// Accuracy flags: `cr`, `insensitive`, `correlated:OTHER`.
+    pub flags: Vec<String>,
+}
+
+/// The final (9-DOF hybrid, reduced) fit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitSummary {
+    /// Structure name.
+    pub structure: String,
+    /// J_ave over the fitted pairs.
+    pub cost_ave: f64,
+    /// J_ave of the identified model against the truth model (null without truth).
+    pub truth_cost_ave: Option<f64>,
+    /// J_ave of the 6-DOF fit the hybrid started from.
+    pub start_cost_ave: f64,
+    /// Fitted pairs.
+    pub pairs: Vec<PairSummary>,
+    /// Every parameter (free, fixed, constrained).
+    pub params: Vec<ParameterSummary>,
+    /// Model file, relative to the campaign folder.
+    pub model_file: String,
+}
+
+/// Verification of one held-out record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifyRecordSummary {
+    /// Dump file, relative to the campaign folder.
+    pub file: String,
+    /// TIC per compared output.
+    pub tic: BTreeMap<String, f64>,
+    /// Mean TIC over the outputs.
+    pub tic_mean: f64,
+    /// When the simulated model overflowed [s]; null otherwise.
+    pub diverged_at_s: Option<f64>,
+}
+
+/// Verification of the final model on the held-out doublets.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifySummary {
+    /// Per output: the mean TIC over the held-out records.
+    pub tic: BTreeMap<String, f64>,
+    /// Mean over outputs and records.
+    pub tic_mean: f64,
+    /// Per record.
+    pub records: Vec<VerifyRecordSummary>,
+}
+
+/// Where and why a campaign stopped.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageFailure {
+    /// Stage name (a `timings_s` key).
+    pub stage: String,
+    /// The error, one line.
+    pub message: String,
+}
+
+/// The whole `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSummary {
+    /// Vehicle name (`bo105`, `trex700l`).
+    pub vehicle: String,
+    /// Campaign seed (the sweeps; the held-out doublets use `verification_seed`).
+    pub seed: u64,
+    /// Seed of the held-out doublet records.
+    pub verification_seed: u64,
+    /// Sweep record length [s] (90 by default, shorter with `--quick`).
+    pub t_rec_s: f64,
+    /// Whether `--quick` was given.
+    pub quick: bool,
+    /// Per excitation mode.
+    pub modes: Modes,
+    /// The final fit; null until fitted.
+    pub fit: Option<FitSummary>,
+    /// The verification; null until verified.
+    pub verify: Option<VerifySummary>,
+    /// Wall time per completed stage [s], plus `total`.
+    pub timings_s: BTreeMap<String, f64>,
+    /// Null when every stage completed.
+    pub error: Option<StageFailure>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fly::summary::{HoldFraction, MaxAbsDeg, RunSummary};
+
+    fn run(axis: &str, phi: f64, aborted: bool, lon: Option<f64>) -> RunSummary {
+        RunSummary {
+            axis: axis.into(),
+            index: 1,
+            file: format!("{axis}-1.bin"),
+            omega_min: 0.2,
+            omega_max: 31.4,
+            duration_s: 90.0,
+            frames: 1,
+            aborted,
+            abort_reason: aborted.then(|| "attitude_limit".into()),
+            max_abs_deg: MaxAbsDeg {
+                phi,
+                theta: phi / 2.0,
+                psi: 0.0,
+            },
+            hold_fraction: HoldFraction::default(),
+            cross_coherence: lon.map(|c| ("lon".to_string(), c)).into_iter().collect(),
+        }
+    }
+
+    #[test]
+    fn mode_summary_takes_peaks_aborts_and_lateral_coherence() {
+        let fly = FlySummary {
+            vehicle: "bo105".into(),
+            mode: "cah".into(),
+            rate_hz: 200,
+            seed: 1,
+            link: "in-process".into(),
+            runs: vec![
+                run("lat", 3.0, false, Some(0.1)),
+                run("lat", 5.0, false, Some(0.3)),
+                run("lon", 9.0, true, Some(0.9)),
+            ],
+        };
+        let mode = ModeSummary::from_fly(&fly, "fly-cah");
+        assert!((mode.cross_coherence_lat_lon.unwrap() - 0.2).abs() < 1e-12);
+        assert_eq!(mode.max_abs_deg.phi, 9.0);
+        assert_eq!(mode.max_abs_deg.theta, 4.5);
+        assert_eq!(mode.aborts, 1);
+        assert_eq!(mode.records, 3);
+    }
+}

@@ -1,0 +1,203 @@
+//! The verification stage: the identified model simulated on held-out doublet records
+//! (CIFER's VERIFID; method in `sysid::fit::verify`), and `verify.json`, which keeps the
+//! measured and predicted time histories for the report.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::anyhow;
+use serde::{Deserialize, Serialize};
+use sysid::fit::verify::{verify_record_in_segments, Verification};
+use sysid::fit::Model;
+use sysid::frf::load_test_dump;
+
+use super::summary::{VerifyRecordSummary, VerifySummary};
+
+/// Every `DECIMATION`-th sample is kept in `verify.json` (200 Hz → 50 Hz): the doublets'
+/// content is below 10 rad/s, and the file stays small.
+pub const DECIMATION: usize = 4;
+
+/// One output of one record: scores and the decimated time histories.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifiedOutput {
+    /// Output name.
+    pub name: String,
+    /// Theil's inequality coefficient.
+    pub tic: f64,
+    /// Fitted bias (trim plus sensor bias), removed from `measured`.
+    pub bias: f64,
+    /// Measured perturbation y − b, decimated.
+    pub measured: Vec<f64>,
+    /// Predicted ŷ, decimated.
+    pub predicted: Vec<f64>,
+}
+
+/// One held-out record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifiedRecord {
+    /// Dump file, relative to the campaign folder.
+    pub file: String,
+    /// Time step of the stored series [s].
+    pub step_s: f64,
+    /// Mean TIC over the outputs.
+    pub tic_mean: f64,
+    /// When the simulated model overflowed [s]; null otherwise.
+    pub diverged_at_s: Option<f64>,
+    /// The compared outputs, model order.
+    pub outputs: Vec<VerifiedOutput>,
+}
+
+/// `verify.json`: the verification of the campaign's final model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifyDocument {
+    /// Model file verified, relative to the campaign folder.
+    pub model_file: String,
+    /// Simulation restarted from the measured state every this many seconds (null: open
+    /// loop over the whole record).
+    pub segment_s: Option<f64>,
+    /// One entry per held-out record.
+    pub records: Vec<VerifiedRecord>,
+}
+
+impl VerifyDocument {
+    /// The `verify` section of `summary.json`: TIC per output averaged over the records.
+    pub fn summary(&self) -> VerifySummary {
+        let mut sums: BTreeMap<String, (f64, usize)> = BTreeMap::new();
+        for record in &self.records {
+            for output in &record.outputs {
+                let entry = sums.entry(output.name.clone()).or_insert((0.0, 0));
+                entry.0 += output.tic;
+                entry.1 += 1;
+            }
+        }
+        let tic: BTreeMap<String, f64> = sums
+            .into_iter()
+            .map(|(name, (sum, n))| (name, sum / n as f64))
+            .collect();
+        let tic_mean = if tic.is_empty() {
+            1.0
+        } else {
+            tic.values().sum::<f64>() / tic.len() as f64
+        };
+        VerifySummary {
+            tic,
+            tic_mean,
+            records: self
+                .records
+                .iter()
+                .map(|record| VerifyRecordSummary {
+                    file: record.file.clone(),
+                    tic: record
+                        .outputs
+                        .iter()
+                        .map(|o| (o.name.clone(), o.tic))
+                        .collect(),
+                    tic_mean: record.tic_mean,
+                    diverged_at_s: record.diverged_at_s,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Verify `model` on the dump `file` in `dir` (`file` relative to it).
+pub fn verify_dump(
+    model: &Model,
+    dir: &Path,
+    file: &str,
+    segment_s: Option<f64>,
+) -> anyhow::Result<VerifiedRecord> {
+    let record = load_test_dump(dir.join(file)).map_err(|e| anyhow!("{e}"))?;
+    let verification =
+        verify_record_in_segments(model, &record, segment_s).map_err(|e| anyhow!("{e}"))?;
+    Ok(verified_record(file, &verification))
+}
+
+fn verified_record(file: &str, verification: &Verification) -> VerifiedRecord {
+    let decimate = |series: &[f64]| -> Vec<f64> {
+        series
+            .iter()
+            .step_by(DECIMATION)
+            // JSON has no NaN or infinity: a runaway prediction is clipped for the plot.
+            .map(|v| {
+                if v.is_finite() {
+                    v.clamp(-1e6, 1e6)
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    };
+    VerifiedRecord {
+        file: file.to_string(),
+        step_s: DECIMATION as f64 / verification.sample_rate_hz,
+        tic_mean: verification.theil_mean,
+        diverged_at_s: verification.diverged_at_s,
+        outputs: verification
+            .outputs
+            .iter()
+            .enumerate()
+            .map(|(i, score)| VerifiedOutput {
+                name: score.output.clone(),
+                tic: score.theil,
+                bias: if score.bias.is_finite() {
+                    score.bias
+                } else {
+                    0.0
+                },
+                measured: verification
+                    .measured
+                    .get(i)
+                    .map_or_else(Vec::new, |s| decimate(s)),
+                predicted: verification
+                    .predicted
+                    .get(i)
+                    .map_or_else(Vec::new, |s| decimate(s)),
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn output(name: &str, tic: f64) -> VerifiedOutput {
+        VerifiedOutput {
+            name: name.into(),
+            tic,
+            bias: 0.0,
+            measured: vec![],
+            predicted: vec![],
+        }
+    }
+
+    #[test]
+    fn summary_averages_each_output_over_the_records() {
+        let document = VerifyDocument {
+            model_file: "model9.json".into(),
+            segment_s: None,
+            records: vec![
+                VerifiedRecord {
+                    file: "a.bin".into(),
+                    step_s: 0.02,
+                    tic_mean: 0.2,
+                    diverged_at_s: None,
+                    outputs: vec![output("p", 0.1), output("q", 0.3)],
+                },
+                VerifiedRecord {
+                    file: "b.bin".into(),
+                    step_s: 0.02,
+                    tic_mean: 0.3,
+                    diverged_at_s: None,
+                    outputs: vec![output("p", 0.3)],
+                },
+            ],
+        };
+        let summary = document.summary();
+        assert!((summary.tic["p"] - 0.2).abs() < 1e-12);
+        assert!((summary.tic["q"] - 0.3).abs() < 1e-12);
+        assert!((summary.tic_mean - 0.25).abs() < 1e-12);
+        assert_eq!(summary.records.len(), 2);
+    }
+}

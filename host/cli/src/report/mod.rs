@@ -1,0 +1,70 @@
+//! `sweephold report DIR`: `report.html` of a campaign folder — one self-contained page
+//! (inline SVG, no script, nothing fetched) drawn only from the files in the folder, so
+//! that it can be regenerated at any time.
+
+pub mod html;
+pub mod inputs;
+pub mod sections;
+pub mod svg;
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+
+use crate::campaign::files;
+pub use inputs::{ReportError, ReportInputs};
+
+/// Arguments of `sweephold report`.
+#[derive(Args, Debug, Clone)]
+#[command(
+    after_help = "DIR is a folder written by `sweephold campaign`. Sections whose \
+stage did not complete say so; a file that exists but does not parse is an error."
+)]
+pub struct ReportArgs {
+    /// The campaign folder.
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
+}
+
+/// Run `sweephold report`: write DIR/report.html and print its path.
+pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
+    let path = write_report(&args.dir)?;
+    println!("report: {}", path.display());
+    Ok(())
+}
+
+/// Read the campaign folder `dir`, write `dir/report.html`, return its path.
+pub fn write_report(dir: &Path) -> Result<PathBuf, ReportError> {
+    let inputs = ReportInputs::load(dir)?;
+    let html = render(&inputs);
+    let path = dir.join(files::REPORT);
+    std::fs::write(&path, html).map_err(|e| ReportError::Write {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    Ok(path)
+}
+
+/// The whole page.
+pub fn render(inputs: &ReportInputs) -> String {
+    let summary = &inputs.summary;
+    let title = format!(
+        "sweephold campaign: {} seed {}",
+        summary.vehicle, summary.seed
+    );
+    let mut body = format!("<h1>{}</h1>\n", svg::escape(&title));
+    body += &html::note(
+        "Frequency-sweep system identification under conditional attitude hold (Jung, Shim & \
+Kim): the firmware flown in the loop with the nonlinear simulator, frequency responses, \
+6-DOF then 9-DOF hybrid state-space fit, verification on held-out doublets, and comparison \
+with the simulator's truth.",
+    );
+    body += &sections::summary_section(inputs);
+    body += &sections::sweep_input_section(inputs);
+    body += &sections::coherence_section(inputs);
+    body += &sections::bode_section(inputs);
+    body += &sections::parameter_section(inputs);
+    body += &sections::cost_section(inputs);
+    body += &sections::verification_section(inputs);
+    html::page(&title, &body)
+}

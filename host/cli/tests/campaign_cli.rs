@@ -1,0 +1,236 @@
+//! `sweephold campaign --quick` end to end through the binary: summary.json's documented
+//! keys and types, one <svg> per plot section of report.html, `sweephold report DIR`
+//! regenerating the same structure, and one-line stage errors with a non-zero exit.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn sweephold(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sweephold"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("sweephold-campaign-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn number(value: &Value, what: &str) -> f64 {
+    value
+        .as_f64()
+        .unwrap_or_else(|| panic!("{what} is not a number: {value}"))
+}
+
+fn optional_number(value: &Value, what: &str) {
+    assert!(
+        value.is_null() || value.is_f64() || value.is_i64(),
+        "{what}: {value}"
+    );
+}
+
+fn string<'a>(value: &'a Value, what: &str) -> &'a str {
+    value
+        .as_str()
+        .unwrap_or_else(|| panic!("{what} is not a string: {value}"))
+}
+
+/// Each `<section id=…>` of the page with its number of `<svg>` elements.
+fn structure(html: &str) -> Vec<(String, usize)> {
+    html.split("<section id=\"")
+        .skip(1)
+        .map(|part| {
+            let id = part.split('"').next().unwrap_or_default().to_string();
+            let body = part.split("</section>").next().unwrap_or_default();
+            (id, body.matches("<svg").count())
+        })
+        .collect()
+}
+
+fn one_line_failure(output: &Output) -> String {
+    assert!(!output.status.success(), "expected a failure");
+    let stderr = String::from_utf8_lossy(&output.stderr).trim().to_string();
+    assert_eq!(stderr.lines().count(), 1, "not one line: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    stderr
+}
+
+fn check_summary(dir: &Path) -> Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let summary: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(string(&summary["vehicle"], "vehicle"), "bo105");
+    assert_eq!(summary["seed"].as_u64(), Some(3));
+    assert!(summary["error"].is_null(), "{}", summary["error"]);
+    for mode in ["cah", "standard", "noise"] {
+        let m = &summary["modes"][mode];
+        let coherence = number(&m["cross_coherence_lat_lon"], "cross_coherence_lat_lon");
+        assert!((0.0..=1.0).contains(&coherence), "{mode}: {coherence}");
+        for angle in ["phi", "theta"] {
+            let deg = number(&m["max_abs_deg"][angle], angle);
+            assert!(deg > 0.0 && deg < 90.0, "{mode} {angle}: {deg}");
+        }
+        assert!(m["aborts"].is_u64(), "{mode} aborts: {}", m["aborts"]);
+    }
+    // The relation the paper is about, even on short records: the standard hold
+    // correlates the controls far more than conditional hold.
+    assert!(
+        number(
+            &summary["modes"]["standard"]["cross_coherence_lat_lon"],
+            "standard"
+        ) > number(&summary["modes"]["cah"]["cross_coherence_lat_lon"], "cah") + 0.2
+    );
+
+    let fit = &summary["fit"];
+    assert!(string(&fit["structure"], "structure").contains("9dof"));
+    assert!(number(&fit["cost_ave"], "cost_ave") >= 0.0);
+    let pairs = fit["pairs"].as_array().expect("pairs");
+    assert!(!pairs.is_empty());
+    for pair in pairs {
+        string(&pair["output"], "output");
+        string(&pair["input"], "input");
+        assert!(number(&pair["cost"], "cost") >= 0.0);
+        let range = pair["range"].as_array().expect("range");
+        assert_eq!(range.len(), 2);
+        assert!(number(&range[0], "lo") < number(&range[1], "hi"));
+    }
+    let params = fit["params"].as_array().expect("params");
+    assert!(params.iter().any(|p| p["name"] == "tau_f"));
+    for param in params {
+        string(&param["name"], "name");
+        number(&param["value"], "value");
+        for key in [
+            "cr_percent",
+            "insensitivity_percent",
+            "truth",
+            "error_percent",
+        ] {
+            assert!(param.get(key).is_some(), "{key} missing");
+            optional_number(&param[key], key);
+        }
+    }
+    assert!(
+        params.iter().any(|p| p["truth"].is_f64()),
+        "no truth values"
+    );
+
+    let tic = &summary["verify"]["tic"];
+    for output in ["p", "q", "r"] {
+        let value = number(&tic[output], output);
+        assert!((0.0..=1.0).contains(&value), "TIC {output}: {value}");
+    }
+    let timings = summary["timings_s"].as_object().expect("timings_s");
+    for stage in [
+        "fly_cah",
+        "fly_standard",
+        "fly_noise",
+        "fly_verification",
+        "frf",
+        "fit_6dof",
+        "fit_9dof",
+        "truth",
+        "verify",
+        "report",
+        "total",
+    ] {
+        assert!(number(&timings[stage], stage) >= 0.0);
+    }
+    summary
+}
+
+#[test]
+fn quick_campaign_report_and_errors() {
+    let dir = scratch("quick");
+    let out = dir.join("campaign");
+    let output = sweephold(&[
+        "campaign",
+        "--quick",
+        "--quiet",
+        "--seed",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("report.html"), "{stdout}");
+    let summary = check_summary(&out);
+
+    // One <svg> at least per plot section; one Bode figure per fitted pair.
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        !html.contains("<script"),
+        "the shipped report has no script"
+    );
+    let sections = structure(&html);
+    for id in sweephold::report::sections::PLOT_SECTIONS {
+        let svgs = sections
+            .iter()
+            .find(|(s, _)| s == id)
+            .map(|(_, n)| *n)
+            .unwrap_or_else(|| panic!("no section {id}"));
+        assert!(svgs >= 1, "section {id} has no <svg>");
+    }
+    let bode = sections.iter().find(|(s, _)| s == "bode").unwrap().1;
+    assert_eq!(bode, summary["fit"]["pairs"].as_array().unwrap().len());
+
+    // `report DIR` regenerates a page of the same structure from the files alone.
+    std::fs::remove_file(out.join("report.html")).unwrap();
+    let output = sweephold(&["report", out.to_str().unwrap()]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let again = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert_eq!(structure(&again), sections);
+
+    // A corrupt file: one line naming it, non-zero exit.
+    std::fs::write(out.join("model9.json"), "{ not json").unwrap();
+    let message = one_line_failure(&sweephold(&["report", out.to_str().unwrap()]));
+    assert!(message.contains("model9.json"), "{message}");
+
+    // An output folder that cannot be created (its parent is a file).
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "x").unwrap();
+    let unwritable = blocker.join("campaign");
+    let message = one_line_failure(&sweephold(&[
+        "campaign",
+        "--quick",
+        "--quiet",
+        "--out",
+        unwritable.to_str().unwrap(),
+    ]));
+    assert!(message.contains("`setup`"), "{message}");
+
+    // A stage failing mid-way: the fly folder is taken by a file. The stage is named,
+    // and summary.json keeps what completed plus the error.
+    let blocked = dir.join("blocked");
+    std::fs::create_dir_all(&blocked).unwrap();
+    std::fs::write(blocked.join("fly-cah"), "x").unwrap();
+    let message = one_line_failure(&sweephold(&[
+        "campaign",
+        "--quick",
+        "--quiet",
+        "--out",
+        blocked.to_str().unwrap(),
+    ]));
+    assert!(message.contains("`fly_cah`"), "{message}");
+    let partial: Value =
+        serde_json::from_str(&std::fs::read_to_string(blocked.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(partial["error"]["stage"], "fly_cah");
+    assert!(partial["modes"]["cah"].is_null() && partial["fit"].is_null());
+    assert!(partial["timings_s"]["setup"].is_f64());
+
+    std::fs::remove_dir_all(&dir).ok();
+}
