@@ -714,7 +714,9 @@ mod tests {
         // truth: where the best fit lies is a property of the structure, not of the
         // optimizer's starts. A structure that misses the simulator's physics fails here
         // (the paper's flap equations alone: J_ave 87, τ_f −7 %, M_b1c +27 %, Lf_lat −22 %).
-        use sysid::fit::synthetic::{exact_frf_document, paper_table1_range, SyntheticGrid};
+        use sysid::fit::synthetic::{
+            exact_frf_document, paper_table1_range, SyntheticGrid, CAMPAIGN_FITTED_PAIRS,
+        };
         use sysid::fit::{fit, FitOptions, PairBand};
         let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
         let structure = shipped("bo105-9dof-hybrid.toml");
@@ -723,24 +725,7 @@ mod tests {
         let reference = truth.linear_model(&[delay; 4]);
         // The pairs a default campaign fits (the others carry no coherent response: their
         // exact responses are near zero and their dB meaningless), on Table 1's ranges.
-        let fitted = [
-            ("p", "lat"),
-            ("p", "lon"),
-            ("p", "ped"),
-            ("q", "lat"),
-            ("q", "lon"),
-            ("r", "lat"),
-            ("r", "ped"),
-            ("r", "col"),
-            ("ax", "lon"),
-            ("ax", "col"),
-            ("ay", "lat"),
-            ("ay", "ped"),
-            ("az", "col"),
-            ("u", "lon"),
-            ("v", "lon"),
-            ("w", "col"),
-        ];
+        let fitted = CAMPAIGN_FITTED_PAIRS;
         let bands: Vec<PairBand> = fitted
             .iter()
             .map(|(output, input)| PairBand {

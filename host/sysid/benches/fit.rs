@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use sysid::fit::cost::PairBand;
 use sysid::fit::synthetic::{
     exact_frf_document, paper_table1_range, SyntheticGrid, BO105_HYBRID_REFERENCE,
-    BO105_HYBRID_STRUCTURE, BO105_SIX_DOF_STRUCTURE,
+    BO105_HYBRID_STRUCTURE, BO105_SIX_DOF_STRUCTURE, CAMPAIGN_FITTED_PAIRS,
 };
 use sysid::fit::{
     fit, fit_from_alternative_starts, start_from_quasi_steady, FitOptions, FitResult,
@@ -39,31 +39,11 @@ fn main() {
         })
         .collect();
     let truth_model = hybrid.model(&truth).expect("truth model");
-    // The pairs a default campaign fits (`sweephold fly` + `frf`: the others carry no
-    // coherent response, and the reference barely couples them — w/ped, az/ped, …).
-    let fitted = [
-        ("p", "lat"),
-        ("p", "lon"),
-        ("p", "ped"),
-        ("q", "lat"),
-        ("q", "lon"),
-        ("r", "lat"),
-        ("r", "ped"),
-        ("r", "col"),
-        ("ax", "lon"),
-        ("ax", "col"),
-        ("ay", "lat"),
-        ("ay", "ped"),
-        ("az", "col"),
-        ("u", "lon"),
-        ("v", "lon"),
-        ("w", "col"),
-    ];
     let keep = |structure: &ModelStructure| {
         let mut structure = structure.clone();
-        structure
-            .pairs
-            .retain(|pair| fitted.contains(&(pair.output.as_str(), pair.input.as_str())));
+        structure.pairs.retain(|pair| {
+            CAMPAIGN_FITTED_PAIRS.contains(&(pair.output.as_str(), pair.input.as_str()))
+        });
         structure
     };
     let (hybrid, six_dof) = (keep(&hybrid), keep(&six_dof));

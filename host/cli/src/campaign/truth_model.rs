@@ -3,7 +3,6 @@
 //! curves from the campaign folder alone.
 
 use serde::{Deserialize, Serialize};
-use sysid::fit::model::RowMajor;
 use sysid::fit::report::ModelMatrices;
 use sysid::fit::Model;
 
@@ -35,37 +34,15 @@ impl TruthModelDocument {
             states: model.states.clone(),
             controls: model.controls.clone(),
             outputs: model.outputs.clone(),
-            matrices: ModelMatrices {
-                m: RowMajor::from_matrix(&model.m),
-                f: RowMajor::from_matrix(&model.f),
-                g: RowMajor::from_matrix(&model.g),
-                h0: RowMajor::from_matrix(&model.h0),
-                h1: RowMajor::from_matrix(&model.h1),
-            },
+            matrices: ModelMatrices::from_model(model),
             delays: model.delays.clone(),
         }
     }
 
     /// The numeric model; `None` when a matrix does not fit the names.
     pub fn model(&self) -> Option<Model> {
-        let (n, m, p) = (self.states.len(), self.controls.len(), self.outputs.len());
-        let sized = |matrix: &RowMajor, rows: usize, cols: usize| {
-            (matrix.rows == rows && matrix.cols == cols)
-                .then(|| matrix.to_matrix())
-                .flatten()
-        };
-        (self.delays.len() == m).then_some(())?;
-        Some(Model {
-            m: sized(&self.matrices.m, n, n)?,
-            f: sized(&self.matrices.f, n, n)?,
-            g: sized(&self.matrices.g, n, m)?,
-            h0: sized(&self.matrices.h0, p, n)?,
-            h1: sized(&self.matrices.h1, p, n)?,
-            delays: self.delays.clone(),
-            states: self.states.clone(),
-            controls: self.controls.clone(),
-            outputs: self.outputs.clone(),
-        })
+        self.matrices
+            .to_model(&self.states, &self.controls, &self.outputs, &self.delays)
     }
 }
 

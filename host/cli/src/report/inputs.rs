@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
 use sysid::document::FrfDocument;
-use sysid::fit::model::RowMajor;
 use sysid::fit::report::ModelMatrices;
 use sysid::fit::{Model, PairFit};
 use sysid::frf::analysis::CoherenceCurve;
@@ -88,24 +87,8 @@ pub struct FittedModel {
 impl FittedModel {
     /// The numeric model; `None` when a matrix does not fit the names.
     pub fn model(&self) -> Option<Model> {
-        let (n, m, p) = (self.states.len(), self.controls.len(), self.outputs.len());
-        let sized = |matrix: &RowMajor, rows: usize, cols: usize| {
-            (matrix.rows == rows && matrix.cols == cols)
-                .then(|| matrix.to_matrix())
-                .flatten()
-        };
-        (self.delays.len() == m).then_some(())?;
-        Some(Model {
-            m: sized(&self.matrices.m, n, n)?,
-            f: sized(&self.matrices.f, n, n)?,
-            g: sized(&self.matrices.g, n, m)?,
-            h0: sized(&self.matrices.h0, p, n)?,
-            h1: sized(&self.matrices.h1, p, n)?,
-            delays: self.delays.clone(),
-            states: self.states.clone(),
-            controls: self.controls.clone(),
-            outputs: self.outputs.clone(),
-        })
+        self.matrices
+            .to_model(&self.states, &self.controls, &self.outputs, &self.delays)
     }
 }
 

@@ -33,6 +33,48 @@ pub struct ModelMatrices {
     pub h1: RowMajor,
 }
 
+impl ModelMatrices {
+    /// The matrices of `model`.
+    pub fn from_model(model: &Model) -> ModelMatrices {
+        ModelMatrices {
+            m: RowMajor::from_matrix(&model.m),
+            f: RowMajor::from_matrix(&model.f),
+            g: RowMajor::from_matrix(&model.g),
+            h0: RowMajor::from_matrix(&model.h0),
+            h1: RowMajor::from_matrix(&model.h1),
+        }
+    }
+
+    /// The numeric model with these names and delays; `None` when a matrix does not fit
+    /// the names or the delays do not match the controls.
+    pub fn to_model(
+        &self,
+        states: &[String],
+        controls: &[String],
+        outputs: &[String],
+        delays: &[f64],
+    ) -> Option<Model> {
+        let (n, m, p) = (states.len(), controls.len(), outputs.len());
+        let sized = |matrix: &RowMajor, rows: usize, cols: usize| {
+            (matrix.rows == rows && matrix.cols == cols)
+                .then(|| matrix.to_matrix())
+                .flatten()
+        };
+        (delays.len() == m).then_some(())?;
+        Some(Model {
+            m: sized(&self.m, n, n)?,
+            f: sized(&self.f, n, n)?,
+            g: sized(&self.g, n, m)?,
+            h0: sized(&self.h0, p, n)?,
+            h1: sized(&self.h1, p, n)?,
+            delays: delays.to_vec(),
+            states: states.to_vec(),
+            controls: controls.to_vec(),
+            outputs: outputs.to_vec(),
+        })
+    }
+}
+
 /// The correlation matrix of the free parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CorrelationMatrix {
@@ -169,13 +211,7 @@ impl ModelDocument {
             states: model.states.clone(),
             controls: model.controls.clone(),
             outputs: model.outputs.clone(),
-            matrices: ModelMatrices {
-                m: RowMajor::from_matrix(&model.m),
-                f: RowMajor::from_matrix(&model.f),
-                g: RowMajor::from_matrix(&model.g),
-                h0: RowMajor::from_matrix(&model.h0),
-                h1: RowMajor::from_matrix(&model.h1),
-            },
+            matrices: ModelMatrices::from_model(model),
             delays: model.delays.clone(),
             parameters: result
                 .parameters
@@ -211,24 +247,8 @@ impl ModelDocument {
 
     /// The numeric model; `None` when a matrix has the wrong size.
     pub fn model(&self) -> Option<Model> {
-        let (n, m, p) = (self.states.len(), self.controls.len(), self.outputs.len());
-        let sized = |matrix: &RowMajor, rows: usize, cols: usize| {
-            (matrix.rows == rows && matrix.cols == cols)
-                .then(|| matrix.to_matrix())
-                .flatten()
-        };
-        (self.delays.len() == m).then_some(())?;
-        Some(Model {
-            m: sized(&self.matrices.m, n, n)?,
-            f: sized(&self.matrices.f, n, n)?,
-            g: sized(&self.matrices.g, n, m)?,
-            h0: sized(&self.matrices.h0, p, n)?,
-            h1: sized(&self.matrices.h1, p, n)?,
-            delays: self.delays.clone(),
-            states: self.states.clone(),
-            controls: self.controls.clone(),
-            outputs: self.outputs.clone(),
-        })
+        self.matrices
+            .to_model(&self.states, &self.controls, &self.outputs, &self.delays)
     }
 }
 
