@@ -2,8 +2,10 @@
 //! identified parameter — the most insensitive one while any insensitivity exceeds its
 //! limit, else the one with the largest Cramér–Rao bound while any exceeds its limit —
 //! by fixing it at zero, refit, and keep the smaller model while J_ave rises by less than
-//! a set amount per step. The first step that costs more is undone and ends the
-//! reduction (the paper keeps Lf_lat for that reason).
+//! a set amount per step. A step that costs more is undone: that parameter is needed (the
+//! paper keeps Lf_lat for that reason) and stays in, flagged if it is, and the reduction
+//! goes on with the worst of the others — a needed parameter early in the order (say a
+//! heave damping) must not shield the unidentifiable ones behind it.
 
 use serde::{Deserialize, Serialize};
 
@@ -29,12 +31,16 @@ pub struct ReductionStep {
 
 /// The parameter to drop next, with the reason, or None when every free parameter meets
 /// the guidelines.
-fn worst_parameter(result: &FitResult, options: &FitOptions) -> Option<(String, String)> {
+fn worst_parameter(
+    result: &FitResult,
+    options: &FitOptions,
+    needed: &[String],
+) -> Option<(String, String)> {
     let free = || {
         result
             .parameters
             .iter()
-            .filter(|p| p.status == ParameterStatus::Free)
+            .filter(|p| p.status == ParameterStatus::Free && !needed.contains(&p.name))
     };
     let worst_by = |key: fn(&super::ParameterReport) -> f64| {
         free()
@@ -74,7 +80,9 @@ pub fn reduce(
         max_starts: options.max_starts.min(2),
         ..options.clone()
     };
-    while let Some((name, reason)) = worst_parameter(&current, options) {
+    // Parameters whose removal cost too much: kept, and not tried again.
+    let mut needed: Vec<String> = Vec::new();
+    while let Some((name, reason)) = worst_parameter(&current, options, &needed) {
         let mut smaller = current.structure.clone();
         let Some(index) = smaller.parameter_index(&name) else {
             break;
@@ -88,33 +96,25 @@ pub fn reduce(
         smaller.parameters[index].upper = None;
         let before = current.average_cost;
         let refit = match fit_on_grids(&smaller, grids, &refit_options) {
-            Ok(refit) => refit,
+            Ok(refit) => Some(refit),
             // A smaller model that cannot be evaluated (e.g. a pole moved onto the jω
             // axis) is not an improvement.
-            Err(FitError::SingularSystem { .. }) => {
-                steps.push(ReductionStep {
-                    dropped: name,
-                    reason,
-                    average_cost_before: before,
-                    average_cost_after: f64::INFINITY,
-                    accepted: false,
-                });
-                break;
-            }
+            Err(FitError::SingularSystem { .. }) => None,
             Err(other) => return Err(other),
         };
-        let accepted = refit.average_cost - before < options.reduce_max_cost_rise;
+        let after = refit.as_ref().map_or(f64::INFINITY, |r| r.average_cost);
+        let accepted = after - before < options.reduce_max_cost_rise;
         steps.push(ReductionStep {
-            dropped: name,
+            dropped: name.clone(),
             reason,
             average_cost_before: before,
-            average_cost_after: refit.average_cost,
+            average_cost_after: after,
             accepted,
         });
-        if !accepted {
-            break;
+        match refit {
+            Some(refit) if accepted => current = refit,
+            _ => needed.push(name),
         }
-        current = refit;
     }
     current.reduction = steps;
     Ok(current)
@@ -176,5 +176,51 @@ u = "b"
         for step in &result.reduction {
             assert!(step.average_cost_after.is_finite());
         }
+    }
+
+    #[test]
+    fn a_needed_parameter_does_not_end_the_reduction() {
+        // Truth ẋ = −2x + 3u, with a tiny true feed-through-like H1 `d`; `keep` is a real
+        // but small coupling the data need. Limits so tight that every parameter is flagged:
+        // the reduction must try them all, restore the needed ones and still drop `d`.
+        let truth_text = r#"
+name = "truth"
+states = ["x"]
+controls = ["u"]
+outputs = ["x"]
+pairs = [{ output = "x", input = "u", range = [0.1, 20.0] }]
+[parameters]
+a = -2.0
+b = 3.0
+[F.x]
+x = "a"
+[G.x]
+u = "b"
+"#;
+        let truth = ModelStructure::parse(truth_text, "truth.toml").unwrap();
+        let document = synthetic_document(&truth.model(&truth.values()).unwrap(), &truth, 20);
+        let candidate_text = truth_text.replace("b = 3.0", "b = 3.0\nd = 0.001")
+            + "[H1.x]\nx = \"d\"\n[H0.x]\nx = 1.0\n";
+        let candidate = ModelStructure::parse(&candidate_text, "candidate.toml").unwrap();
+        let options = FitOptions {
+            reduce: true,
+            // Every parameter violates these: a and b are needed, d is not.
+            insensitivity_limit_percent: 0.0,
+            cramer_rao_limit_percent: 0.0,
+            ..FitOptions::default()
+        };
+        let result = fit(&candidate, &document, &options).unwrap();
+        let tried: Vec<(&str, bool)> = result
+            .reduction
+            .iter()
+            .map(|s| (s.dropped.as_str(), s.accepted))
+            .collect();
+        // Each parameter tried once; a and b restored, d dropped, whatever the order.
+        assert_eq!(tried.len(), 3, "{tried:?}");
+        for (name, accepted) in &tried {
+            assert_eq!(*accepted, *name == "d", "{tried:?}");
+        }
+        assert!((result.parameter("a").unwrap() + 2.0).abs() < 1e-3);
+        assert!((result.parameter("b").unwrap() - 3.0).abs() < 1e-3);
     }
 }

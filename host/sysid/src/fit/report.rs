@@ -371,7 +371,7 @@ pub fn reduction_table(steps: &[ReductionStep]) -> String {
             if step.accepted {
                 "kept out"
             } else {
-                "restored (cost rose too much)"
+                "restored: needed (cost rose too much)"
             }
         );
     }
