@@ -307,7 +307,7 @@ pub struct StartSetOutcome {
 /// with its own values, e.g. from a 6-DOF fit and from the file), keep the lowest J_ave,
 /// and only then reduce it. A 6-DOF fit can land in a degenerate minimum (its roll
 /// damping and control power both huge, their ratio right) whose Eq. 26–27 starts are
-/// useless; the file's generic starts are the fallback. Each set still gets the usual
+/// useless; the file's generic starts are the fallback. Each set gets its share of the
 /// perturbed restarts. Errors only when every set fails (the first set's error).
 pub fn fit_from_alternative_starts(
     starts: &[(String, ModelStructure)],
@@ -324,12 +324,18 @@ pub fn fit_from_alternative_starts(
         });
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
+    // The restart budget is shared: each set gets its part of `max_starts` (at least two,
+    // so that each can still confirm its minimum).
+    let per_set = FitOptions {
+        max_starts: (options.max_starts / starts.len()).max(2),
+        ..options.clone()
+    };
     let mut best: Option<FitResult> = None;
     let mut first_error = None;
     let mut outcomes = Vec::with_capacity(starts.len());
     for (label, structure) in starts {
         let (usable, _) = usable_pairs(structure, data, options.min_auto_range_ratio);
-        match fit_on_grids(&usable, &grids, options) {
+        match fit_on_grids(&usable, &grids, &per_set) {
             Ok(result) => {
                 outcomes.push(StartSetOutcome {
                     label: label.clone(),
