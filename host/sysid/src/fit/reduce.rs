@@ -126,12 +126,8 @@ mod tests {
     use crate::fit::test_support::synthetic_document;
     use crate::fit::{fit, FitOptions, ParameterStatus};
 
-    #[test]
-    fn drops_a_parameter_the_data_do_not_need() {
-        // Truth: ẋ = −2x + 3u (no delay, no zero). The structure adds a feed-through-like
-        // H1 term `d` whose true value is 0 and a delay `tau` whose true value is 0:
-        // both are unidentifiable (insensitive) around zero and get dropped.
-        let truth_text = r#"
+    /// The truth of both tests: ẋ = −2x + 3u, no delay, no zero.
+    const LAG_TRUTH: &str = r#"
 name = "truth"
 states = ["x"]
 controls = ["u"]
@@ -145,9 +141,20 @@ x = "a"
 [G.x]
 u = "b"
 "#;
-        let truth = ModelStructure::parse(truth_text, "truth.toml").unwrap();
-        let document = synthetic_document(&truth.model(&truth.values()).unwrap(), &truth, 20);
-        let candidate_text = truth_text.replace(
+
+    /// Exact responses of [`LAG_TRUTH`].
+    fn lag_data() -> crate::document::FrfDocument {
+        let truth = ModelStructure::parse(LAG_TRUTH, "truth.toml").unwrap();
+        synthetic_document(&truth.model(&truth.values()).unwrap(), &truth, 20)
+    }
+
+    #[test]
+    fn drops_a_parameter_the_data_do_not_need() {
+        // The lag's structure plus a feed-through-like
+        // H1 term `d` whose true value is 0 and a delay `tau` whose true value is 0:
+        // both are unidentifiable (insensitive) around zero and get dropped.
+        let document = lag_data();
+        let candidate_text = LAG_TRUTH.replace(
             "b = 3.0",
             "b = 3.0\nd = 0.001\ntau = { start = 0.0001, min = 0.0 }",
         ) + "[H1.x]\nx = \"d\"\n[H0.x]\nx = 1.0\n[delays]\nu = \"tau\"\n";
@@ -180,26 +187,11 @@ u = "b"
 
     #[test]
     fn a_needed_parameter_does_not_end_the_reduction() {
-        // Truth ẋ = −2x + 3u, with a tiny true feed-through-like H1 `d`; `keep` is a real
-        // but small coupling the data need. Limits so tight that every parameter is flagged:
-        // the reduction must try them all, restore the needed ones and still drop `d`.
-        let truth_text = r#"
-name = "truth"
-states = ["x"]
-controls = ["u"]
-outputs = ["x"]
-pairs = [{ output = "x", input = "u", range = [0.1, 20.0] }]
-[parameters]
-a = -2.0
-b = 3.0
-[F.x]
-x = "a"
-[G.x]
-u = "b"
-"#;
-        let truth = ModelStructure::parse(truth_text, "truth.toml").unwrap();
-        let document = synthetic_document(&truth.model(&truth.values()).unwrap(), &truth, 20);
-        let candidate_text = truth_text.replace("b = 3.0", "b = 3.0\nd = 0.001")
+        // The lag plus a feed-through-like H1 `d` whose truth is 0. Limits so tight that
+        // every parameter is flagged: the reduction must try them all, restore the needed
+        // ones (a, b) and still drop `d`.
+        let document = lag_data();
+        let candidate_text = LAG_TRUTH.replace("b = 3.0", "b = 3.0\nd = 0.001")
             + "[H1.x]\nx = \"d\"\n[H0.x]\nx = 1.0\n";
         let candidate = ModelStructure::parse(&candidate_text, "candidate.toml").unwrap();
         let options = FitOptions {
