@@ -9,6 +9,7 @@
 use std::collections::BTreeMap;
 
 use clap::Parser;
+use sweephold::campaign::stage::Stage;
 use sweephold::{Cli, Command};
 
 const TARGET_S: f64 = 30.0;
@@ -66,21 +67,8 @@ fn main() {
         );
         last = Some(outcome.summary);
     }
-    let order = [
-        "setup",
-        "fly_cah",
-        "fly_standard",
-        "fly_noise",
-        "fly_verification",
-        "frf",
-        "fit_6dof",
-        "fit_9dof",
-        "truth",
-        "verify",
-        "report",
-    ];
     println!("campaign --vehicle {vehicle}: median of {runs} run(s), per stage:");
-    for stage in order {
+    for stage in Stage::ALL.map(Stage::name) {
         if let Some(values) = stages.get_mut(stage) {
             println!("  {stage:<17} {:>7.2} s", median(values));
         }

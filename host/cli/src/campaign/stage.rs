@@ -34,6 +34,21 @@ pub enum Stage {
 }
 
 impl Stage {
+    /// Every stage, in the order a campaign runs them.
+    pub const ALL: [Stage; 11] = [
+        Stage::Setup,
+        Stage::FlyCah,
+        Stage::FlyStandard,
+        Stage::FlyNoise,
+        Stage::FlyVerification,
+        Stage::Frf,
+        Stage::Fit6Dof,
+        Stage::Fit9Dof,
+        Stage::Truth,
+        Stage::Verify,
+        Stage::Report,
+    ];
+
     /// The stage's name in `summary.json` (`timings_s` keys, `error.stage`).
     pub fn name(self) -> &'static str {
         match self {

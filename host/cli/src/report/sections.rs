@@ -11,6 +11,7 @@ use sysid::fit::Model;
 use super::html::{figure, note, section, table, Cell, Mark};
 use super::inputs::ReportInputs;
 use super::svg::{colors, min_max_decimate, BarChart, Figure, Panel, Scale, Series};
+use crate::campaign::stage::Stage;
 use crate::campaign::summary::{FitSummary, ModeSummary};
 
 /// Section ids of the plot sections, in page order (each holds at least one `<svg>`).
@@ -149,28 +150,16 @@ folder (`sweephold report DIR` redraws it).",
 
 /// Stages in run order, `total` last.
 fn stage_order(timings: &std::collections::BTreeMap<String, f64>) -> Vec<(String, f64)> {
-    const ORDER: [&str; 12] = [
-        "setup",
-        "fly_cah",
-        "fly_standard",
-        "fly_noise",
-        "fly_verification",
-        "frf",
-        "fit_6dof",
-        "fit_9dof",
-        "truth",
-        "verify",
-        "report",
-        "total",
-    ];
-    let mut rows: Vec<(String, f64)> = ORDER
+    let mut order = Stage::ALL.map(Stage::name).to_vec();
+    order.push("total");
+    let mut rows: Vec<(String, f64)> = order
         .iter()
         .filter_map(|name| timings.get(*name).map(|v| (name.to_string(), *v)))
         .collect();
     rows.extend(
         timings
             .iter()
-            .filter(|(k, _)| !ORDER.contains(&k.as_str()))
+            .filter(|(k, _)| !order.contains(&k.as_str()))
             .map(|(k, v)| (k.clone(), *v)),
     );
     rows
