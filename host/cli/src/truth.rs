@@ -268,9 +268,9 @@ impl FoldedFlapping {
                 }
             }
         }
-        // Without a flap state of its own the structure cannot hold that flapping: its
-        // quasi-static part is then all folded (the block entry stays −1/τ_f-free at 0, so
-        // use the simulator's to keep the inverse defined).
+        // A structure without one of the flap states has no row for it: its diagonal entry
+        // takes the simulator's decay so that the block stays invertible (that flapping's
+        // quasi-static effect is then folded entirely into the body rows).
         for f in 0..2 {
             if state_index(structure_flaps[f]).is_none() {
                 structure_block[(f, f)] = a_ff[(f, f)];

@@ -315,7 +315,9 @@ pub fn fit_from_alternative_starts(
     options: &FitOptions,
 ) -> Result<(FitResult, Vec<StartSetOutcome>), FitError> {
     let Some((_, first)) = starts.first() else {
-        return Err(FitError::NoPairs);
+        return Err(FitError::StartValues(
+            "no set of start values to fit from".into(),
+        ));
     };
     let (usable, skipped) = usable_pairs(first, data, options.min_auto_range_ratio);
     if usable.pairs.is_empty() && !first.pairs.is_empty() {
@@ -358,7 +360,9 @@ pub fn fit_from_alternative_starts(
         }
     }
     let Some(mut result) = best else {
-        return Err(first_error.unwrap_or(FitError::NoPairs));
+        return Err(first_error.unwrap_or(FitError::StartValues(
+            "no set of start values to fit from".into(),
+        )));
     };
     if options.reduce {
         result = reduce::reduce(result, &grids, options)?;
