@@ -144,6 +144,29 @@ impl Rotor {
         let s = self.stiffness_excess();
         (g * g + 4.0) / (self.omega * g * (2.0 + s))
     }
+
+    /// Cross-coupling K_cs of the two tip-path-plane modes in hover, from the blade data:
+    /// the coefficient of the other flapping state in the first-order flap equations
+    /// written with unit damping, `τ_f β̇1c = −β1c + K_cs β1s + …`,
+    /// `τ_f β̇1s = −β1s − K_cs β1c + …`.
+    ///
+    /// From the same `M·β' = N·β` as [`Rotor::flap_time_constant`],
+    /// `M⁻¹N = [[−g(2+s), 2s − g²], [g² − 2s, −g(2+s)]] / (g² + 4)`; dividing by the
+    /// diagonal rate `g(2+s)/(g² + 4)` (that is, multiplying by Ω·τ_f) leaves
+    ///
+    /// ```text
+    /// K_cs = (2s − g²) / (g·(2 + s)),   g = γ/8,  s = λ_β² − 1
+    /// ```
+    ///
+    /// Zero for an articulated rotor with λ_β² − 1 = g²/2; positive for a stiff hingeless
+    /// rotor. It is a property of the rotor design (Lock number, flap frequency), so a
+    /// flight-test engineer knows it before flying — the 9-DOF structure fixes it from
+    /// this value because the sweeps barely inform it (insensitivity ~14 %).
+    pub fn flap_cross_coupling(&self, air_density: f64) -> f64 {
+        let g = self.lock_number(air_density) / 8.0;
+        let s = self.stiffness_excess();
+        (2.0 * s - g * g) / (g * (2.0 + s))
+    }
 }
 
 /// A lifting surface (vertical fin or horizontal tailplane).
@@ -391,6 +414,12 @@ impl Helicopter {
         self.main_rotor.flap_time_constant(self.air_density)
     }
 
+    /// Main-rotor flap cross-coupling K_cs in hover, from blade data
+    /// ([`Rotor::flap_cross_coupling`]).
+    pub fn flap_cross_coupling(&self) -> f64 {
+        self.main_rotor.flap_cross_coupling(self.air_density)
+    }
+
     /// Blade pitches for stick fractions `[lat, lon, ped, col]`.
     pub fn blade_pitch(&self, controls: [f64; 4]) -> BladePitch {
         BladePitch {
@@ -443,6 +472,35 @@ mod tests {
         // The small-g approximation 16/(γΩ) is within a few percent.
         let approx = 16.0 / (gamma * heli.main_rotor.omega);
         assert!((tau / approx - 1.0).abs() < 0.05, "{tau} vs {approx}");
+    }
+
+    #[test]
+    fn flap_cross_coupling_is_the_flap_block_of_the_multiblade_equations() {
+        // The closed form against the 2×2 solve of M·β' = N·β it comes from: K_cs is the
+        // off-diagonal of M⁻¹N over its (negated) diagonal.
+        for heli in [Helicopter::bo105(), Helicopter::trex700l()] {
+            let rotor = heli.main_rotor;
+            let g = rotor.lock_number(heli.air_density) / 8.0;
+            let s = rotor.stiffness_excess();
+            let (m, n) = ([[g, 2.0], [-2.0, g]], [[-s, -g], [g, -s]]);
+            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+            let inverse = [
+                [m[1][1] / det, -m[0][1] / det],
+                [-m[1][0] / det, m[0][0] / det],
+            ];
+            let entry = |i: usize, j: usize| inverse[i][0] * n[0][j] + inverse[i][1] * n[1][j];
+            let from_solve = entry(0, 1) / -entry(0, 0);
+            let closed_form = heli.flap_cross_coupling();
+            assert!(
+                (closed_form - from_solve).abs() < 1e-12,
+                "{closed_form} vs {from_solve}"
+            );
+            // Antisymmetric: the β1s row carries −K_cs.
+            assert!((entry(1, 0) / -entry(1, 1) + closed_form).abs() < 1e-12);
+        }
+        // Bo-105: γ = 5.07, λ_β = 1.117 → K_cs = 0.066.
+        let bo105 = Helicopter::bo105().flap_cross_coupling();
+        assert!((bo105 - 0.0662).abs() < 5e-4, "{bo105}");
     }
 
     #[test]

@@ -647,6 +647,14 @@ mod tests {
             assert!((mapped.flap_signs[flap] * coupling + 1.0).abs() < 1e-12);
             assert!((1.0..1.1).contains(&coupling), "{coupling}");
         }
+        // The flap cross-coupling the file fixes from rotor theory is the simulator's
+        // (0.1 % apart: the two flap scales s_c, s_s differ by that much).
+        let rotor = truth.vehicle.helicopter().flap_cross_coupling();
+        let kcs = mapped.values["Kcs"];
+        assert!(
+            (kcs / rotor - 1.0).abs() < 0.005,
+            "mapped {kcs}, rotor theory {rotor}"
+        );
         // Stable rotor: positive flapping moment derivatives in the structure's signs.
         assert!(mapped.values["Lb1s"] > 100.0, "{}", mapped.values["Lb1s"]);
         assert!(mapped.values["Mb1c"] > 20.0, "{}", mapped.values["Mb1c"]);
