@@ -379,7 +379,7 @@ fn flap_row_parameters(
     if let Some(index) = structure.parameter_index("tau_f") {
         values[index] = tau_f;
     }
-    let mut out = BTreeMap::new();
+    let mut candidates: BTreeMap<String, Vec<(f64, bool)>> = BTreeMap::new();
     for entry in &structure.entries {
         let Some(row_name) = structure.states.get(entry.row) else {
             continue;
@@ -423,10 +423,29 @@ fn flap_row_parameters(
             _ => None,
         };
         if let Some(a) = simulator_entry {
-            out.insert(name.clone(), mass * row_sign * a / coefficient);
+            let unit = coefficient.abs() == 1.0;
+            candidates
+                .entry(name.clone())
+                .or_insert_with(Vec::new)
+                .push((mass * row_sign * a / coefficient, unit));
         }
     }
-    out
+    // A parameter may stand alone in several entries: written directly (`u = "Lfu"`),
+    // through a constraint (`v = "Mfv"` with Mfv = Lfu) or scaled by a constant
+    // (`p = "Kpq"` with Kpq = hub_height·Lfu). The last entry that carries it with a unit
+    // coefficient maps it; a scaled one only when there is no other.
+    candidates
+        .into_iter()
+        .filter_map(|(name, list)| {
+            let chosen = list
+                .iter()
+                .rev()
+                .find(|(_, unit)| *unit)
+                .or(list.last())
+                .map(|(value, _)| *value)?;
+            Some((name, chosen))
+        })
+        .collect()
 }
 
 /// Map the truth onto `structure`'s parameters (see the module documentation).
@@ -655,6 +674,12 @@ mod tests {
             (kcs / rotor - 1.0).abs() < 0.005,
             "mapped {kcs}, rotor theory {rotor}"
         );
+        // The file ties the cross-axis rate coupling to the flap-back, Kpq = h·Lfu: the
+        // rotor sees its hub's velocity, h = 1.48 m above the CG. The simulator's disc
+        // has exactly that: ∂β̇1c/∂p over ∂β̇1s/∂u is the hub height.
+        let hub_height = truth.a("beta1c", "p").unwrap() / truth.a("beta1s", "u").unwrap();
+        assert!((hub_height / 1.48 - 1.0).abs() < 0.01, "{hub_height}");
+        assert!((mapped.values["Kpq"] / (1.48 * mapped.values["Lfu"]) - 1.0).abs() < 1e-12);
         // Stable rotor: positive flapping moment derivatives in the structure's signs.
         assert!(mapped.values["Lb1s"] > 100.0, "{}", mapped.values["Lb1s"]);
         assert!(mapped.values["Mb1c"] > 20.0, "{}", mapped.values["Mb1c"]);

@@ -1,6 +1,8 @@
 //! The model structures a campaign fits, compiled into the binary so that `sweephold
 //! campaign` works from any directory.
 
+use std::collections::BTreeMap;
+
 use sysid::fit::structure::ParameterKind;
 use sysid::fit::{ModelStructure, StructureError};
 
@@ -16,12 +18,18 @@ pub fn six_dof() -> Result<ModelStructure, StructureError> {
 }
 
 /// The 9-DOF hybrid structure (both vehicles), with the rotor data of `vehicle` in it:
-/// the file fixes the flap cross-coupling `Kcs` at the Bo-105's rotor-theory value, and
-/// another vehicle gets its own ([`bo105::Rotor::flap_cross_coupling`]).
+/// the file is written for the Bo-105 — its `hub_height` constant and the flap
+/// cross-coupling `Kcs` it fixes from rotor theory — and another vehicle gets its own
+/// ([`bo105::Rotor::flap_cross_coupling`], the hub position of its main rotor).
 pub fn nine_dof_hybrid(vehicle: bo105::Vehicle) -> Result<ModelStructure, StructureError> {
-    let mut structure =
-        ModelStructure::parse(NINE_DOF_HYBRID_TOML, "bo105-9dof-hybrid.toml (built in)")?;
     let helicopter = vehicle.helicopter();
+    // The hub is at body z = hub[2] (z down): its height above the CG is −hub[2].
+    let constants = BTreeMap::from([("hub_height".to_string(), -helicopter.main_rotor.hub[2])]);
+    let mut structure = ModelStructure::parse_with_constants(
+        NINE_DOF_HYBRID_TOML,
+        "bo105-9dof-hybrid.toml (built in)",
+        &constants,
+    )?;
     if let Some(index) = structure.parameter_index("Kcs") {
         let parameter = &mut structure.parameters[index];
         // Only a fixed entry is a rotor-data prior; a free one stays the fit's to find.
@@ -67,5 +75,23 @@ mod tests {
             (trex - bo105_rotor).abs() > 0.01,
             "TREX {trex}, Bo-105 {bo105_rotor}"
         );
+    }
+
+    #[test]
+    fn the_hub_height_is_the_flown_vehicles() {
+        let file = ModelStructure::parse(NINE_DOF_HYBRID_TOML, "file").unwrap();
+        let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105).unwrap();
+        let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l).unwrap();
+        // The file's number is the Bo-105's hub position.
+        assert_eq!(file.constants["hub_height"], 1.48);
+        assert_eq!(bo105.constants["hub_height"], 1.48);
+        let trex_hub = -bo105::Helicopter::trex700l().main_rotor.hub[2];
+        assert_eq!(trex.constants["hub_height"], trex_hub);
+        assert!(trex_hub > 0.0 && trex_hub < 0.5, "{trex_hub}");
+        // It reaches the model: Kpq = hub_height·Lfu.
+        let kpq = |s: &ModelStructure| s.parameter_value("Kpq", &s.values()).unwrap();
+        let lfu = |s: &ModelStructure| s.parameter_value("Lfu", &s.values()).unwrap();
+        assert!((kpq(&trex) - trex_hub * lfu(&trex)).abs() < 1e-15);
+        assert!((kpq(&bo105) - 1.48 * lfu(&bo105)).abs() < 1e-15);
     }
 }

@@ -11,7 +11,7 @@ pub enum StructureProblem {
     Syntax(String),
     /// A state, control or output name that the structure does not declare.
     UnknownName {
-        /// `state`, `control`, `output` or `matrix row`.
+        /// `state`, `control`, `output`, `matrix row` or `constant`.
         kind: &'static str,
         /// The offending name.
         name: String,

@@ -232,7 +232,26 @@ fn token_text(token: &Token) -> String {
 
 /// Parse a linear expression; the error says why it is not one.
 pub fn parse_linear(text: &str) -> Result<LinearForm, String> {
-    let tokens = tokenize(text)?;
+    parse_linear_with_constants(text, &BTreeMap::new())
+}
+
+/// Parse a linear expression in which the names in `constants` stand for their numbers
+/// (a structure file's `[constants]`, e.g. a hub height): `hub_height*Mfu` is then the
+/// linear `1.48·Mfu`, where two parameters multiplied would not be.
+pub fn parse_linear_with_constants(
+    text: &str,
+    constants: &BTreeMap<String, f64>,
+) -> Result<LinearForm, String> {
+    let tokens: Vec<Token> = tokenize(text)?
+        .into_iter()
+        .map(|token| match token {
+            Token::Name(name) => match constants.get(&name) {
+                Some(&value) => Token::Number(value),
+                None => Token::Name(name),
+            },
+            other => other,
+        })
+        .collect();
     if tokens.is_empty() {
         return Err("empty expression".into());
     }
@@ -253,6 +272,17 @@ pub fn parse_linear(text: &str) -> Result<LinearForm, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn constants_stand_for_their_numbers() {
+        let constants = BTreeMap::from([("hub_height".to_string(), 1.5)]);
+        let form = parse_linear_with_constants("-tau_f - hub_height*Mfu", &constants).unwrap();
+        assert_eq!(coefficient(&form, "tau_f"), -1.0);
+        assert_eq!(coefficient(&form, "Mfu"), -1.5);
+        assert!(!form.terms.contains_key("hub_height"));
+        // Without the constant it is a product of two names, which is not linear.
+        assert!(parse_linear("-tau_f - hub_height*Mfu").is_err());
+    }
 
     fn coefficient(form: &LinearForm, name: &str) -> f64 {
         form.terms.get(name).copied().unwrap_or(0.0)

@@ -13,7 +13,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::error::{FitError, StructureError, StructureProblem};
-use super::expression::{parse_linear, LinearForm};
+use super::expression::{parse_linear_with_constants, LinearForm};
 use super::model::Model;
 
 /// Whether the optimizer moves a parameter.
@@ -177,6 +177,9 @@ pub struct ModelStructure {
     pub default_output_states: Vec<(usize, usize)>,
     /// File name used in error messages.
     pub source_name: String,
+    /// Named numbers of the file's `[constants]` (e.g. `hub_height`), with any override
+    /// the caller gave ([`Self::parse_with_constants`]); expressions were built with these.
+    pub constants: BTreeMap<String, f64>,
 }
 
 // ---------------------------------------------------------------------------------------
@@ -235,6 +238,8 @@ struct RawStructure {
     controls: Vec<Spanned<String>>,
     outputs: Vec<Spanned<String>>,
     auto_range_limit: Option<Spanned<Vec<f64>>>,
+    #[serde(default)]
+    constants: BTreeMap<Spanned<String>, Spanned<f64>>,
     #[serde(default)]
     parameters: BTreeMap<Spanned<String>, Spanned<RawParameter>>,
     #[serde(rename = "M", default)]
@@ -374,13 +379,24 @@ impl Resolver<'_> {
 impl ModelStructure {
     /// Parse a structure from TOML text; `source_name` names it in error messages.
     pub fn parse(text: &str, source_name: &str) -> Result<Self, StructureError> {
+        Self::parse_with_constants(text, source_name, &BTreeMap::new())
+    }
+
+    /// Parse a structure with some of its `[constants]` replaced — the same structure for
+    /// another aircraft (its hub height, say). Overriding a constant the file does not
+    /// declare is an error, so a misspelt name cannot pass unnoticed.
+    pub fn parse_with_constants(
+        text: &str,
+        source_name: &str,
+        overrides: &BTreeMap<String, f64>,
+    ) -> Result<Self, StructureError> {
         let context = Context { text, source_name };
         let raw: RawStructure = toml::from_str(text).map_err(|error| StructureError {
             source_name: source_name.to_string(),
             line: error.span().map(|span| line_of(text, span.start)),
             problem: StructureProblem::Syntax(explain_syntax(error.message())),
         })?;
-        Self::from_raw(raw, &context)
+        Self::from_raw(raw, &context, overrides)
     }
 
     /// Read and parse a structure file.
@@ -394,10 +410,57 @@ impl ModelStructure {
         Self::parse(&text, &source_name)
     }
 
-    fn from_raw(raw: RawStructure, context: &Context<'_>) -> Result<Self, StructureError> {
+    fn from_raw(
+        raw: RawStructure,
+        context: &Context<'_>,
+        overrides: &BTreeMap<String, f64>,
+    ) -> Result<Self, StructureError> {
         let states = context.names(&raw.states, "state")?;
         let controls = context.names(&raw.controls, "control")?;
         let outputs = context.names(&raw.outputs, "output")?;
+
+        let mut constants = BTreeMap::new();
+        for (key, value) in &raw.constants {
+            let name = key.get_ref().clone();
+            if !value.get_ref().is_finite() {
+                return Err(context.error(
+                    value.span(),
+                    StructureProblem::BadParameter {
+                        name,
+                        reason: "a constant must be a finite number".to_string(),
+                    },
+                ));
+            }
+            if raw.parameters.keys().any(|p| p.get_ref() == &name) {
+                return Err(context.error(key.span(), StructureProblem::DuplicateName(name)));
+            }
+            constants.insert(name, *value.get_ref());
+        }
+        for (name, &value) in overrides {
+            match constants.get_mut(name) {
+                Some(slot) if value.is_finite() => *slot = value,
+                Some(_) => {
+                    return Err(StructureError {
+                        source_name: context.source_name.to_string(),
+                        line: None,
+                        problem: StructureProblem::BadParameter {
+                            name: name.clone(),
+                            reason: "a constant must be a finite number".to_string(),
+                        },
+                    })
+                }
+                None => {
+                    return Err(StructureError {
+                        source_name: context.source_name.to_string(),
+                        line: None,
+                        problem: StructureProblem::UnknownName {
+                            kind: "constant",
+                            name: name.clone(),
+                        },
+                    })
+                }
+            }
+        }
         if states.is_empty() || controls.is_empty() || outputs.is_empty() {
             return Err(context.error(
                 raw.name.span(),
@@ -452,15 +515,17 @@ impl ModelStructure {
                         if table.min.is_some() || table.max.is_some() {
                             return Err(bad("a constrained parameter cannot have bounds"));
                         }
-                        let form = parse_linear(expression).map_err(|reason| {
-                            context.error(
-                                value.span(),
-                                StructureProblem::BadExpression {
-                                    expression: expression.clone(),
-                                    reason,
-                                },
-                            )
-                        })?;
+                        let form = parse_linear_with_constants(expression, &constants).map_err(
+                            |reason| {
+                                context.error(
+                                    value.span(),
+                                    StructureProblem::BadExpression {
+                                        expression: expression.clone(),
+                                        reason,
+                                    },
+                                )
+                            },
+                        )?;
                         derived_forms.insert(name.clone(), form);
                         derived_order.push((name, line, value.span()));
                     } else {
@@ -513,15 +578,16 @@ impl ModelStructure {
                         terms: Vec::new(),
                     }),
                     RawValue::Expression(text) => {
-                        let form = parse_linear(text).map_err(|reason| {
-                            context.error(
-                                value.span(),
-                                StructureProblem::BadExpression {
-                                    expression: text.clone(),
-                                    reason,
-                                },
-                            )
-                        })?;
+                        let form =
+                            parse_linear_with_constants(text, &constants).map_err(|reason| {
+                                context.error(
+                                    value.span(),
+                                    StructureProblem::BadExpression {
+                                        expression: text.clone(),
+                                        reason,
+                                    },
+                                )
+                            })?;
                         resolver
                             .resolve(&form, &mut Vec::new())
                             .map_err(|problem| context.error(value.span(), problem))
@@ -652,6 +718,7 @@ impl ModelStructure {
             auto_range_limit,
             default_output_states,
             source_name: context.source_name.to_string(),
+            constants,
         })
     }
 
@@ -839,6 +906,39 @@ input = "u"
         assert_eq!(
             structure.parameter_value("d", &structure.values()),
             Some(-5.0)
+        );
+    }
+
+    #[test]
+    fn constants_enter_expressions_and_can_be_overridden() {
+        let text = SMALL
+            .replace("[parameters]", "[constants]\narm = 2.0\n\n[parameters]")
+            .replace("[F.x]\nx = \"a\"", "[F.x]\nx = \"a - arm*b\"");
+        let structure = ModelStructure::parse(&text, "arm.toml").unwrap();
+        assert_eq!(structure.constants["arm"], 2.0);
+        // F = a − arm·b = −2 − 2·3.
+        let model = structure.model(&structure.values()).unwrap();
+        assert_eq!(model.f[(0, 0)], -8.0);
+        // A constant is no parameter: nothing to fit.
+        assert!(structure.parameter_index("arm").is_none());
+
+        let overrides = BTreeMap::from([("arm".to_string(), 0.5)]);
+        let other = ModelStructure::parse_with_constants(&text, "arm.toml", &overrides).unwrap();
+        assert_eq!(other.constants["arm"], 0.5);
+        assert_eq!(other.model(&other.values()).unwrap().f[(0, 0)], -3.5);
+
+        let misspelt = BTreeMap::from([("amr".to_string(), 0.5)]);
+        let error = ModelStructure::parse_with_constants(&text, "arm.toml", &misspelt).unwrap_err();
+        assert!(
+            error.to_string().contains("unknown constant `amr`"),
+            "{error}"
+        );
+
+        let clash = text.replace("arm = 2.0", "arm = 2.0\nb = 1.0");
+        let error = ModelStructure::parse(&clash, "clash.toml").unwrap_err();
+        assert!(
+            error.to_string().contains("`b` is declared twice"),
+            "{error}"
         );
     }
 

@@ -80,10 +80,9 @@ pub fn paper_table1_range(output: &str, input: &str) -> Option<[f64; 2]> {
 /// the same values; a test in `host/cli/src/truth.rs` keeps them within 0.1 % of that
 /// mapping), rounded to five significant figures. It is the "truth" of synthetic tests and
 /// of the fit benchmark; the delays are the servos' equivalent delay.
-pub const BO105_HYBRID_REFERENCE: [(&str, f64); 39] = [
+pub const BO105_HYBRID_REFERENCE: [(&str, f64); 38] = [
     ("tau_f", 0.069563),
     ("Kcs", 0.066254),
-    ("Kpq", 0.0039972),
     ("Mfu", 0.0020702),
     ("Lfu", 0.0027085),
     ("Nb1s", 35.533),
