@@ -426,7 +426,7 @@ fn flap_row_parameters(
             let unit = coefficient.abs() == 1.0;
             candidates
                 .entry(name.clone())
-                .or_insert_with(Vec::new)
+                .or_default()
                 .push((mass * row_sign * a / coefficient, unit));
         }
     }
