@@ -5,7 +5,11 @@
 //! a set amount per step. A step that costs more is undone: that parameter is needed (the
 //! paper keeps Lf_lat for that reason) and stays in, flagged if it is, and the reduction
 //! goes on with the worst of the others — a needed parameter early in the order (say a
-//! heave damping) must not shield the unidentifiable ones behind it.
+//! heave damping) must not shield the unidentifiable ones behind it. When only needed
+//! parameters are left to drop, those found needed before a later drop was accepted are
+//! tried once more: the smaller model may not need them any longer (a speed derivative
+//! that carried a correlated one, dropped since, can then be flagged at CR 170 % and
+//! cost nothing to remove).
 
 use serde::{Deserialize, Serialize};
 
@@ -80,9 +84,20 @@ pub fn reduce(
         max_starts: options.max_starts.min(2),
         ..options.clone()
     };
-    // Parameters whose removal cost too much: kept, and not tried again.
-    let mut needed: Vec<String> = Vec::new();
-    while let Some((name, reason)) = worst_parameter(&current, options, &needed) {
+    // Parameters whose removal cost too much, with the number of accepted drops at the
+    // time: kept, and tried again only once more drops have been accepted since.
+    let mut needed: Vec<(String, usize)> = Vec::new();
+    let mut accepted_drops = 0usize;
+    loop {
+        let needed_names: Vec<String> = needed.iter().map(|(name, _)| name.clone()).collect();
+        let Some((name, reason)) = worst_parameter(&current, options, &needed_names) else {
+            let before = needed.len();
+            needed.retain(|(_, at)| *at == accepted_drops);
+            if needed.len() == before {
+                break;
+            }
+            continue;
+        };
         let mut smaller = current.structure.clone();
         let Some(index) = smaller.parameter_index(&name) else {
             break;
@@ -112,8 +127,11 @@ pub fn reduce(
             accepted,
         });
         match refit {
-            Some(refit) if accepted => current = refit,
-            _ => needed.push(name),
+            Some(refit) if accepted => {
+                current = refit;
+                accepted_drops += 1;
+            }
+            _ => needed.push((name, accepted_drops)),
         }
     }
     current.reduction = steps;
@@ -207,7 +225,9 @@ u = "b"
             .iter()
             .map(|s| (s.dropped.as_str(), s.accepted))
             .collect();
-        // Each parameter tried once; a and b restored, d dropped, whatever the order.
+        // Each parameter tried once; a and b restored, d dropped. (d, the most
+        // insensitive at its truth of 0, goes first; a and b are found needed after the
+        // last accepted drop, so the final pass has nothing to try again.)
         assert_eq!(tried.len(), 3, "{tried:?}");
         for (name, accepted) in &tried {
             assert_eq!(*accepted, *name == "d", "{tried:?}");
