@@ -18,13 +18,20 @@ pub fn six_dof() -> Result<ModelStructure, StructureError> {
 }
 
 /// The 9-DOF hybrid structure (both vehicles), with the rotor data of `vehicle` in it:
-/// the file is written for the Bo-105 — its `hub_height` constant and the flap
-/// cross-coupling `Kcs` it fixes from rotor theory — and another vehicle gets its own
-/// ([`bo105::Rotor::flap_cross_coupling`], the hub position of its main rotor).
+/// the file is written for the Bo-105 — its geometry constants (`hub_height`,
+/// `hub_forward`, `shaft_tilt_sine`) and the flap cross-coupling `Kcs` it fixes from rotor
+/// theory — and another vehicle gets its own ([`bo105::Rotor::flap_cross_coupling`], the
+/// hub position and shaft tilt of its main rotor).
 pub fn nine_dof_hybrid(vehicle: bo105::Vehicle) -> Result<ModelStructure, StructureError> {
     let helicopter = vehicle.helicopter();
-    // The hub is at body z = hub[2] (z down): its height above the CG is −hub[2].
-    let constants = BTreeMap::from([("hub_height".to_string(), -helicopter.main_rotor.hub[2])]);
+    // The hub is at body (x, z) = (hub[0], hub[2]) from the CG, z down: its height above
+    // the CG is −hub[2].
+    let hub = helicopter.main_rotor.hub;
+    let constants = BTreeMap::from([
+        ("hub_height".to_string(), -hub[2]),
+        ("hub_forward".to_string(), hub[0]),
+        ("shaft_tilt_sine".to_string(), helicopter.shaft_tilt.sin()),
+    ]);
     let mut structure = ModelStructure::parse_with_constants(
         NINE_DOF_HYBRID_TOML,
         "bo105-9dof-hybrid.toml (built in)",
@@ -82,9 +89,16 @@ mod tests {
         let file = ModelStructure::parse(NINE_DOF_HYBRID_TOML, "file").unwrap();
         let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105).unwrap();
         let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l).unwrap();
-        // The file's number is the Bo-105's hub position.
-        assert_eq!(file.constants["hub_height"], 1.48);
-        assert_eq!(bo105.constants["hub_height"], 1.48);
+        // The file's numbers are the Bo-105's geometry (to the digits written).
+        let bo105_data = bo105::Helicopter::bo105();
+        for (name, value) in [
+            ("hub_height", -bo105_data.main_rotor.hub[2]),
+            ("hub_forward", bo105_data.main_rotor.hub[0]),
+            ("shaft_tilt_sine", bo105_data.shaft_tilt.sin()),
+        ] {
+            assert!((file.constants[name] - value).abs() < 5e-4, "{name}");
+            assert_eq!(bo105.constants[name], value, "{name}");
+        }
         let trex_hub = -bo105::Helicopter::trex700l().main_rotor.hub[2];
         assert_eq!(trex.constants["hub_height"], trex_hub);
         assert!(trex_hub > 0.0 && trex_hub < 0.5, "{trex_hub}");
