@@ -80,7 +80,7 @@ pub fn paper_table1_range(output: &str, input: &str) -> Option<[f64; 2]> {
 /// the same values; a test in `host/cli/src/truth.rs` keeps them within 0.1 % of that
 /// mapping), rounded to five significant figures. It is the "truth" of synthetic tests and
 /// of the fit benchmark; the delays are the servos' equivalent delay.
-pub const BO105_HYBRID_REFERENCE: [(&str, f64); 38] = [
+pub const BO105_HYBRID_REFERENCE: [(&str, f64); 39] = [
     ("tau_f", 0.069562),
     ("Kcs", 0.066254),
     ("Mfu", 0.0020702),
@@ -108,6 +108,7 @@ pub const BO105_HYBRID_REFERENCE: [(&str, f64); 38] = [
     ("Yped", -1.455),
     ("Zcol", -14.562),
     ("Lcol", 0.7802),
+    ("Mcol", -0.89022),
     ("Lped", -1.819),
     ("Ncol", 3.0999),
     ("Nped", 4.3927),
