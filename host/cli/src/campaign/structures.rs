@@ -85,7 +85,7 @@ mod tests {
     }
 
     #[test]
-    fn the_hub_height_is_the_flown_vehicles() {
+    fn the_geometry_constants_are_the_flown_vehicles() {
         let file = ModelStructure::parse(NINE_DOF_HYBRID_TOML, "file").unwrap();
         let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105).unwrap();
         let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l).unwrap();
