@@ -2,6 +2,7 @@
 //! DERIVID-like), print the parameter table (value, Cramér–Rao bound, insensitivity,
 //! flags) and the cost per pair, and optionally write `model.json`.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs;
 use std::io::{self, Write};
@@ -56,6 +57,30 @@ pub struct FitArgs {
     /// truth and error % per parameter, J against the truth model per pair.
     #[arg(long, value_name = "VEHICLE")]
     pub truth: Option<bo105::Vehicle>,
+    /// Set one of the structure file's `[constants]`, e.g. `--constant hub_height=0.25` to
+    /// fit the shipped Bo-105 file to another aircraft's geometry; repeatable. A name the
+    /// file does not declare is an error.
+    #[arg(long = "constant", value_name = "NAME=VALUE", value_parser = parse_constant)]
+    pub constants: Vec<(String, f64)>,
+}
+
+/// `NAME=VALUE` of `--constant`.
+fn parse_constant(text: &str) -> Result<(String, f64), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("`{text}` is not NAME=VALUE"))?;
+    let name = name.trim();
+    if name.is_empty() {
+        return Err(format!("`{text}` has no name before `=`"));
+    }
+    let value: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{}` is not a number", value.trim()))?;
+    if !value.is_finite() {
+        return Err(format!("`{}` is not a finite number", value));
+    }
+    Ok((name.to_string(), value))
 }
 
 /// Run `sweephold fit`.
@@ -68,7 +93,8 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             args.frf.display()
         )
     })?;
-    let structure = ModelStructure::from_path(&args.model)?;
+    let constants: BTreeMap<String, f64> = args.constants.iter().cloned().collect();
+    let structure = ModelStructure::from_path_with_constants(&args.model, &constants)?;
     if args.points < 2 {
         bail!("--points must be at least 2");
     }
@@ -290,6 +316,7 @@ lat = "b"
             max_starts: 4,
             points: 20,
             truth: None,
+            constants: Vec::new(),
         };
         run(&args).unwrap();
         let document: ModelDocument =

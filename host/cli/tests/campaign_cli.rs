@@ -159,6 +159,46 @@ fn quick_campaign_report_and_errors() {
     assert!(stdout.contains("report.html"), "{stdout}");
     let summary = check_summary(&out);
 
+    // `fit --constant`: the shipped structure with another hub height reaches the model
+    // (Kpq = hub_height·Lfu); a constant the file does not declare is one line, exit 1.
+    let hybrid =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sysid/models/bo105-9dof-hybrid.toml");
+    let frf = out.join("frf.json");
+    let refit = dir.join("refit.json");
+    let fit_args = |constant: &str| {
+        sweephold(&[
+            "fit",
+            "--frf",
+            frf.to_str().unwrap(),
+            "--model",
+            hybrid.to_str().unwrap(),
+            "--max-starts",
+            "1",
+            "--constant",
+            constant,
+            "--out",
+            refit.to_str().unwrap(),
+        ])
+    };
+    let output = fit_args("hub_height=0.25");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let model: Value = serde_json::from_str(&std::fs::read_to_string(&refit).unwrap()).unwrap();
+    let value = |name: &str| {
+        let parameters = model["parameters"].as_array().expect("parameters");
+        let parameter = parameters.iter().find(|p| p["name"] == name).expect(name);
+        number(&parameter["value"], name)
+    };
+    assert!((value("Kpq") - 0.25 * value("Lfu")).abs() <= 1e-12 * value("Lfu").abs().max(1e-9));
+    let message = one_line_failure(&fit_args("hub_heigth=0.25"));
+    assert!(
+        message.contains("unknown constant `hub_heigth`"),
+        "{message}"
+    );
+
     // One <svg> at least per plot section; one Bode figure per fitted pair.
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(

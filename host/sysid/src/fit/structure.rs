@@ -401,13 +401,22 @@ impl ModelStructure {
 
     /// Read and parse a structure file.
     pub fn from_path(path: &Path) -> Result<Self, StructureError> {
+        Self::from_path_with_constants(path, &BTreeMap::new())
+    }
+
+    /// Read and parse a structure file with some of its `[constants]` replaced (see
+    /// [`Self::parse_with_constants`]).
+    pub fn from_path_with_constants(
+        path: &Path,
+        overrides: &BTreeMap<String, f64>,
+    ) -> Result<Self, StructureError> {
         let source_name = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|error| StructureError {
             source_name: source_name.clone(),
             line: None,
             problem: StructureProblem::Io(error.to_string()),
         })?;
-        Self::parse(&text, &source_name)
+        Self::parse_with_constants(&text, &source_name, overrides)
     }
 
     fn from_raw(
