@@ -454,7 +454,9 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
     let nine: FitResult = run.stage(Stage::Fit9Dof, |run| {
         // As `sweephold fit --start-from`: the 6-DOF's Eq. 26–27 starts and the file's
         // own, the lower J_ave kept and then reduced.
-        let hybrid = structures::nine_dof_hybrid(run.args.vehicle.sim())?;
+        // Kinematics and gravity about the trim the flight controller captured.
+        let trim = structures::TrimAttitude::captured(&cah_dumps)?;
+        let hybrid = structures::nine_dof_hybrid(run.args.vehicle.sim(), trim)?;
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
         let starts = [
             (files::MODEL_6DOF.to_string(), started),
