@@ -147,6 +147,46 @@ mod tests {
         );
     }
 
+    /// A dump holding a corrupt run of bytes and then one `TrimCaptured` event.
+    fn dump_with_trim(dir: &Path, name: &str, phi: f32, theta: f32) -> std::path::PathBuf {
+        use sweephold_protocol::codec::encode_to_vec;
+        use sweephold_protocol::Controls;
+        let event = Frame::Event(Event::TrimCaptured {
+            tick: 210,
+            sticks: Controls::from_array([0.0; 4]),
+            phi,
+            theta,
+            psi: 0.0,
+        });
+        let mut bytes = vec![0x55, 0x13, 0x00];
+        bytes.extend_from_slice(encode_to_vec(&event).unwrap().as_bytes());
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+
+    #[test]
+    fn the_trim_attitude_is_the_mean_of_the_dumps_captures() {
+        let dir = std::env::temp_dir().join(format!("sweephold-trim-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let dumps = [
+            dump_with_trim(&dir, "a.bin", -0.04, 0.03),
+            dump_with_trim(&dir, "b.bin", -0.06, 0.05),
+        ];
+        let trim = TrimAttitude::captured(&dumps).unwrap().unwrap();
+        assert!((trim.phi + 0.05).abs() < 1e-7, "{trim:?}");
+        assert!((trim.theta - 0.04).abs() < 1e-7, "{trim:?}");
+        // A dump without a capture contributes nothing; none at all gives None.
+        let empty = dir.join("empty.bin");
+        std::fs::write(&empty, [0u8; 16]).unwrap();
+        assert_eq!(TrimAttitude::captured(&[&empty]).unwrap(), None);
+        // A missing file is an error naming it.
+        let missing = dir.join("missing.bin");
+        let error = TrimAttitude::captured(&[&missing]).unwrap_err();
+        assert!(error.to_string().contains("missing.bin"), "{error}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
     #[test]
     fn a_captured_trim_attitude_sets_the_kinematics() {
         let trim = TrimAttitude {
