@@ -10,25 +10,14 @@
 //! `SWEEPHOLD_CR_SEEDS=N` changes the number of seeds.
 
 use std::path::Path;
-use std::process::Command;
 use std::time::Instant;
 
 const KEY_PARAMETERS: [&str; 9] = [
     "tau_f", "Lb1s", "Mb1c", "Zcol", "Nped", "Mf_lat", "Mf_lon", "Lf_lat", "Lf_lon",
 ];
 
-fn run(binary: &str, args: &[&str]) {
-    let output = Command::new(binary)
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {binary}: {e}"));
-    assert!(
-        output.status.success(),
-        "sweephold {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
+mod support;
+use support::run_sweephold as run;
 
 /// (value, CR bound in absolute units) of each key parameter in a model.json.
 fn key_estimates(model_json: &Path) -> Vec<(f64, f64)> {

@@ -8,7 +8,6 @@
 //! Run: `cargo bench -p sweephold --bench fit_campaign`
 
 use std::path::Path;
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use sysid::document::FrfDocument;
@@ -19,18 +18,8 @@ use sysid::fit::{
 const TARGET: Duration = Duration::from_secs(5);
 const REPEATS: usize = 3;
 
-fn run(binary: &str, args: &[String]) {
-    let output = Command::new(binary)
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {binary}: {e}"));
-    assert!(
-        output.status.success(),
-        "sweephold {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
+mod support;
+use support::run_sweephold as run;
 
 fn main() {
     let binary = env!("CARGO_BIN_EXE_sweephold");

@@ -140,19 +140,7 @@ mod tests {
 
     #[test]
     fn stage_names_are_unique_snake_case() {
-        let stages = [
-            Stage::Setup,
-            Stage::FlyCah,
-            Stage::FlyStandard,
-            Stage::FlyNoise,
-            Stage::FlyVerification,
-            Stage::Frf,
-            Stage::Fit6Dof,
-            Stage::Fit9Dof,
-            Stage::Truth,
-            Stage::Verify,
-            Stage::Report,
-        ];
+        let stages = Stage::ALL;
         let mut names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
         assert!(names.iter().all(|n| n
             .chars()
