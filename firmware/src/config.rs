@@ -150,7 +150,7 @@ impl std::error::Error for ConfigError {}
 
 /// The paper's test on `primary`: conditional attitude hold with off-axis noise, a 90 s
 /// sweep 0.3–31.4 rad/s at 5 % of stick travel, 2 s raised-cosine fades, no ω_min hold,
-/// 2 % RMS noise low-passed at ω_max, seed 1, hold engage 6° / release 4°.
+/// 3 % RMS noise low-passed at ω_max, seed 1, hold engage 6° / release 4°.
 pub const fn paper_test(primary: Axis) -> TestConfig {
     TestConfig {
         mode: ExcitationMode::ConditionalAttitudeHold,
