@@ -308,7 +308,9 @@ pub struct StartSetOutcome {
 /// and only then reduce it. A 6-DOF fit can land in a degenerate minimum (its roll
 /// damping and control power both huge, their ratio right) whose Eq. 26–27 starts are
 /// useless; the file's generic starts are the fallback. Each set gets its share of the
-/// perturbed restarts. Errors only when every set fails (the first set's error).
+/// perturbed restarts; the set with the lowest J_ave gets the whole `max_starts` when its
+/// minimum was not found twice within its share. Errors only when every set fails (the
+/// first set's error).
 pub fn fit_from_alternative_starts(
     starts: &[(String, ModelStructure)],
     data: &FrfDocument,
@@ -327,15 +329,16 @@ pub fn fit_from_alternative_starts(
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
     // The restart budget is shared: each set gets its part of `max_starts` (at least two,
-    // so that each can still confirm its minimum).
+    // so that each can still confirm its minimum). The set that reaches the lowest J_ave
+    // gets the whole budget afterwards if its minimum was not found twice.
     let per_set = FitOptions {
         max_starts: (options.max_starts / starts.len()).max(2),
         ..options.clone()
     };
-    let mut best: Option<FitResult> = None;
+    let mut best: Option<(usize, FitResult)> = None;
     let mut first_error = None;
     let mut outcomes = Vec::with_capacity(starts.len());
-    for (label, structure) in starts {
+    for (set, (label, structure)) in starts.iter().enumerate() {
         let (usable, _) = usable_pairs(structure, data, options.min_auto_range_ratio);
         match fit_on_grids(&usable, &grids, &per_set) {
             Ok(result) => {
@@ -345,9 +348,9 @@ pub fn fit_from_alternative_starts(
                 });
                 if best
                     .as_ref()
-                    .is_none_or(|b| result.average_cost < b.average_cost)
+                    .is_none_or(|(_, b)| result.average_cost < b.average_cost)
                 {
-                    best = Some(result);
+                    best = Some((set, result));
                 }
             }
             Err(error) => {
@@ -359,11 +362,26 @@ pub fn fit_from_alternative_starts(
             }
         }
     }
-    let Some(mut result) = best else {
+    let Some((best_set, mut result)) = best else {
         return Err(first_error.unwrap_or(FitError::StartValues(
             "no set of start values to fit from".into(),
         )));
     };
+    // The lowest minimum is only taken once found twice (CIFER's rule). Seed 8 of the
+    // 20-seed campaign: both sets stopped unconfirmed after four starts each (J_ave 280
+    // and 190); the file's set, given all eight, found J_ave 25 twice. Its first starts
+    // are repeated (the perturbations are drawn from the same seed), so the refit
+    // reaches at least the same minimum.
+    if !result.minimum_confirmed && per_set.max_starts < options.max_starts {
+        let (usable, _) = usable_pairs(&starts[best_set].1, data, options.min_auto_range_ratio);
+        let refit = fit_on_grids(&usable, &grids, options)?;
+        if refit.average_cost <= result.average_cost {
+            if let Some(outcome) = outcomes.get_mut(best_set) {
+                outcome.average_cost = Ok(refit.average_cost);
+            }
+            result = refit;
+        }
+    }
     if options.reduce {
         result = reduce::reduce(result, &grids, options)?;
     }
