@@ -428,48 +428,7 @@ impl ModelStructure {
         let controls = context.names(&raw.controls, "control")?;
         let outputs = context.names(&raw.outputs, "output")?;
 
-        let mut constants = BTreeMap::new();
-        for (key, value) in &raw.constants {
-            let name = key.get_ref().clone();
-            if !value.get_ref().is_finite() {
-                return Err(context.error(
-                    value.span(),
-                    StructureProblem::BadParameter {
-                        name,
-                        reason: "a constant must be a finite number".to_string(),
-                    },
-                ));
-            }
-            if raw.parameters.keys().any(|p| p.get_ref() == &name) {
-                return Err(context.error(key.span(), StructureProblem::DuplicateName(name)));
-            }
-            constants.insert(name, *value.get_ref());
-        }
-        for (name, &value) in overrides {
-            match constants.get_mut(name) {
-                Some(slot) if value.is_finite() => *slot = value,
-                Some(_) => {
-                    return Err(StructureError {
-                        source_name: context.source_name.to_string(),
-                        line: None,
-                        problem: StructureProblem::BadParameter {
-                            name: name.clone(),
-                            reason: "a constant must be a finite number".to_string(),
-                        },
-                    })
-                }
-                None => {
-                    return Err(StructureError {
-                        source_name: context.source_name.to_string(),
-                        line: None,
-                        problem: StructureProblem::UnknownName {
-                            kind: "constant",
-                            name: name.clone(),
-                        },
-                    })
-                }
-            }
-        }
+        let constants = file_constants(&raw, context, overrides)?;
         if states.is_empty() || controls.is_empty() || outputs.is_empty() {
             return Err(context.error(
                 raw.name.span(),
@@ -846,6 +805,58 @@ fn check_band(band: &[f64]) -> Result<[f64; 2], String> {
         [_, _] => Err("need 0 < lo < hi".into()),
         _ => Err(format!("need two numbers [lo, hi], got {}", band.len())),
     }
+}
+
+/// The file's `[constants]` with the caller's overrides applied. A constant must be a finite
+/// number and must not share a parameter's name; an override must name a declared constant.
+fn file_constants(
+    raw: &RawStructure,
+    context: &Context<'_>,
+    overrides: &BTreeMap<String, f64>,
+) -> Result<BTreeMap<String, f64>, StructureError> {
+    let mut constants = BTreeMap::new();
+    for (key, value) in &raw.constants {
+        let name = key.get_ref().clone();
+        if !value.get_ref().is_finite() {
+            return Err(context.error(
+                value.span(),
+                StructureProblem::BadParameter {
+                    name,
+                    reason: "a constant must be a finite number".to_string(),
+                },
+            ));
+        }
+        if raw.parameters.keys().any(|p| p.get_ref() == &name) {
+            return Err(context.error(key.span(), StructureProblem::DuplicateName(name)));
+        }
+        constants.insert(name, *value.get_ref());
+    }
+    for (name, &value) in overrides {
+        match constants.get_mut(name) {
+            Some(slot) if value.is_finite() => *slot = value,
+            Some(_) => {
+                return Err(StructureError {
+                    source_name: context.source_name.to_string(),
+                    line: None,
+                    problem: StructureProblem::BadParameter {
+                        name: name.clone(),
+                        reason: "a constant must be a finite number".to_string(),
+                    },
+                })
+            }
+            None => {
+                return Err(StructureError {
+                    source_name: context.source_name.to_string(),
+                    line: None,
+                    problem: StructureProblem::UnknownName {
+                        kind: "constant",
+                        name: name.clone(),
+                    },
+                })
+            }
+        }
+    }
+    Ok(constants)
 }
 
 #[cfg(test)]
