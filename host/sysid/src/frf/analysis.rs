@@ -530,11 +530,7 @@ const CROSS_COHERENCE_MIN_PERIODS: f64 = 4.0;
 /// The windows that estimate the cross-control coherence at grid point `k` (frequency
 /// `omega`): those spanning at least [`CROSS_COHERENCE_MIN_PERIODS`] periods; where
 /// none does (the bottom of the band), the longest window that resolves ω at all.
-fn cross_coherence_windows<'a>(
-    spectra: &'a [WindowSpectra],
-    k: usize,
-    omega: f64,
-) -> Vec<&'a WindowSpectra> {
+fn cross_coherence_windows(spectra: &[WindowSpectra], k: usize, omega: f64) -> Vec<&WindowSpectra> {
     let resolving = spectra.iter().filter(|s| k >= s.valid_from);
     let periods = |s: &WindowSpectra| omega * s.seconds / std::f64::consts::TAU;
     let long_enough: Vec<&WindowSpectra> = resolving
