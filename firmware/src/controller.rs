@@ -586,7 +586,6 @@ fn step_axis(
         0.0
     };
     let previous = held.state;
-    let gains = &input.gains;
     let (state, perturbation, sweep, noise) = match mode {
         ExcitationMode::ConditionalAttitudeHold => {
             match next_hold_state(previous, input.hold_angle, thresholds) {
@@ -605,18 +604,7 @@ fn step_axis(
                     (HoldState::Released, sweep + noise + carry, sweep, noise)
                 }
                 HoldState::Engaged => {
-                    if previous != HoldState::Engaged {
-                        let last = held.last_perturbation;
-                        held.controller
-                            .engage(gains, input.deviation, input.rate, last);
-                    }
-                    let output = held.controller.update_with_decay(
-                        gains,
-                        input.deviation,
-                        input.rate,
-                        dt_s,
-                        input.decay.transfer,
-                    );
+                    let output = controller_output(held, input, previous, dt_s);
                     (HoldState::Engaged, output, 0.0, 0.0)
                 }
                 HoldState::Frozen => (HoldState::Frozen, held.last_perturbation, 0.0, 0.0),
@@ -625,18 +613,7 @@ fn step_axis(
         // Standard and off-axis-noise methods: the controller always drives the axis and
         // the excitation is added on top.
         ExcitationMode::Standard | ExcitationMode::OffAxisNoise => {
-            if previous != HoldState::Engaged {
-                let last = held.last_perturbation;
-                held.controller
-                    .engage(gains, input.deviation, input.rate, last);
-            }
-            let output = held.controller.update_with_decay(
-                gains,
-                input.deviation,
-                input.rate,
-                dt_s,
-                input.decay.transfer,
-            );
+            let output = controller_output(held, input, previous, dt_s);
             (HoldState::Engaged, output + sweep + noise, sweep, noise)
         }
     };
@@ -647,6 +624,29 @@ fn step_axis(
         sweep,
         noise,
     }
+}
+
+/// The attitude-hold controller's output this tick. A controller that was not driving the
+/// axis the tick before is engaged first, bumplessly from the last command.
+fn controller_output(
+    held: &mut HeldAxis,
+    input: &AxisInput,
+    previous: HoldState,
+    dt_s: f32,
+) -> f32 {
+    let gains = &input.gains;
+    if previous != HoldState::Engaged {
+        let last = held.last_perturbation;
+        held.controller
+            .engage(gains, input.deviation, input.rate, last);
+    }
+    held.controller.update_with_decay(
+        gains,
+        input.deviation,
+        input.rate,
+        dt_s,
+        input.decay.transfer,
+    )
 }
 
 /// exp(−dt/τ): the per-tick factor of a first-order fade with time constant τ (0: gone
