@@ -19,17 +19,12 @@ const SECONDS: f64 = 180.0;
 const TARGET: Duration = Duration::from_millis(500);
 const REPETITIONS: usize = 9;
 
-/// SplitMix64 uniform in (−1, 1): reproducible noise without a dependency.
-struct Noise(u64);
+/// Uniform noise in [−1, 1): reproducible, from the crate's generator.
+struct Noise(sysid::random::SplitMix64);
 
 impl Noise {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        self.0.symmetric()
     }
 }
 
@@ -46,7 +41,7 @@ fn sweep(t: f64) -> f64 {
 fn record(primary: usize, seed: u64) -> Record {
     let names = ["lat", "lon", "ped", "col"];
     let len = (SECONDS * RATE) as usize;
-    let mut noise = Noise(seed);
+    let mut noise = Noise(sysid::random::SplitMix64::new(seed));
     let mut inputs: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(len)).collect();
     let mut filtered = [0.0f64; 4];
     for k in 0..len {

@@ -5,3 +5,4 @@
 pub mod document;
 pub mod fit;
 pub mod frf;
+pub mod random;

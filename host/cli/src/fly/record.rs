@@ -5,6 +5,7 @@ use sweephold_firmware::Config;
 use sweephold_protocol::{
     Controls, Decoder, Event, Frame, HoldState, Measurements, Phase, PilotInput, Sample, SensorIn,
 };
+use sysid::random::SplitMix64;
 
 use super::link::FlightControllerLink;
 use super::summary::{HoldFraction, MaxAbsDeg};
@@ -147,7 +148,9 @@ pub fn fly_record(
     options.spike_probability = disturbances.sensor_spike;
     let mut sim = Sim::at_trim(aircraft.heli.clone(), trim, options);
     let trim_sticks = trim.controls.map(|c| c as f32);
-    let mut pilot_rng = SplitMix(u64::from(config.test.seed) ^ 0x9170_7D15_7A2B);
+    let mut pilot_rng = SplitMix(SplitMix64::new(
+        u64::from(config.test.seed) ^ 0x9170_7D15_7A2B,
+    ));
 
     link.begin_record(config)?;
     let mut dump = Vec::with_capacity((max_s * rate) as usize * 140);
@@ -219,22 +222,13 @@ pub fn measurements(r: &bo105::SensorReading) -> Measurements {
     }
 }
 
-/// splitmix64 with a Box–Muller Gaussian, for the simulated pilot's hands.
-struct SplitMix(u64);
+/// SplitMix64 with a Box–Muller Gaussian (the cosine branch only), for the simulated
+/// pilot's hands.
+struct SplitMix(SplitMix64);
 
 impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        ((self.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
     fn gaussian(&mut self) -> f64 {
-        let (a, b) = (self.unit(), self.unit());
+        let (a, b) = (self.0.unit_open(), self.0.unit_open());
         (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
     }
 }

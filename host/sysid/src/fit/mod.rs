@@ -500,7 +500,7 @@ pub(crate) fn fit_on_grids(
     };
 
     let first_start = DVector::from_iterator(free.len(), free.iter().map(|&i| base[i]));
-    let mut random = optimizer::SplitMix64::new(options.seed);
+    let mut random = crate::random::SplitMix64::new(options.seed);
     let mut starts = Vec::new();
     let mut finals: Vec<(DVector<f64>, f64)> = Vec::new();
     let mut minimum_confirmed = false;

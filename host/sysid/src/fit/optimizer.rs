@@ -19,6 +19,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::error::FitError;
+use crate::random::SplitMix64;
 
 /// Stopping rules of one Levenberg–Marquardt run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -237,35 +238,6 @@ where
         iterations,
         reason,
     })
-}
-
-/// SplitMix64: a small, fast, deterministic generator (Steele, Lea & Flood 2014).
-#[derive(Clone, Debug)]
-pub struct SplitMix64 {
-    state: u64,
-}
-
-impl SplitMix64 {
-    /// A generator from a seed.
-    pub fn new(seed: u64) -> Self {
-        Self { state: seed }
-    }
-
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [−1, 1).
-    pub fn symmetric(&mut self) -> f64 {
-        // 53 random mantissa bits → [0, 1), then map to [−1, 1).
-        let unit = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        2.0 * unit - 1.0
-    }
 }
 
 /// A perturbed start: each value scaled by (1 + spread·U(−1, 1)); zeros get an additive

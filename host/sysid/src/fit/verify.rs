@@ -752,15 +752,9 @@ mod tests {
             })
             .collect();
         let clean = simulate(model, &inputs, rate).unwrap();
-        // Deterministic pseudo-noise (SplitMix-like hash), scaled to `noise` × RMS.
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            seed = seed.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = seed;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) as f64 / u64::MAX as f64) * 2.0 - 1.0
-        };
+        // Deterministic pseudo-noise, scaled to `noise` × RMS.
+        let mut random = crate::random::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || random.symmetric();
         let outputs = model
             .outputs
             .iter()

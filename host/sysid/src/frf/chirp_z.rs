@@ -283,16 +283,10 @@ mod tests {
 
     /// A deterministic pseudo-random sequence (SplitMix64), values in [−1, 1).
     fn pseudo_random(len: usize, seed: u64) -> Vec<Complex64> {
-        let mut state = seed;
-        let mut next = || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        (0..len).map(|_| Complex64::new(next(), next())).collect()
+        let mut random = crate::random::SplitMix64::new(seed);
+        (0..len)
+            .map(|_| Complex64::new(random.symmetric(), random.symmetric()))
+            .collect()
     }
 
     fn relative_error(x: &[Complex64], start: f64, step: f64, m: usize) -> f64 {

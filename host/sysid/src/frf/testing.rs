@@ -8,6 +8,7 @@ use sweephold_protocol::{
 };
 
 use super::records::{Channel, Record};
+use crate::random::SplitMix64;
 
 /// Tischler's exponential sweep, closed form (DESIGN.md §1):
 /// θ(t) = ω_min t + (ω_max − ω_min)·C2·[(T/C1)(e^{C1 t/T} − 1) − t], C1 = 4,
@@ -43,25 +44,20 @@ impl Sweep {
 
 /// SplitMix64 with Box–Muller: reproducible Gaussian noise without a dependency.
 pub struct Noise {
-    state: u64,
+    random: SplitMix64,
     spare: Option<f64>,
 }
 
 impl Noise {
     pub fn new(seed: u64) -> Noise {
         Noise {
-            state: seed,
+            random: SplitMix64::new(seed),
             spare: None,
         }
     }
 
     fn uniform(&mut self) -> f64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        self.random.unit_open()
     }
 
     /// A standard normal deviate.
