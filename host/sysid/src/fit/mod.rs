@@ -756,6 +756,44 @@ mod tests {
         }
     }
 
+    /// Two sets share `max_starts`; the one with the lower J_ave gets all of it when its
+    /// minimum was not found twice within its share (a zero tolerance: no two starts of
+    /// imperfect data end at the same J_ave to the last bit).
+    #[test]
+    fn an_unconfirmed_best_set_gets_the_whole_budget() {
+        let structure = first_order_structure();
+        let truth = structure.values();
+        let mut document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 60);
+        for pair in &mut document.pairs {
+            for (k, value) in pair.mag_db.iter_mut().enumerate() {
+                *value += 0.3 * ((k * 7) as f64).sin();
+            }
+        }
+        let hopeless = structure.with_values(&[-50.0, -300.0, 0.09]).unwrap();
+        let good = structure.with_values(&[-1.2, 3.3, 0.02]).unwrap();
+        let starts = vec![
+            ("hopeless".to_string(), hopeless),
+            ("good".to_string(), good),
+        ];
+        let strict = FitOptions {
+            max_starts: 6,
+            same_minimum_tolerance: 0.0,
+            ..FitOptions::default()
+        };
+        let (result, outcomes) = fit_from_alternative_starts(&starts, &document, &strict).unwrap();
+        assert!(!result.minimum_confirmed);
+        assert_eq!(result.starts.len(), 6, "{:?}", result.starts);
+        assert_eq!(outcomes[1].average_cost, Ok(result.average_cost));
+        // With the usual tolerance the good set confirms within its share of three.
+        let usual = FitOptions {
+            max_starts: 6,
+            ..FitOptions::default()
+        };
+        let (result, _) = fit_from_alternative_starts(&starts, &document, &usual).unwrap();
+        assert!(result.minimum_confirmed);
+        assert!(result.starts.len() <= 3, "{:?}", result.starts);
+    }
+
     #[test]
     fn fit_is_deterministic_for_a_seed() {
         let structure = first_order_structure();
