@@ -45,7 +45,8 @@ pub struct FitOptions {
     pub points_per_pair: usize,
     /// Levenberg–Marquardt iteration limit per start.
     pub max_iterations: usize,
-    /// Most starts (the first from the structure's start values, the rest perturbed).
+    /// Most starts (the first from the structure's start values, exact zeros nudged to
+    /// 1e−3; the rest perturbed).
     pub max_starts: usize,
     /// Perturbation of restarts: each free value × (1 + spread·U(−1, 1)).
     pub start_spread: f64,
@@ -272,6 +273,10 @@ impl FitResult {
         ModelDocument::from_result(self)
     }
 }
+
+/// What a free parameter starting at exactly zero starts at instead (the first start;
+/// the perturbed ones add spread·U(−1, 1)·0.1 to it).
+const ZERO_START_NUDGE: f64 = 1e-3;
 
 /// Fit `structure` to the responses in `data`.
 pub fn fit(
@@ -511,6 +516,13 @@ pub(crate) fn fit_on_grids(
     for start_number in 0..options.max_starts.max(1) {
         let start = if start_number == 0 {
             let mut x = first_start.clone();
+            // A free parameter at exactly zero makes the responses it alone carries
+            // exactly zero, −600 dB on the magnitude floor: J ~10⁶ and a log-magnitude
+            // residual with no usable gradient, so the start goes nowhere (the 6-DOF
+            // file's zero couplings: its first start ended at J_ave 1.8·10⁶, now 63).
+            for value in x.iter_mut().filter(|value| **value == 0.0) {
+                *value = ZERO_START_NUDGE;
+            }
             bounds.project(&mut x);
             x
         } else {
@@ -694,6 +706,24 @@ mod tests {
         assert!(result.average_cost < 1e-12, "J_ave {}", result.average_cost);
         assert!(result.minimum_confirmed);
         assert!(result.starts.len() >= 2);
+    }
+
+    /// A gain starting at exactly zero makes its responses exactly zero (−600 dB on the
+    /// magnitude floor), where the log-magnitude residual has no usable gradient: the
+    /// first start nudges it off zero and then converges by itself.
+    #[test]
+    fn a_parameter_starting_at_zero_is_fitted_from_the_first_start() {
+        let structure = first_order_structure();
+        let truth = structure.values();
+        let document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 20);
+        let start = structure.with_values(&[-2.8, 0.0, 0.02]).unwrap();
+        let options = FitOptions {
+            max_starts: 1,
+            ..FitOptions::default()
+        };
+        let result = fit(&start, &document, &options).unwrap();
+        assert!(result.average_cost < 1e-9, "J_ave {}", result.average_cost);
+        assert_recovered(&result, &structure, &truth);
     }
 
     #[test]
