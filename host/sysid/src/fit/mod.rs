@@ -789,16 +789,23 @@ mod tests {
     /// Two sets share `max_starts`; the one with the lower J_ave gets all of it when its
     /// minimum was not found twice within its share (a zero tolerance: no two starts of
     /// imperfect data end at the same J_ave to the last bit).
-    #[test]
-    fn an_unconfirmed_best_set_gets_the_whole_budget() {
-        let structure = first_order_structure();
+    /// Responses of the first-order structure with a deterministic ripple on the
+    /// magnitudes, so that the minimum is not exact and restarts matter.
+    fn imperfect_first_order_document(structure: &ModelStructure) -> FrfDocument {
         let truth = structure.values();
-        let mut document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 60);
+        let mut document = synthetic_document(&structure.model(&truth).unwrap(), structure, 60);
         for pair in &mut document.pairs {
             for (k, value) in pair.mag_db.iter_mut().enumerate() {
                 *value += 0.3 * ((k * 7) as f64).sin();
             }
         }
+        document
+    }
+
+    #[test]
+    fn an_unconfirmed_best_set_gets_the_whole_budget() {
+        let structure = first_order_structure();
+        let document = imperfect_first_order_document(&structure);
         let hopeless = structure.with_values(&[-50.0, -300.0, 0.09]).unwrap();
         let good = structure.with_values(&[-1.2, 3.3, 0.02]).unwrap();
         let starts = vec![
@@ -827,14 +834,7 @@ mod tests {
     #[test]
     fn fit_is_deterministic_for_a_seed() {
         let structure = first_order_structure();
-        let truth = structure.values();
-        let mut document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 60);
-        // Imperfect data so that the minimum is not exact and restarts matter.
-        for pair in &mut document.pairs {
-            for (k, value) in pair.mag_db.iter_mut().enumerate() {
-                *value += 0.3 * ((k * 7) as f64).sin();
-            }
-        }
+        let document = imperfect_first_order_document(&structure);
         let options = FitOptions {
             seed: 42,
             ..FitOptions::default()
