@@ -523,7 +523,7 @@ fn curves_from_spectra(prepared: &PreparedGroup, spectra: &[WindowSpectra]) -> V
 /// so such windows read it as partly unrelated (Carter's misalignment bias). With the
 /// averages-weighted mean below, the shortest window that resolves ω dominates: a
 /// noise-free second-order response (1 rad/s, ζ 0.3) of a 0.2–31.4 rad/s sweep read 0.77
-/// from two periods on and 0.88 from four (`a_control_driven_through_dynamics_reads_coherent`),
+/// from two periods on and 0.90 from four (`a_control_driven_through_dynamics_reads_coherent`),
 /// while unrelated noise stays near zero either way.
 const CROSS_COHERENCE_MIN_PERIODS: f64 = 4.0;
 
