@@ -84,6 +84,7 @@ fn record(primary: usize, seed: u64) -> Record {
             .map(|(n, v)| Channel::new(*n, v))
             .collect(),
         outputs,
+        references: Vec::new(),
         notes: Vec::new(),
     }
 }

@@ -784,6 +784,7 @@ mod tests {
                 })
                 .collect(),
             outputs,
+            references: Vec::new(),
             notes: Vec::new(),
         }
     }

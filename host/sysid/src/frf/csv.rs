@@ -232,6 +232,7 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
             .zip(outputs)
             .map(|((name, _), values)| Channel::new(name.clone(), values))
             .collect(),
+        references: Vec::new(),
         notes,
     };
     record.validate()?;

@@ -59,6 +59,20 @@ fn is_excitation(phase: Phase) -> bool {
     matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
 }
 
+/// The commands `lat lon ped col`, then the excitation injected into each (sweep +
+/// off-axis noise): the reference channels.
+fn input_row(sample: &Sample) -> [f64; 8] {
+    let command = sample.command.to_array();
+    let sweep = sample.sweep.to_array();
+    let noise = sample.noise.to_array();
+    let mut row = [0.0; 8];
+    for i in 0..4 {
+        row[i] = f64::from(command[i]);
+        row[4 + i] = f64::from(sweep[i]) + f64::from(noise[i]);
+    }
+    row
+}
+
 fn outputs_of(sample: &Sample) -> [f64; 11] {
     let m = &sample.meas;
     [
@@ -212,12 +226,13 @@ fn record_from_samples_with(
         });
     }
 
-    // Rows on the tick grid, with gaps filled by linear interpolation.
-    let mut inputs: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(span)).collect();
+    // Rows on the tick grid, with gaps filled by linear interpolation. Each input row is
+    // the four commands followed by the four references (sweep + noise injected).
+    let mut inputs: Vec<Vec<f64>> = (0..8).map(|_| Vec::with_capacity(span)).collect();
     let mut outputs: Vec<Vec<f64>> = (0..11).map(|_| Vec::with_capacity(span)).collect();
-    let mut previous: Option<(u32, [f64; 4], [f64; 11])> = None;
+    let mut previous: Option<(u32, [f64; 8], [f64; 11])> = None;
     for sample in samples {
-        let command = sample.command.to_array().map(f64::from);
+        let command = input_row(sample);
         let output = outputs_of(sample);
         if let Some((tick, last_in, last_out)) = previous {
             let step = sample.tick.wrapping_sub(tick);
@@ -243,6 +258,7 @@ fn record_from_samples_with(
         }
         previous = Some((sample.tick, command, output));
     }
+    let references = inputs.split_off(4);
 
     let mut notes = Vec::new();
     if missing > 0 {
@@ -268,6 +284,11 @@ fn record_from_samples_with(
             .zip(outputs)
             .map(|(name, values)| Channel::new(*name, values))
             .collect(),
+        references: DUMP_INPUTS
+            .iter()
+            .zip(references)
+            .map(|(name, values)| Channel::new(*name, values))
+            .collect(),
         notes,
     };
     record.validate()?;
@@ -289,6 +310,20 @@ mod tests {
         assert_eq!(record.len(), spec.sweep_samples);
         assert_eq!(record.inputs.len(), 4);
         assert_eq!(record.outputs.len(), 11);
+        // References: sweep + noise of each control (the synthetic dump injects 1.5 ×
+        // the command).
+        assert_eq!(record.references.len(), 4);
+        let (lat, reference) = (
+            record.input("lat").unwrap(),
+            record.reference("lat").unwrap(),
+        );
+        assert!(lat.iter().any(|&v| v != 0.0));
+        for (command, reference) in lat.iter().zip(reference) {
+            assert!(
+                (reference - 1.5 * command).abs() < 1e-6,
+                "{reference} vs {command}"
+            );
+        }
         let band = record.sweep_band.unwrap();
         assert!((band[0] - 0.5).abs() < 1e-6 && (band[1] - 20.0).abs() < 1e-5);
         // The first excitation sample carries its own tick value in `p` (see DumpSpec).

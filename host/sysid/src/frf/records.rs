@@ -48,6 +48,11 @@ pub struct Record {
     pub inputs: Vec<Channel>,
     /// Output channels (responses), e.g. `u v w p q r ax ay az phi theta`.
     pub outputs: Vec<Channel>,
+    /// Reference channels: for an input, the excitation the flight controller injected
+    /// into it (sweep and off-axis noise, not the hold controller's share), named after
+    /// that input. Empty when unknown (CSV records). Only the reference estimator
+    /// ([`ResponseEstimator::SweepReference`](super::ResponseEstimator::SweepReference)) reads them.
+    pub references: Vec<Channel>,
     /// Remarks made while loading (gaps filled, …); copied into the document's notes.
     pub notes: Vec<String>,
 }
@@ -87,8 +92,17 @@ impl Record {
             .map(|c| c.values.as_slice())
     }
 
+    /// The reference (injected excitation) of the input called `name`.
+    pub fn reference(&self, name: &str) -> Option<&[f64]> {
+        self.references
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
+
     /// Check the record: positive finite rate, the primary among the inputs, at least one
-    /// output, equal channel lengths, unique names, finite samples, a sane band.
+    /// output, equal channel lengths, unique names, finite samples, a sane band, each
+    /// reference named after an input.
     pub fn validate(&self) -> Result<(), FrfError> {
         let bad = |message: String| {
             Err(FrfError::InvalidRecord {
@@ -109,12 +123,30 @@ impl Record {
             return bad("no output channels".into());
         }
         let len = self.len();
-        let channels = self.inputs.iter().chain(&self.outputs);
         let mut names = std::collections::HashSet::new();
-        for channel in channels {
+        for channel in self.inputs.iter().chain(&self.outputs) {
             if !names.insert(channel.name.as_str()) {
                 return bad(format!("channel `{}` appears twice", channel.name));
             }
+        }
+        let mut referenced = std::collections::HashSet::new();
+        for reference in &self.references {
+            if self.input(&reference.name).is_none() {
+                return bad(format!(
+                    "reference `{}` is not named after an input",
+                    reference.name
+                ));
+            }
+            if !referenced.insert(reference.name.as_str()) {
+                return bad(format!("reference `{}` appears twice", reference.name));
+            }
+        }
+        for channel in self
+            .inputs
+            .iter()
+            .chain(&self.outputs)
+            .chain(&self.references)
+        {
             if channel.values.len() != len {
                 return bad(format!(
                     "channel `{}` has {} samples, others {len}",
@@ -165,6 +197,7 @@ impl RecordGroup {
                 ))
             } else if names(&record.inputs) != names(&first.inputs)
                 || names(&record.outputs) != names(&first.outputs)
+                || names(&record.references) != names(&first.references)
             {
                 Some("has other channels".to_string())
             } else {
@@ -239,11 +272,22 @@ impl RecordGroup {
         let outputs = (0..first.outputs.len())
             .map(|i| Channel::new(first.outputs[i].name.clone(), join(&|r| &r.outputs, i)))
             .collect();
+        // Same detrend and join tapers as the inputs: the reference estimate relates the
+        // references to the inputs and outputs window by window.
+        let references = (0..first.references.len())
+            .map(|i| {
+                Channel::new(
+                    first.references[i].name.clone(),
+                    join(&|r| &r.references, i),
+                )
+            })
+            .collect();
         JoinedRecord {
             sample_rate_hz: first.sample_rate_hz,
             primary: first.primary.clone(),
             inputs,
             outputs,
+            references,
         }
     }
 }
@@ -259,6 +303,8 @@ pub struct JoinedRecord {
     pub inputs: Vec<Channel>,
     /// Output channels.
     pub outputs: Vec<Channel>,
+    /// Reference channels (see [`Record::references`]).
+    pub references: Vec<Channel>,
 }
 
 impl JoinedRecord {
@@ -356,6 +402,7 @@ mod tests {
             sweep_band: Some([1.0, 10.0]),
             inputs: vec![Channel::new("lat", lat)],
             outputs: vec![Channel::new("p", p)],
+            references: Vec::new(),
             notes: vec![],
         }
     }

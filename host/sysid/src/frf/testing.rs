@@ -211,6 +211,7 @@ pub fn record(
             .into_iter()
             .map(|(n, v)| Channel::new(n, v))
             .collect(),
+        references: Vec::new(),
         notes: vec![],
     }
 }
@@ -310,8 +311,10 @@ pub fn dump_bytes(spec: &DumpSpec) -> Vec<u8> {
             sweep_omega: 0.0,
             hold: [HoldState::Released; 3],
             command: Controls::from_array(command),
-            sweep: Controls::default(),
-            noise: Controls::default(),
+            // The injected excitation: the commands themselves, split 2:1 between
+            // sweep and noise (the dump's references are 1.5 × the commands).
+            sweep: Controls::from_array(command),
+            noise: Controls::from_array(command.map(|c| 0.5 * c)),
             pilot: Controls::default(),
             meas,
         })

@@ -281,7 +281,12 @@ fn clear_refusals() {
     let rec = load_dump_bytes(&simulated_dump(40.0), "sim.dump").unwrap();
     // Too short for the band.
     let mut short = rec.clone();
-    for c in short.inputs.iter_mut().chain(short.outputs.iter_mut()) {
+    for c in short
+        .inputs
+        .iter_mut()
+        .chain(short.outputs.iter_mut())
+        .chain(short.references.iter_mut())
+    {
         c.values.truncate(300);
     }
     let err = compute_frequency_responses(
