@@ -9,7 +9,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 use sysid::frf::{
     analyse, group_by_primary, load_csv, load_dump, write_plots, CsvColumns, FrfAnalysis,
-    FrfOptions, Record,
+    FrfOptions, Record, ResponseEstimator,
 };
 
 /// Arguments of `sweephold frf`.
@@ -50,6 +50,9 @@ pub struct FrfArgs {
     /// Number of log-spaced frequencies.
     #[arg(long, value_name = "N", default_value_t = 200)]
     pub points: usize,
+    /// How the conditioned responses are estimated.
+    #[arg(long, value_enum, default_value_t = EstimatorArg::Cross)]
+    pub estimator: EstimatorArg,
     /// CSV: the time column [s].
     #[arg(long, value_name = "COLUMN", default_value = "time_s")]
     pub time: String,
@@ -77,6 +80,26 @@ pub struct FrfArgs {
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--estimator`: see [`ResponseEstimator`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EstimatorArg {
+    /// Cross-spectral H = Guu⁻¹·Guy (CIFER's MISOSA)
+    Cross,
+    /// The recorded sweep as instrument of the swept control: free of the bias an engaged
+    /// hold puts into the cross-spectral estimate by feeding sensor noise into the stick,
+    /// but more scattered (see the README); dumps only
+    SweepReference,
+}
+
+impl From<EstimatorArg> for ResponseEstimator {
+    fn from(arg: EstimatorArg) -> ResponseEstimator {
+        match arg {
+            EstimatorArg::Cross => ResponseEstimator::CrossSpectral,
+            EstimatorArg::SweepReference => ResponseEstimator::SweepReference,
+        }
+    }
 }
 
 /// A frequency band [rad/s] as given on the command line.
@@ -124,6 +147,7 @@ impl FrfArgs {
             windows: self.windows,
             overlap: self.overlap,
             coherence_threshold: self.coherence_threshold,
+            estimator: self.estimator.into(),
             ..FrfOptions::default()
         }
     }

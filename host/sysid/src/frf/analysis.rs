@@ -25,8 +25,9 @@ use crate::document::{CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VE
 use super::coherence::{debiased_coherence, random_error, valid_range};
 use super::composite::{blend, Estimate};
 use super::miso::{InputFactor, MAX_INPUTS};
-use super::options::FrfOptions;
+use super::options::{FrfOptions, ResponseEstimator};
 use super::records::{rms, JoinedRecord, RecordGroup};
+use super::reference::ReferenceSolve;
 use super::spectra::{
     compute_spectra, log_grid, lowest_resolved, window_lengths, SpectraSettings, WindowSpectra,
 };
@@ -159,6 +160,9 @@ pub(crate) struct PreparedGroup {
     pub conditioning: Vec<usize>,
     /// Outputs with any variation, as indices into `joined.outputs`.
     pub outputs: Vec<usize>,
+    /// With the reference estimator: the swept control's recorded excitation, as an
+    /// index into `joined.references`.
+    pub sweep_reference: Option<usize>,
     pub records: usize,
     pub notes: Vec<String>,
 }
@@ -271,6 +275,24 @@ pub(crate) fn prepare_group(
             }
         }
     }
+    let sweep_reference = if with_outputs && opts.estimator == ResponseEstimator::SweepReference {
+        let recorded = joined
+            .references
+            .iter()
+            .position(|r| r.name == axis)
+            .filter(|&r| rms(&joined.references[r].values) > 0.0)
+            .ok_or_else(|| {
+                FrfError::InvalidOption(format!(
+                    "{axis} sweep: the sweep-reference estimator needs the excitation injected into `{axis}`, and these records carry none (telemetry dumps do; CSV records do not)"
+                ))
+            })?;
+        notes.push(format!(
+            "{axis} sweep: responses estimated against the recorded sweep (sweep-reference estimator)"
+        ));
+        Some(recorded)
+    } else {
+        None
+    };
     Ok(PreparedGroup {
         primary: group.primary().to_string(),
         joined,
@@ -278,21 +300,28 @@ pub(crate) fn prepare_group(
         windows,
         conditioning,
         outputs,
+        sweep_reference,
         records: group.records().len(),
         notes,
     })
 }
 
+/// Spectra of the group's conditioning inputs (positions `0..n`), with the reference
+/// estimator also the swept control's recorded excitation (position `n`), and,
+/// `with_outputs`, its outputs.
 fn spectra_of(
     prepared: &PreparedGroup,
     opts: &FrfOptions,
     with_outputs: bool,
 ) -> Vec<WindowSpectra> {
-    let inputs: Vec<&[f64]> = prepared
+    let mut inputs: Vec<&[f64]> = prepared
         .conditioning
         .iter()
         .map(|&i| prepared.joined.inputs[i].values.as_slice())
         .collect();
+    if let (true, Some(r)) = (with_outputs, prepared.sweep_reference) {
+        inputs.push(prepared.joined.references[r].values.as_slice());
+    }
     let outputs: Vec<&[f64]> = if with_outputs {
         prepared
             .outputs
@@ -315,6 +344,54 @@ fn spectra_of(
     )
 }
 
+/// The conditioning inputs' n×n block of a window's input matrix at grid index k.
+fn conditioning_block(
+    s: &WindowSpectra,
+    k: usize,
+    n: usize,
+) -> [Complex64; MAX_INPUTS * MAX_INPUTS] {
+    let mut block = [Complex64::new(0.0, 0.0); MAX_INPUTS * MAX_INPUTS];
+    for i in 0..n {
+        for j in 0..n {
+            block[i * n + j] = s.input_input(k, i, j);
+        }
+    }
+    block
+}
+
+/// Instrument j of the conditioning inputs (module docs of [`reference`]): the recorded
+/// sweep (spectra position n) for the primary (position n − 1), the input itself for
+/// the others.
+///
+/// [`reference`]: super::reference
+fn instrument(j: usize, n: usize) -> usize {
+    if j + 1 == n {
+        n
+    } else {
+        j
+    }
+}
+
+/// The reference solve of a window at grid index k (recorded sweep at position n).
+fn reference_solve(
+    s: &WindowSpectra,
+    k: usize,
+    n: usize,
+    min_pivot: f64,
+) -> Option<ReferenceSolve> {
+    let mut gzu = [Complex64::new(0.0, 0.0); MAX_INPUTS * MAX_INPUTS];
+    let mut gzz = [Complex64::new(0.0, 0.0); MAX_INPUTS * MAX_INPUTS];
+    let mut guu = [0.0; MAX_INPUTS];
+    for i in 0..n {
+        guu[i] = s.input_input(k, i, i).re;
+        for j in 0..n {
+            gzu[i * n + j] = s.input_input(k, instrument(i, n), j);
+            gzz[i * n + j] = s.input_input(k, instrument(i, n), instrument(j, n));
+        }
+    }
+    ReferenceSolve::new(&gzu, &gzz, &guu, n, min_pivot).ok()
+}
+
 fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut FrfAnalysis) {
     let axis = &prepared.primary;
     let spectra = spectra_of(prepared, opts, true);
@@ -327,7 +404,22 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
         .iter()
         .map(|s| {
             (s.valid_from.min(grid.len())..grid.len())
-                .map(|k| InputFactor::new(s.input_matrix(k), n_in, opts.min_pivot).ok())
+                .map(|k| {
+                    InputFactor::new(&conditioning_block(s, k, n_in), n_in, opts.min_pivot).ok()
+                })
+                .collect()
+        })
+        .collect();
+    let with_references = prepared.sweep_reference.is_some();
+    let reference_solves: Vec<Vec<Option<ReferenceSolve>>> = spectra
+        .iter()
+        .map(|s| {
+            (s.valid_from.min(grid.len())..grid.len())
+                .map(|k| {
+                    with_references
+                        .then(|| reference_solve(s, k, n_in, opts.min_pivot))
+                        .flatten()
+                })
                 .collect()
         })
         .collect();
@@ -367,6 +459,7 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
         };
         let mut siso = Vec::with_capacity(grid.len());
         let mut guy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
+        let mut gzy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
         for (k, &omega) in grid.iter().enumerate() {
             let mut miso_estimates = Vec::with_capacity(spectra.len());
             let mut multiple_estimates = Vec::with_capacity(spectra.len());
@@ -385,11 +478,27 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
                     }
                     let c = factor.condition(&guy[..n_in], gyy);
                     let error = random_error(c.partial_coherence, s.independent);
-                    miso_estimates.push(Estimate {
-                        response: c.response,
-                        coherence: c.partial_coherence,
-                        random_error: error,
-                    });
+                    if with_references {
+                        // Reference estimate: this window counts only where the
+                        // recorded sweep drives the swept control.
+                        if let Some(solve) = &reference_solves[w][k - s.valid_from] {
+                            for (i, g) in gzy.iter_mut().enumerate().take(n_in) {
+                                *g = s.input_output(k, instrument(i, n_in), o_local);
+                            }
+                            miso_estimates.push(Estimate {
+                                response: solve.solve(&gzy[..n_in])[primary],
+                                coherence: c.partial_coherence,
+                                random_error: error
+                                    * solve.variance_ratio(factor.conditioned_primary()).sqrt(),
+                            });
+                        }
+                    } else {
+                        miso_estimates.push(Estimate {
+                            response: c.response,
+                            coherence: c.partial_coherence,
+                            random_error: error,
+                        });
+                    }
                     multiple_estimates.push(Estimate {
                         response: Complex64::new(0.0, 0.0),
                         coherence: c.multiple_coherence,

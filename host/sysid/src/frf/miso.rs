@@ -101,6 +101,12 @@ impl InputFactor {
         })
     }
 
+    /// G_pp·r: the last (primary) input's autospectrum conditioned on the others,
+    /// 1/[G_uu⁻¹]_pp.
+    pub fn conditioned_primary(&self) -> f64 {
+        self.last_conditioned
+    }
+
     /// Solve G_uu·H = g for H (length n).
     // Triangular solves read best with the matrix indices written out.
     #[allow(clippy::needless_range_loop)]

@@ -13,6 +13,8 @@
 //!    log-spaced frequency grid.
 //! 3. [`miso`] — per frequency and window length, the conditioned responses
 //!    `H = Guu⁻¹·Guy` (Cholesky solve), partial and multiple coherence.
+//!    With a feedback controller in the loop, [`reference`] solves `G_ru·H = G_ry`
+//!    with the recorded excitation as reference instead (an option).
 //! 4. [`composite`] — per frequency, the window-length estimates are blended with
 //!    weights 1/εr².
 //! 5. [`coherence`] — random error, valid ranges, cross-control coherence.
@@ -44,6 +46,7 @@ pub mod miso;
 pub mod options;
 pub mod plots;
 pub mod records;
+pub mod reference;
 pub mod spectra;
 
 #[cfg(test)]
@@ -62,7 +65,7 @@ pub use csv::{load_csv, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };
-pub use options::FrfOptions;
+pub use options::{FrfOptions, ResponseEstimator};
 pub use plots::write_plots;
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
 

@@ -28,6 +28,25 @@ pub struct FrfOptions {
     /// Chirp-Z points per resolution bin 2π/T of a window (default 8): spectra are
     /// computed on this linear grid and interpolated onto the log grid.
     pub oversampling: usize,
+    /// How the conditioned responses are estimated (default [`ResponseEstimator::CrossSpectral`]).
+    pub estimator: ResponseEstimator,
+}
+
+/// How the conditioned (MISO) responses are estimated from the spectra.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ResponseEstimator {
+    /// H = G_uu⁻¹·G_uy (CIFER's MISOSA). Unbiased when the controls are independent of
+    /// whatever in the outputs they do not cause; pulled towards the controller's inverse
+    /// where an engaged hold drives the swept control from noisy measurements.
+    #[default]
+    CrossSpectral,
+    /// H = G_zu⁻¹·G_zy with the swept control's recorded excitation (the sweep) as its
+    /// instrument and the other controls as their own ([`reference`](super::reference)).
+    /// Needs records with reference channels (telemetry dumps). Coherences and valid
+    /// ranges stay those of the cross-spectral estimate; the random error grows by the
+    /// estimator's variance ratio. Less biased, more scattered: README, "Frequency
+    /// responses", has the measured trade.
+    SweepReference,
 }
 
 impl Default for FrfOptions {
@@ -41,6 +60,7 @@ impl Default for FrfOptions {
             excitation_ratio: 0.01,
             min_pivot: 1e-3,
             oversampling: 8,
+            estimator: ResponseEstimator::CrossSpectral,
         }
     }
 }
