@@ -12,7 +12,7 @@
 //! Run: `cargo bench -p sweephold --bench cr_honesty` (about 2 minutes on 2 cores).
 //! `SWEEPHOLD_CR_SEEDS=N` changes the number of seeds; `SWEEPHOLD_CR_FLY_ARGS="..."` adds
 //! arguments to every `fly` (e.g. `--perfect-sensors`, to see which biases the sensor noise
-//! causes).
+//! causes), `SWEEPHOLD_CR_FRF_ARGS="..."` to every `frf` (e.g. `--estimator reference`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -95,7 +95,10 @@ fn main() {
             .map(|p| p.display().to_string())
             .collect();
         dumps.sort();
-        let mut frf_args = vec!["frf", "--quiet", "--out"];
+        let frf_extra = std::env::var("SWEEPHOLD_CR_FRF_ARGS").unwrap_or_default();
+        let mut frf_args = vec!["frf", "--quiet"];
+        frf_args.extend(frf_extra.split_whitespace());
+        frf_args.push("--out");
         let frf = d("frf.json");
         frf_args.push(&frf);
         frf_args.extend(dumps.iter().map(String::as_str));
