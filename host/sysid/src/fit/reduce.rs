@@ -9,7 +9,9 @@
 //! parameters are left to drop, those found needed before a later drop was accepted are
 //! tried once more: the smaller model may not need them any longer (a speed derivative
 //! that carried a correlated one, dropped since, can then be flagged at CR 170 % and
-//! cost nothing to remove).
+//! cost nothing to remove). A parameter whose zero would make the mass matrix M singular
+//! (the flapping time constant τ_f) is never dropped: the result would not be a
+//! state-space model.
 
 use serde::{Deserialize, Serialize};
 
@@ -27,10 +29,30 @@ pub struct ReductionStep {
     pub reason: String,
     /// J_ave before the step.
     pub average_cost_before: f64,
-    /// J_ave after refitting without the parameter.
+    /// J_ave after refitting without the parameter; infinite (`null` in JSON) when the
+    /// model without it cannot be evaluated or is no state-space model (M singular).
+    #[serde(with = "infinite_as_null")]
     pub average_cost_after: f64,
     /// Whether the smaller model was kept.
     pub accepted: bool,
+}
+
+/// JSON has no infinity: a non-finite J is written as `null` and read back as +∞
+/// (serde_json would write `null` and then refuse to read it back into an f64).
+mod infinite_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(value: &f64, serializer: S) -> Result<S::Ok, S::Error> {
+        if value.is_finite() {
+            serializer.serialize_f64(*value)
+        } else {
+            serializer.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::INFINITY))
+    }
 }
 
 /// The parameter to drop next, with the reason, or None when every free parameter meets
@@ -68,6 +90,13 @@ fn worst_parameter(
         }
     }
     None
+}
+
+/// Whether the structure's mass matrix M at its current values can be inverted.
+fn has_invertible_mass_matrix(structure: &super::structure::ModelStructure) -> bool {
+    structure
+        .model(&structure.values())
+        .is_ok_and(|model| model.m.lu().is_invertible())
 }
 
 /// Reduce a fitted model step by step (see the module documentation).
@@ -109,6 +138,20 @@ pub fn reduce(
         smaller.parameters[index].value = 0.0;
         smaller.parameters[index].lower = None;
         smaller.parameters[index].upper = None;
+        if !has_invertible_mass_matrix(&smaller) {
+            // A mass-matrix term (τ_f of the flapping) at zero leaves a model that is no
+            // longer a state-space model (M singular: no time response, no verification),
+            // however little it costs in the frequency domain: needed.
+            steps.push(ReductionStep {
+                dropped: name.clone(),
+                reason: format!("{reason}; at zero M would be singular"),
+                average_cost_before: current.average_cost,
+                average_cost_after: f64::INFINITY,
+                accepted: false,
+            });
+            needed.push((name, accepted_drops));
+            continue;
+        }
         let before = current.average_cost;
         let refit = match fit_on_grids(&smaller, grids, &refit_options) {
             Ok(refit) => Some(refit),
@@ -140,7 +183,9 @@ pub fn reduce(
 
 #[cfg(test)]
 mod tests {
+    use super::{has_invertible_mass_matrix, ReductionStep};
     use crate::fit::structure::ModelStructure;
+    use crate::fit::test_support::hybrid_structure;
     use crate::fit::test_support::synthetic_document;
     use crate::fit::{fit, FitOptions, ParameterStatus};
 
@@ -201,6 +246,30 @@ u = "b"
         for step in &result.reduction {
             assert!(step.average_cost_after.is_finite());
         }
+    }
+
+    #[test]
+    fn a_flapping_time_constant_at_zero_leaves_no_state_space_model() {
+        let mut structure = hybrid_structure();
+        assert!(has_invertible_mass_matrix(&structure));
+        let tau_f = structure.parameter_index("tau_f").unwrap();
+        structure.parameters[tau_f].value = 0.0;
+        assert!(!has_invertible_mass_matrix(&structure));
+    }
+
+    #[test]
+    fn a_step_that_could_not_be_evaluated_survives_a_json_round_trip() {
+        let step = ReductionStep {
+            dropped: "tau_f".into(),
+            reason: "insensitivity 80.0 %; at zero M would be singular".into(),
+            average_cost_before: 12.5,
+            average_cost_after: f64::INFINITY,
+            accepted: false,
+        };
+        let json = serde_json::to_string(&step).unwrap();
+        assert!(json.contains("\"average_cost_after\":null"), "{json}");
+        let back: ReductionStep = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, step);
     }
 
     #[test]

@@ -370,8 +370,10 @@ pub fn reduction_table(steps: &[ReductionStep]) -> String {
             step.average_cost_after,
             if step.accepted {
                 "kept out"
-            } else {
+            } else if step.average_cost_after.is_finite() {
                 "restored: needed (cost rose too much)"
+            } else {
+                "restored: needed (the model without it is unusable)"
             }
         );
     }
