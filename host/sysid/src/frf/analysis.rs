@@ -410,19 +410,20 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
                 .collect()
         })
         .collect();
+    // With the sweep-reference estimator, its solve per window and frequency as well.
     let with_references = prepared.sweep_reference.is_some();
-    let reference_solves: Vec<Vec<Option<ReferenceSolve>>> = spectra
-        .iter()
-        .map(|s| {
-            (s.valid_from.min(grid.len())..grid.len())
-                .map(|k| {
-                    with_references
-                        .then(|| reference_solve(s, k, n_in, opts.min_pivot))
-                        .flatten()
-                })
-                .collect()
-        })
-        .collect();
+    let reference_solves: Vec<Vec<Option<ReferenceSolve>>> = if with_references {
+        spectra
+            .iter()
+            .map(|s| {
+                (s.valid_from.min(grid.len())..grid.len())
+                    .map(|k| reference_solve(s, k, n_in, opts.min_pivot))
+                    .collect()
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     let factor_at = |w: usize, k: usize| -> Option<&InputFactor> {
         let s = &spectra[w];
         (k >= s.valid_from)
@@ -481,7 +482,11 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
                     if with_references {
                         // Reference estimate: this window counts only where the
                         // recorded sweep drives the swept control.
-                        if let Some(solve) = &reference_solves[w][k - s.valid_from] {
+                        let solve = reference_solves
+                            .get(w)
+                            .and_then(|solves| solves.get(k - s.valid_from))
+                            .and_then(Option::as_ref);
+                        if let Some(solve) = solve {
                             for (i, g) in gzy.iter_mut().enumerate().take(n_in) {
                                 *g = s.input_output(k, instrument(i, n_in), o_local);
                             }

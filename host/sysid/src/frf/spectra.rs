@@ -115,12 +115,6 @@ impl WindowSpectra {
         self.uu[((k - self.valid_from) * self.n_in + i) * self.n_in + j]
     }
 
-    /// The n_in × n_in input matrix at grid index k, row-major.
-    pub fn input_matrix(&self, k: usize) -> &[Complex64] {
-        let start = (k - self.valid_from) * self.n_in * self.n_in;
-        &self.uu[start..start + self.n_in * self.n_in]
-    }
-
     /// G_{u_i y_o} at grid index k.
     pub fn input_output(&self, k: usize, i: usize, o: usize) -> Complex64 {
         self.uy[((k - self.valid_from) * self.n_in + i) * self.n_out + o]
