@@ -3,7 +3,8 @@
 //! The excitation record of a dump is every Sample whose phase is fade-in, sweep or
 //! fade-out, of the first test (Header) that has any, plus up to [`SETTLE_S`] of trim
 //! on either side. Inputs are the applied commands
-//! `lat lon ped col`; outputs are `u v w p q r ax ay az phi theta`. The rate and the
+//! `lat lon ped col`; outputs are `u v w p q r ax ay az phi theta`; the references are
+//! what the firmware injected into each control (`sweep` + `noise`). The rate and the
 //! swept axis come from the Header, the sweep band from its ω_min..ω_max. Ticks lost in
 //! transmission are filled by linear interpolation (and noted); a record missing more
 //! than 10 % of its ticks is refused.
@@ -232,7 +233,7 @@ fn record_from_samples_with(
     let mut outputs: Vec<Vec<f64>> = (0..11).map(|_| Vec::with_capacity(span)).collect();
     let mut previous: Option<(u32, [f64; 8], [f64; 11])> = None;
     for sample in samples {
-        let command = input_row(sample);
+        let row = input_row(sample);
         let output = outputs_of(sample);
         if let Some((tick, last_in, last_out)) = previous {
             let step = sample.tick.wrapping_sub(tick);
@@ -242,7 +243,7 @@ fn record_from_samples_with(
             }
             for k in 1..step {
                 let t = f64::from(k) / f64::from(step);
-                for (channel, (&a, &b)) in inputs.iter_mut().zip(last_in.iter().zip(&command)) {
+                for (channel, (&a, &b)) in inputs.iter_mut().zip(last_in.iter().zip(&row)) {
                     channel.push(a + t * (b - a));
                 }
                 for (channel, (&a, &b)) in outputs.iter_mut().zip(last_out.iter().zip(&output)) {
@@ -250,13 +251,13 @@ fn record_from_samples_with(
                 }
             }
         }
-        for (channel, &v) in inputs.iter_mut().zip(&command) {
+        for (channel, &v) in inputs.iter_mut().zip(&row) {
             channel.push(v);
         }
         for (channel, &v) in outputs.iter_mut().zip(&output) {
             channel.push(v);
         }
-        previous = Some((sample.tick, command, output));
+        previous = Some((sample.tick, row, output));
     }
     let references = inputs.split_off(4);
 
