@@ -240,6 +240,7 @@ impl Campaign<'_> {
             pilot_override_at_s: None,
             pilot_noise: 0.0,
             perfect_sensors: false,
+            linearized_plant: false,
             quiet: true,
             fc: FcArg::InProcess,
             elf: None,

@@ -215,6 +215,7 @@ mod tests {
             rate_hz: 200,
             seed: 1,
             link: "in-process".into(),
+            plant: "nonlinear".into(),
             runs: vec![
                 run("lat", 3.0, false, Some(0.1)),
                 run("lat", 5.0, false, Some(0.3)),

@@ -165,6 +165,13 @@ pub struct FlyArgs {
     /// Perfect sensors (no noise, bias or latency).
     #[arg(long = "perfect-sensors")]
     pub perfect_sensors: bool,
+    /// Fly the simulator's first-order expansion about the hover trim instead of the
+    /// nonlinear model: the aircraft is then exactly the truth the fit is scored
+    /// against, so an identification error left on these dumps is the estimator's
+    /// (closed loop, windowing, noise), not the aircraft's nonlinearity. A diagnostic;
+    /// still air only (refused with --gust).
+    #[arg(long = "linearized-plant")]
+    pub linearized_plant: bool,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
@@ -231,6 +238,12 @@ impl FlyArgs {
         }
         if !(self.gust >= 0.0 && self.gust.is_finite()) {
             bail!("--gust {}: must be a finite level >= 0", self.gust);
+        }
+        if self.linearized_plant && self.gust > 0.0 {
+            bail!(
+                "--linearized-plant flies in still air only: drop --gust {}",
+                self.gust
+            );
         }
         if !(self.pilot_noise >= 0.0 && self.pilot_noise < 0.5) {
             bail!("--pilot-noise {}: must be in [0, 0.5)", self.pilot_noise);
@@ -370,6 +383,7 @@ pub fn fly_with_workers(
         // Sensors only: the actuators keep their servo dynamics and delay.
         sim_options.sensor_noise = bo105::SensorNoise::perfect();
     }
+    sim_options.linearized_plant = args.linearized_plant;
     let disturbances = Disturbances {
         gust_level: args.gust,
         sensor_dropout: args.sensor_dropout,
@@ -454,6 +468,12 @@ pub fn fly_with_workers(
         rate_hz: u32::from(args.rate_hz),
         seed: args.seed,
         link,
+        plant: if args.linearized_plant {
+            "linearized"
+        } else {
+            "nonlinear"
+        }
+        .to_string(),
         runs,
     };
     let path = args.out.join("summary.json");

@@ -70,8 +70,17 @@ pub struct FlySummary {
     pub seed: u64,
     /// Flight-controller link (`in-process`, `qemu`, `serial:PATH`).
     pub link: String,
+    /// The aircraft flown: `nonlinear` (the simulator) or `linearized` (its expansion
+    /// about the hover trim, `--linearized-plant`). Absent in older files: `nonlinear`.
+    #[serde(default = "nonlinear_plant")]
+    pub plant: String,
     /// The records, in flying order.
     pub runs: Vec<RunSummary>,
+}
+
+/// The plant of a summary written before `plant` existed.
+fn nonlinear_plant() -> String {
+    "nonlinear".to_string()
 }
 
 impl FlySummary {
