@@ -104,34 +104,46 @@ impl LinearPlant {
 
     /// ẋ at (x, a).
     pub(crate) fn derivative(&self, x: &[f64; STATE_LEN], a: &[f64; 4]) -> [f64; STATE_LEN] {
-        let mut derivative = self.derivative_trim;
-        for (row, out) in derivative.iter_mut().enumerate() {
-            *out += affine(
-                &self.state_jacobian[row],
-                &self.actuator_jacobian[row],
-                x,
-                &self.state_trim,
-                a,
-                &self.actuator_trim,
-            );
-        }
-        derivative
+        self.expand(
+            self.derivative_trim,
+            &self.state_jacobian,
+            &self.actuator_jacobian,
+            x,
+            a,
+        )
     }
 
     /// Body force [N] at (x, a).
     pub(crate) fn force(&self, x: &[f64; STATE_LEN], a: &[f64; 4]) -> [f64; 3] {
-        let mut force = self.force_trim;
-        for (row, out) in force.iter_mut().enumerate() {
-            *out += affine(
-                &self.force_state_jacobian[row],
-                &self.force_actuator_jacobian[row],
-                x,
-                &self.state_trim,
-                a,
-                &self.actuator_trim,
-            );
+        self.expand(
+            self.force_trim,
+            &self.force_state_jacobian,
+            &self.force_actuator_jacobian,
+            x,
+            a,
+        )
+    }
+
+    /// value₀ + J_x·(x − x₀) + J_a·(a − a₀), row by row.
+    fn expand<const ROWS: usize>(
+        &self,
+        value_at_trim: [f64; ROWS],
+        state_jacobian: &[[f64; STATE_LEN]; ROWS],
+        actuator_jacobian: &[[f64; 4]; ROWS],
+        x: &[f64; STATE_LEN],
+        a: &[f64; 4],
+    ) -> [f64; ROWS] {
+        let mut value = value_at_trim;
+        for (row, out) in value.iter_mut().enumerate() {
+            let states: f64 = (0..STATE_LEN)
+                .map(|j| state_jacobian[row][j] * (x[j] - self.state_trim[j]))
+                .sum();
+            let actuators: f64 = (0..4)
+                .map(|j| actuator_jacobian[row][j] * (a[j] - self.actuator_trim[j]))
+                .sum();
+            *out += states + actuators;
         }
-        force
+        value
     }
 
     /// One classical RK4 step of size h with the actuators held at `a`.
@@ -144,20 +156,6 @@ impl LinearPlant {
             x[i] += h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
     }
-}
-
-/// J_x·(x − x₀) + J_a·(a − a₀) for one row.
-fn affine(
-    state_row: &[f64; STATE_LEN],
-    actuator_row: &[f64; 4],
-    x: &[f64; STATE_LEN],
-    x0: &[f64; STATE_LEN],
-    a: &[f64; 4],
-    a0: &[f64; 4],
-) -> f64 {
-    let states: f64 = (0..STATE_LEN).map(|j| state_row[j] * (x[j] - x0[j])).sum();
-    let actuators: f64 = (0..4).map(|j| actuator_row[j] * (a[j] - a0[j])).sum();
-    states + actuators
 }
 
 /// x + h·k.
