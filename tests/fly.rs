@@ -143,6 +143,22 @@ fn bad_configuration_is_refused_up_front() {
     .expect("20 Hz is refused");
     assert!(error.to_string().contains("rate"), "{error}");
     assert!(!out.exists(), "nothing written");
+
+    // The linearized plant has no wind input: a gust level is refused, not ignored.
+    let args = fly_args(&[
+        "--linearized-plant",
+        "--gust",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let error = sweephold::fly::fly(&args, &|| {
+        Box::new(sweephold::fly::link::InProcessLink::new())
+    })
+    .err()
+    .expect("a gust on the linearized plant is refused");
+    assert!(error.to_string().contains("--linearized-plant"), "{error}");
+    assert!(!out.exists(), "nothing written");
 }
 
 /// The paper's comparison on shortened (20 s) lateral records over three seeds: conditional
