@@ -128,37 +128,24 @@ fn spikes_and_gusts_end_in_hold_or_a_limit_abort() {
 fn bad_configuration_is_refused_up_front() {
     let dir = Scratch::new("refused");
     let out = dir.path().join("never");
-    let args = fly_args(&[
-        "--axes",
-        "lat",
-        "--rate",
-        "20",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let error = sweephold::fly::fly(&args, &|| {
-        Box::new(sweephold::fly::link::InProcessLink::new())
-    })
-    .err()
-    .expect("20 Hz is refused");
-    assert!(error.to_string().contains("rate"), "{error}");
-    assert!(!out.exists(), "nothing written");
-
-    // The linearized plant has no wind input: a gust level is refused, not ignored.
-    let args = fly_args(&[
-        "--linearized-plant",
-        "--gust",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let error = sweephold::fly::fly(&args, &|| {
-        Box::new(sweephold::fly::link::InProcessLink::new())
-    })
-    .err()
-    .expect("a gust on the linearized plant is refused");
-    assert!(error.to_string().contains("--linearized-plant"), "{error}");
-    assert!(!out.exists(), "nothing written");
+    let out_arg = out.to_str().unwrap();
+    // (arguments, a word the error must name)
+    let cases: [(&[&str], &str); 2] = [
+        (&["--axes", "lat", "--rate", "20"], "rate"),
+        // The linearized plant has no wind input: a gust level is refused, not ignored.
+        (&["--linearized-plant", "--gust", "1"], "--linearized-plant"),
+    ];
+    for (arguments, named) in cases {
+        let mut all = arguments.to_vec();
+        all.extend(["--out", out_arg]);
+        let error = sweephold::fly::fly(&fly_args(&all), &|| {
+            Box::new(sweephold::fly::link::InProcessLink::new())
+        })
+        .err()
+        .unwrap_or_else(|| panic!("{arguments:?} is refused"));
+        assert!(error.to_string().contains(named), "{arguments:?}: {error}");
+        assert!(!out.exists(), "{arguments:?}: nothing written");
+    }
 }
 
 /// The paper's comparison on shortened (20 s) lateral records over three seeds: conditional
