@@ -465,12 +465,12 @@ impl Sim {
                 self.command
             };
             self.update_actuators(delayed, h);
-            let pitch = self.model.heli.blade_pitch(self.actuator_position);
             let start = self.x;
             let force = if let Some(plant) = &self.linear_plant {
                 plant.rk4_step(&mut self.x, &self.actuator_position, h);
                 plant.force(&start, &self.actuator_position)
             } else {
+                let pitch = self.model.heli.blade_pitch(self.actuator_position);
                 let loads = rk4_step(
                     &self.model,
                     &mut self.x,

@@ -12,7 +12,7 @@
 //! Run: `cargo bench -p sweephold --bench cr_honesty` (about 2 minutes on 2 cores).
 //! `SWEEPHOLD_CR_SEEDS=N` changes the number of seeds; `SWEEPHOLD_CR_FLY_ARGS="..."` adds
 //! arguments to every `fly` (e.g. `--perfect-sensors`, to see which biases the sensor noise
-//! causes), `SWEEPHOLD_CR_FRF_ARGS="..."` to every `frf` (e.g. `--estimator reference`).
+//! causes), `SWEEPHOLD_CR_FRF_ARGS="..."` to every `frf` (e.g. `--estimator sweep-reference`).
 
 use std::path::Path;
 use std::time::Instant;

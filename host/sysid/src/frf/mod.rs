@@ -13,8 +13,8 @@
 //!    log-spaced frequency grid.
 //! 3. [`miso`] — per frequency and window length, the conditioned responses
 //!    `H = Guu⁻¹·Guy` (Cholesky solve), partial and multiple coherence.
-//!    With a feedback controller in the loop, [`reference`] solves `G_ru·H = G_ry`
-//!    with the recorded excitation as reference instead (an option).
+//!    With a feedback controller in the loop, [`reference`] solves `G_zu·H = G_zy`
+//!    with the recorded sweep as instrument z instead (an option).
 //! 4. [`composite`] — per frequency, the window-length estimates are blended with
 //!    weights 1/εr².
 //! 5. [`coherence`] — random error, valid ranges, cross-control coherence.
