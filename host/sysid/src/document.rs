@@ -54,6 +54,10 @@ pub struct FrfDocument {
     pub cross_coherence: Vec<CrossCoherence>,
     /// Coherence threshold used for `valid_range`.
     pub coherence_threshold: f64,
+    /// Largest random error a point of a `valid_range` may have, when one was set
+    /// (`frf --max-random-error`); absent: the coherence alone decided.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_random_error: Option<f64>,
     /// Notes: controls left out of conditioning, ill-conditioned bands, etc.
     #[serde(default)]
     pub notes: Vec<String>,

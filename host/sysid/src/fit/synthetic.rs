@@ -187,6 +187,7 @@ pub fn exact_frf_document(model: &Model, bands: &[PairBand], grid: SyntheticGrid
         siso: Vec::new(),
         cross_coherence: Vec::new(),
         coherence_threshold: 0.6,
+        max_random_error: None,
         notes: vec!["synthetic: exact responses of a known model".into()],
     }
 }

@@ -22,7 +22,7 @@ use num_complex::Complex64;
 
 use crate::document::{CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
 
-use super::coherence::{debiased_coherence, random_error, valid_range};
+use super::coherence::{accurate_range, debiased_coherence, random_error};
 use super::composite::{blend, Estimate};
 use super::miso::{InputFactor, MAX_INPUTS};
 use super::options::{FrfOptions, ResponseEstimator};
@@ -133,6 +133,7 @@ pub fn analyse(groups: &[RecordGroup], opts: &FrfOptions) -> Result<FrfAnalysis,
             siso: Vec::new(),
             cross_coherence: Vec::new(),
             coherence_threshold: opts.coherence_threshold,
+            max_random_error: opts.max_random_error,
             notes: Vec::new(),
         },
         cross_coherence_curves: Vec::new(),
@@ -533,9 +534,8 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
             }
         }
         let input = input_name(primary);
-        let (pair, dropped) = pair_response(&input, output, &miso, opts.coherence_threshold);
-        let (siso_pair, siso_dropped) =
-            pair_response(&input, output, &siso, opts.coherence_threshold);
+        let (pair, dropped) = pair_response(&input, output, &miso, opts);
+        let (siso_pair, siso_dropped) = pair_response(&input, output, &siso, opts);
         if dropped + siso_dropped > 0 {
             notes.push(format!(
                 "{input}→{output}: {} non-finite points left out",
@@ -668,12 +668,13 @@ fn rounded(omega: f64) -> f64 {
 }
 
 /// Magnitude, unwrapped phase, coherence, random error and valid range of composite
-/// estimates; non-finite points are left out (their count is returned).
+/// estimates; non-finite points are left out (their count is returned). The valid range
+/// takes the coherence threshold and, when set, the largest random error of `opts`.
 fn pair_response(
     input: &str,
     output: &str,
     points: &[(f64, Estimate)],
-    threshold: f64,
+    opts: &FrfOptions,
 ) -> (PairResponse, usize) {
     let mut pair = PairResponse {
         input: input.to_string(),
@@ -718,7 +719,13 @@ fn pair_response(
         pair.coherence.push(e.coherence.clamp(0.0, 1.0));
         pair.random_error.push(e.random_error);
     }
-    pair.valid_range = valid_range(&pair.omega, &pair.coherence, threshold);
+    pair.valid_range = accurate_range(
+        &pair.omega,
+        &pair.coherence,
+        &pair.random_error,
+        opts.coherence_threshold,
+        opts.max_random_error,
+    );
     anchor_phase_branch(&mut pair);
     (pair, dropped)
 }

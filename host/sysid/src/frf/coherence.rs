@@ -97,14 +97,36 @@ pub fn debiased_coherence(estimate: f64, independent_averages: f64) -> Option<f6
 /// fit over a band with holes in it would weight points the data do not support. A run
 /// needs at least two points. `omega` must be ascending; returns `[ω_lo, ω_hi]`.
 pub fn valid_range(omega: &[f64], coherence: &[f64], threshold: f64) -> Option<[f64; 2]> {
+    widest_run(omega, coherence.iter().map(|&c| c >= threshold))
+}
+
+/// [`valid_range`] with a second condition per point: the random error `ε_r` (see
+/// [`random_error`]) at most `max_random_error` as well as `coherence ≥ threshold`.
+/// `None` for `max_random_error` gives [`valid_range`].
+pub fn accurate_range(
+    omega: &[f64],
+    coherence: &[f64],
+    random_error: &[f64],
+    threshold: f64,
+    max_random_error: Option<f64>,
+) -> Option<[f64; 2]> {
+    let max = max_random_error.unwrap_or(f64::INFINITY);
+    widest_run(
+        omega,
+        coherence
+            .iter()
+            .zip(random_error)
+            .map(|(&c, &e)| c >= threshold && e <= max),
+    )
+}
+
+/// The run of consecutive `true` flags spanning the most octaves (two points at least, the
+/// earlier run on a tie), as `[ω_lo, ω_hi]`.
+fn widest_run(omega: &[f64], flags: impl Iterator<Item = bool>) -> Option<[f64; 2]> {
     let mut best: Option<(f64, [f64; 2])> = None;
     let mut run_start: Option<usize> = None;
-    let len = omega.len().min(coherence.len());
     // One step past the end closes a run that reaches the last point.
-    let flags = coherence[..len]
-        .iter()
-        .map(|&c| c >= threshold)
-        .chain([false]);
+    let flags = flags.take(omega.len()).chain([false]);
     for (k, valid) in flags.enumerate() {
         match (valid, run_start) {
             (true, None) => run_start = Some(k),
@@ -188,6 +210,31 @@ mod tests {
         assert_eq!(valid_range(&omega, &coherence, 0.6), Some([1.0, 3.0]));
         assert_eq!(valid_range(&omega, &coherence, 0.95), None);
         assert_eq!(valid_range(&omega, &[0.7; 8], 0.6), Some([1.0, 16.0]));
+    }
+
+    #[test]
+    fn accurate_range_also_bounds_the_random_error() {
+        let omega = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 16.0];
+        let coherence = [0.7; 8];
+        let error = [0.3, 0.3, 0.1, 0.1, 0.1, 0.25, 0.1, 0.1];
+        // Runs with ε_r ≤ 0.2: 3..5 (ln 5/3) and 8..16 (ln 2), the second is wider.
+        assert_eq!(
+            accurate_range(&omega, &coherence, &error, 0.6, Some(0.2)),
+            Some([8.0, 16.0])
+        );
+        assert_eq!(
+            accurate_range(&omega, &coherence, &error, 0.6, Some(0.3)),
+            Some([1.0, 16.0])
+        );
+        assert_eq!(
+            accurate_range(&omega, &coherence, &error, 0.6, Some(0.05)),
+            None
+        );
+        // No bound: the coherence alone, as `valid_range`.
+        assert_eq!(
+            accurate_range(&omega, &coherence, &error, 0.6, None),
+            valid_range(&omega, &coherence, 0.6)
+        );
     }
 
     proptest::proptest! {

@@ -326,14 +326,66 @@ fn clear_refusals() {
     let err = compute_frequency_responses(&[g.clone(), g], &FrfOptions::default()).unwrap_err();
     assert!(matches!(err, FrfError::DuplicateAxis(_)), "{err}");
     // Bad options.
-    let bad = FrfOptions {
-        overlap: 1.5,
+    let bad_options = [
+        FrfOptions {
+            overlap: 1.5,
+            ..FrfOptions::default()
+        },
+        FrfOptions {
+            max_random_error: Some(0.0),
+            ..FrfOptions::default()
+        },
+        FrfOptions {
+            max_random_error: Some(f64::NAN),
+            ..FrfOptions::default()
+        },
+    ];
+    for bad in bad_options {
+        let err =
+            compute_frequency_responses(&[RecordGroup::new(vec![rec.clone()]).unwrap()], &bad)
+                .unwrap_err();
+        assert!(matches!(err, FrfError::InvalidOption(_)), "{err}");
+    }
+}
+
+#[test]
+fn a_random_error_bound_keeps_only_points_that_meet_it() {
+    // A noisy first-order response: coherence passes 0.6 where the random error, from
+    // few windows at the low end, is still large.
+    let block = Block::first_order(2.0, 0.25, 0.04);
+    let (input, output) = siso_run(&block, paper_sweep(60.0), 1.0, 3);
+    let rec = record(RATE, [0.3, 31.4], vec![("lat", input)], vec![("p", output)]);
+    let group = RecordGroup::new(vec![rec]).unwrap();
+    let coherence_only_options = FrfOptions {
+        max_random_error: None,
         ..FrfOptions::default()
     };
-    assert!(matches!(
-        compute_frequency_responses(&[RecordGroup::new(vec![rec]).unwrap()], &bad),
-        Err(FrfError::InvalidOption(_))
-    ));
+    let coherence_only =
+        compute_frequency_responses(std::slice::from_ref(&group), &coherence_only_options).unwrap();
+    let bounded_options = FrfOptions {
+        max_random_error: Some(0.1),
+        ..FrfOptions::default()
+    };
+    let bounded = compute_frequency_responses(&[group], &bounded_options).unwrap();
+    assert_eq!(coherence_only.max_random_error, None);
+    assert_eq!(bounded.max_random_error, Some(0.1));
+    let loose = coherence_only.pair("lat", "p").unwrap();
+    let strict = bounded.pair("lat", "p").unwrap();
+    // Same estimates, only the range differs.
+    assert_eq!(loose.mag_db, strict.mag_db);
+    let [loose_lo, loose_hi] = loose.valid_range.unwrap();
+    let [lo, hi] = strict.valid_range.unwrap();
+    eprintln!("coherence only {loose_lo:.3}..{loose_hi:.3}, with ε_r ≤ 0.1 {lo:.3}..{hi:.3}");
+    assert!(lo >= loose_lo && hi <= loose_hi);
+    assert!(
+        lo > loose_lo || hi < loose_hi,
+        "the bound removed nothing: this case must have valid points with ε_r > 0.1"
+    );
+    for k in 0..strict.omega.len() {
+        if (lo..=hi).contains(&strict.omega[k]) {
+            assert!(strict.coherence[k] >= 0.6 && strict.random_error[k] <= 0.1);
+        }
+    }
 }
 
 #[test]
