@@ -59,6 +59,10 @@ pub struct FitOptions {
     pub reduce: bool,
     /// Reduction keeps dropping parameters while J_ave rises by less than this per step.
     pub reduce_max_cost_rise: f64,
+    /// A reduction step is also undone when its refit moves another free parameter by more
+    /// than this many of that parameter's Cramér–Rao bounds: the model then slid into
+    /// another minimum rather than losing a term the data do not determine ([`reduce`]).
+    pub reduce_max_shift_cramer_rao: f64,
     /// Flag a Cramér–Rao bound above this percentage of the value.
     pub cramer_rao_limit_percent: f64,
     /// Flag an insensitivity above this percentage of the value.
@@ -82,6 +86,7 @@ impl Default for FitOptions {
             same_minimum_tolerance: 1e-4,
             reduce: false,
             reduce_max_cost_rise: 2.0,
+            reduce_max_shift_cramer_rao: 10.0,
             cramer_rao_limit_percent: 20.0,
             insensitivity_limit_percent: 10.0,
             correlation_limit: 0.9,

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use super::cost::PairGrid;
 use super::error::FitError;
 use super::structure::ParameterKind;
-use super::{fit_on_grids, FitOptions, FitResult, ParameterStatus};
+use super::{fit_on_grids, FitOptions, FitResult, ParameterReport, ParameterStatus};
 
 /// One reduction step.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -35,6 +35,11 @@ pub struct ReductionStep {
     pub average_cost_after: f64,
     /// Whether the smaller model was kept.
     pub accepted: bool,
+    /// The refit moved another parameter by more than
+    /// [`FitOptions::reduce_max_shift_cramer_rao`] of its Cramér–Rao bounds (so the step
+    /// was undone whatever its cost; the reason names the parameter).
+    #[serde(default)]
+    pub left_the_minimum: bool,
 }
 
 /// JSON has no infinity: a non-finite J is written as `null` and read back as +∞
@@ -90,6 +95,29 @@ fn worst_parameter(
         }
     }
     None
+}
+
+/// The free parameter of `before` (other than `dropped`) that the refit moved furthest,
+/// in units of its Cramér–Rao bound at `before`, and that distance. Dropping a parameter
+/// the data do not determine shifts the others by about their correlation with it times
+/// its own value in bounds (a few bounds at most, since it is dropped for a bound of
+/// 20 % or more or an insensitivity of 10 % or more); a shift of tens of bounds means the
+/// refit went to another minimum. Parameters without a finite bound are not measured.
+fn largest_shift(
+    before: &[ParameterReport],
+    after: &[ParameterReport],
+    dropped: &str,
+) -> Option<(String, f64)> {
+    before
+        .iter()
+        .filter(|p| p.status == ParameterStatus::Free && p.name != dropped)
+        .filter_map(|p| {
+            let bound = p.cramer_rao_percent? / 100.0 * p.value.abs();
+            let moved = after.iter().find(|q| q.name == p.name)?.value;
+            let shift = (moved - p.value).abs() / bound;
+            (bound > 0.0 && shift.is_finite()).then(|| (p.name.clone(), shift))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// Whether the structure's mass matrix M at its current values can be inverted.
@@ -148,6 +176,7 @@ pub fn reduce(
                 average_cost_before: current.average_cost,
                 average_cost_after: f64::INFINITY,
                 accepted: false,
+                left_the_minimum: false,
             });
             needed.push((name, accepted_drops));
             continue;
@@ -161,13 +190,26 @@ pub fn reduce(
             Err(other) => return Err(other),
         };
         let after = refit.as_ref().map_or(f64::INFINITY, |r| r.average_cost);
-        let accepted = after - before < options.reduce_max_cost_rise;
+        let shift = refit
+            .as_ref()
+            .and_then(|r| largest_shift(&current.parameters, &r.parameters, &name));
+        let slid = shift
+            .as_ref()
+            .is_some_and(|(_, s)| *s > options.reduce_max_shift_cramer_rao);
+        let accepted = after - before < options.reduce_max_cost_rise && !slid;
+        let reason = match shift {
+            Some((moved, s)) if slid => {
+                format!("{reason}; the refit moved {moved} by {s:.0} Cramér–Rao bounds")
+            }
+            _ => reason,
+        };
         steps.push(ReductionStep {
             dropped: name.clone(),
             reason,
             average_cost_before: before,
             average_cost_after: after,
             accepted,
+            left_the_minimum: slid,
         });
         match refit {
             Some(refit) if accepted => {
@@ -183,7 +225,8 @@ pub fn reduce(
 
 #[cfg(test)]
 mod tests {
-    use super::{has_invertible_mass_matrix, ReductionStep};
+    use super::{has_invertible_mass_matrix, largest_shift, ReductionStep};
+    use crate::fit::{ParameterReport, ParameterStatus as Status};
     use crate::fit::structure::ModelStructure;
     use crate::fit::test_support::hybrid_structure;
     use crate::fit::test_support::synthetic_document;
@@ -257,6 +300,46 @@ u = "b"
         assert!(!has_invertible_mass_matrix(&structure));
     }
 
+    fn report(name: &str, value: f64, status: Status, cramer_rao_percent: f64) -> ParameterReport {
+        ParameterReport {
+            name: name.into(),
+            value,
+            status,
+            cramer_rao_percent: Some(cramer_rao_percent),
+            insensitivity_percent: None,
+            flags: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_shift_is_counted_in_the_moved_parameters_own_bounds() {
+        // Zw −0.9 at CR 50 % (bound 0.45) moving to −52 is 113.6 bounds; Zcol −14.7 at CR
+        // 2 % (bound 0.294) moving to −14.1 is 2.04 bounds; Nv is the dropped one and
+        // a fixed parameter is not measured, however far it "moves".
+        let before = [
+            report("Zw", -0.9, Status::Free, 50.0),
+            report("Zcol", -14.7, Status::Free, 2.0),
+            report("Nv", 0.4, Status::Free, 25.0),
+            report("Kcs", 0.066, Status::Fixed, 1.0),
+        ];
+        let mut after = before.clone();
+        after[0].value = -52.0;
+        after[1].value = -14.1;
+        after[2].value = 0.0;
+        after[3].value = 5.0;
+        let (name, shift) = largest_shift(&before, &after, "Nv").unwrap();
+        assert_eq!(name, "Zw");
+        assert!((shift - 51.1 / 0.45).abs() < 1e-9, "{shift}");
+        // Without Zw the largest is Zcol's small, ordinary move.
+        let (name, shift) = largest_shift(&before[1..], &after[1..], "Nv").unwrap();
+        assert_eq!(name, "Zcol");
+        assert!((shift - 0.6 / 0.294).abs() < 1e-9, "{shift}");
+        // No bound, nothing measured.
+        let mut unbounded = before.clone();
+        unbounded.iter_mut().for_each(|p| p.cramer_rao_percent = None);
+        assert_eq!(largest_shift(&unbounded, &after, "Nv"), None);
+    }
+
     #[test]
     fn a_step_that_could_not_be_evaluated_survives_a_json_round_trip() {
         let step = ReductionStep {
@@ -265,6 +348,7 @@ u = "b"
             average_cost_before: 12.5,
             average_cost_after: f64::INFINITY,
             accepted: false,
+            left_the_minimum: false,
         };
         let json = serde_json::to_string(&step).unwrap();
         assert!(json.contains("\"average_cost_after\":null"), "{json}");

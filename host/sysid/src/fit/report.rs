@@ -370,6 +370,8 @@ pub fn reduction_table(steps: &[ReductionStep]) -> String {
             step.average_cost_after,
             if step.accepted {
                 "kept out"
+            } else if step.left_the_minimum {
+                "restored: needed (the refit left the minimum)"
             } else if step.average_cost_after.is_finite() {
                 "restored: needed (cost rose too much)"
             } else {
