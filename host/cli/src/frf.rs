@@ -42,12 +42,12 @@ pub struct FrfArgs {
     #[arg(long, value_name = "G2", default_value_t = 0.6)]
     pub coherence_threshold: f64,
     /// Largest random error ε_r = √(1−γ²)/(|γ|·√(2·n_d)) a valid frequency may have, besides
-    /// the coherence threshold (e.g. 0.15); `none`: the coherence alone decides. The
+    /// the coherence threshold; `none`: the coherence alone decides. The
     /// coherence does not see how few independent windows an estimate rests on: at the
     /// bottom of the band only the longest window resolves a frequency, and γ² = 0.65 there
     /// scatters three times as much as from the shorter windows. What it does to a fit is
     /// measured in the README ("`sweephold frf`").
-    #[arg(long, value_name = "E|none", default_value = "none", value_parser = parse_max_random_error)]
+    #[arg(long, value_name = "E|none", default_value = "0.15", value_parser = parse_max_random_error)]
     pub max_random_error: MaxRandomError,
     /// Number of window lengths (from 20π/ω_max to half the record).
     #[arg(long, value_name = "N", default_value_t = 5)]
@@ -409,10 +409,7 @@ mod tests {
             serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
         let pair = document.pair("lat", "p").expect("lat → p");
         assert_eq!(pair.omega.len(), 60);
-        assert_eq!(document.max_random_error, None);
-        assert!(!std::fs::read_to_string(&out)
-            .unwrap()
-            .contains("max_random_error"));
+        assert_eq!(document.max_random_error, Some(0.15));
         // p/lat = 0.2/(1 − 0.9 z⁻¹): 6 dB (gain 2) at low frequency.
         assert!((pair.mag_db[0] - 6.02).abs() < 0.5, "{}", pair.mag_db[0]);
         assert!(plots.join("frf_lat_p.svg").exists());
@@ -445,7 +442,10 @@ mod tests {
         for bad in ["0", "-0.1", "NaN", "inf", "x"] {
             assert!(parse_max_random_error(bad).is_err(), "{bad}");
         }
-        assert_eq!(parse(&["a.dump"]).max_random_error, MaxRandomError(None));
+        assert_eq!(
+            parse(&["a.dump"]).max_random_error,
+            MaxRandomError(Some(0.15))
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -226,11 +226,11 @@ pub fn reduce(
 #[cfg(test)]
 mod tests {
     use super::{has_invertible_mass_matrix, largest_shift, ReductionStep};
-    use crate::fit::{ParameterReport, ParameterStatus as Status};
     use crate::fit::structure::ModelStructure;
     use crate::fit::test_support::hybrid_structure;
     use crate::fit::test_support::synthetic_document;
     use crate::fit::{fit, FitOptions, ParameterStatus};
+    use crate::fit::{ParameterReport, ParameterStatus as Status};
 
     /// The truth of both tests: ẋ = −2x + 3u, no delay, no zero.
     const LAG_TRUTH: &str = r#"
@@ -336,7 +336,9 @@ u = "b"
         assert!((shift - 0.6 / 0.294).abs() < 1e-9, "{shift}");
         // No bound, nothing measured.
         let mut unbounded = before.clone();
-        unbounded.iter_mut().for_each(|p| p.cramer_rao_percent = None);
+        unbounded
+            .iter_mut()
+            .for_each(|p| p.cramer_rao_percent = None);
         assert_eq!(largest_shift(&unbounded, &after, "Nv"), None);
     }
 

@@ -19,13 +19,12 @@ pub struct FrfOptions {
     /// Coherence γ² at or above which a frequency counts as valid (default 0.6).
     pub coherence_threshold: f64,
     /// Largest random error ε_r = √(1−γ²)/(|γ|·√(2·n_d)) a valid frequency may also have
-    /// (default `None`: the coherence alone decides). The coherence threshold does not see
-    /// how many windows an estimate rests on: at the bottom of the band only the longest
-    /// window resolves the frequency, with two or three independent averages, and a
-    /// γ² = 0.65 estimate there scatters by ε_r ≈ 0.3 where the same γ² from the shorter
-    /// windows scatters by 0.1. Not the default: measured over 20 simulated Bo-105
-    /// campaigns it makes the key parameters more accurate and the fit less robust
-    /// (README, "`sweephold frf`").
+    /// (default 0.15; `None`: the coherence alone decides). The coherence threshold does
+    /// not see how many windows an estimate rests on: at the bottom of the band only the
+    /// longest window resolves the frequency, with two or three independent averages, and
+    /// a γ² = 0.65 estimate there scatters by ε_r ≈ 0.3 where the same γ² from the shorter
+    /// windows scatters by 0.1. The value and its trade are measured over 20 simulated
+    /// Bo-105 campaigns in the README ("`sweephold frf`").
     pub max_random_error: Option<f64>,
     /// A control whose RMS is below this fraction of the swept control's RMS counts as
     /// not excited and is left out of the conditioning (default 0.01).
@@ -66,7 +65,7 @@ impl Default for FrfOptions {
             windows: 5,
             overlap: 0.8,
             coherence_threshold: 0.6,
-            max_random_error: None,
+            max_random_error: Some(0.15),
             excitation_ratio: 0.01,
             min_pivot: 1e-3,
             oversampling: 8,
