@@ -7,7 +7,10 @@
 //! ratio is outside.
 //!
 //! Beside the ratio it prints each parameter's truth (the simulator's linearization, from
-//! `fit --truth bo105`) and the mean error against it: the bias, which no bound covers.
+//! `fit --truth bo105`) and the mean error against it: the bias, which no bound covers;
+//! and it counts the seeds whose nine key parameters are all within 10 % of the truth and
+//! those whose reduced model still keeps a free parameter with a Cramér–Rao bound above
+//! 20 % or an insensitivity above 10 % (the per-seed lines name them).
 //!
 //! Run: `cargo bench -p sweephold --bench cr_honesty` (about 2 minutes on 2 cores).
 //! `SWEEPHOLD_CR_SEEDS=N` changes the number of seeds; `SWEEPHOLD_CR_FLY_ARGS="..."` adds
@@ -65,6 +68,24 @@ fn key_estimates(model_json: &Path) -> Vec<Estimate> {
         .collect()
 }
 
+/// The free parameters of a reduced model.json that still break a guideline (Cramér–Rao
+/// bound above 20 % or insensitivity above 10 % of the value).
+fn flagged_free_parameters(model_json: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(model_json).expect("model.json written");
+    let document: serde_json::Value = serde_json::from_str(&text).expect("model.json parses");
+    let percent = |p: &serde_json::Value, key: &str| p[key].as_f64().unwrap_or(f64::INFINITY);
+    document["parameters"]
+        .as_array()
+        .expect("parameters")
+        .iter()
+        .filter(|p| p["status"] == "free")
+        .filter(|p| {
+            percent(p, "cramer_rao_percent") > 20.0 || percent(p, "insensitivity_percent") > 10.0
+        })
+        .filter_map(|p| p["name"].as_str().map(str::to_string))
+        .collect()
+}
+
 fn main() {
     let binary = env!("CARGO_BIN_EXE_sweephold");
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../sysid/models");
@@ -76,6 +97,7 @@ fn main() {
         .unwrap_or(20);
     let scratch = std::env::temp_dir().join(format!("sweephold-cr-honesty-{}", std::process::id()));
     let mut estimates: Vec<Vec<Estimate>> = Vec::new();
+    let (mut seeds_all_within_ten, mut seeds_flagged) = (0usize, 0usize);
     let started = Instant::now();
     for seed in 1..=seeds {
         let dir = scratch.join(format!("seed-{seed}"));
@@ -128,15 +150,31 @@ fn main() {
             ],
         );
         let keys = key_estimates(Path::new(&m9));
+        let flagged = flagged_free_parameters(Path::new(&m9));
+        let all_within_ten = keys
+            .iter()
+            .all(|e| (e.value - e.truth).abs() <= 0.1 * e.truth.abs());
+        seeds_all_within_ten += usize::from(all_within_ten);
+        seeds_flagged += usize::from(!flagged.is_empty());
         eprintln!(
-            "seed {seed}/{seeds} ({:.0} s): {}",
+            "seed {seed}/{seeds} ({:.0} s): {}{}{}",
             started.elapsed().as_secs_f64(),
             KEY_PARAMETERS
                 .iter()
                 .zip(&keys)
                 .map(|(name, estimate)| format!("{name} {:.4}", estimate.value))
                 .collect::<Vec<_>>()
-                .join(", ")
+                .join(", "),
+            if all_within_ten {
+                ""
+            } else {
+                "; not all within 10 %"
+            },
+            if flagged.is_empty() {
+                String::new()
+            } else {
+                format!("; flagged {}", flagged.join(" "))
+            }
         );
         estimates.push(keys);
         let _ = std::fs::remove_dir_all(&dir);
@@ -166,6 +204,10 @@ fn main() {
             if ok { "" } else { "  outside [1/3, 3]" }
         );
     }
+    println!(
+        "seeds with all nine key parameters within 10 % of the truth: {seeds_all_within_ten}/{seeds}; \
+         reduced models keeping a free parameter with CR > 20 % or insensitivity > 10 %: {seeds_flagged}/{seeds}"
+    );
     println!(
         "{seeds} seeds in {:.0} s; bounds {}",
         started.elapsed().as_secs_f64(),
