@@ -60,8 +60,9 @@ pub struct FitOptions {
     /// Reduction keeps dropping parameters while J_ave rises by less than this per step.
     pub reduce_max_cost_rise: f64,
     /// A reduction step is also undone when its refit moves another free parameter by more
-    /// than this many of that parameter's Cramér–Rao bounds: the model then slid into
-    /// another minimum rather than losing a term the data do not determine ([`reduce`]).
+    /// than this many of that parameter's Cramér–Rao bounds (default 10, the most a drop can
+    /// move it near a minimum with the guideline limits): the model then slid into another
+    /// minimum rather than losing a term the data do not determine ([`reduce`]).
     pub reduce_max_shift_cramer_rao: f64,
     /// Flag a Cramér–Rao bound above this percentage of the value.
     pub cramer_rao_limit_percent: f64,

@@ -98,11 +98,12 @@ fn worst_parameter(
 }
 
 /// The free parameter of `before` (other than `dropped`) that the refit moved furthest,
-/// in units of its Cramér–Rao bound at `before`, and that distance. Dropping a parameter
-/// the data do not determine shifts the others by about their correlation with it times
-/// its own value in bounds (a few bounds at most, since it is dropped for a bound of
-/// 20 % or more or an insensitivity of 10 % or more); a shift of tens of bounds means the
-/// refit went to another minimum. Parameters without a finite bound are not measured.
+/// in units of its Cramér–Rao bound at `before`, and that distance. Near a minimum the
+/// cost is quadratic, and fixing θ_k at zero moves each other θ_j by ρ_jk·θ_k/CR_k of its
+/// own bounds (ρ the correlation). The reduction drops θ_k only for an insensitivity of
+/// 10 % or more (then CR_k ≥ 10 % of |θ_k|, since CR ≥ insensitivity) or a bound of 20 % or
+/// more, so that move is at most 10 bounds; a larger one means the refit left the
+/// quadratic basin for another minimum. Parameters without a finite bound are not measured.
 fn largest_shift(
     before: &[ParameterReport],
     after: &[ParameterReport],
