@@ -13,6 +13,7 @@
 //! nonlinearity. Still air only: wind, gusts and external loads are not part of it.
 
 use crate::model::{self, Model, ModelFlags, STATE_LEN};
+use crate::sim::rk4_from;
 use crate::trim::Trim;
 
 /// Central-difference step: states and actuator positions are O(0.1–10) in their units,
@@ -149,20 +150,6 @@ impl LinearPlant {
     /// One classical RK4 step of size h with the actuators held at `a`.
     pub(crate) fn rk4_step(&self, x: &mut [f64; STATE_LEN], a: &[f64; 4], h: f64) {
         let k1 = self.derivative(x, a);
-        let k2 = self.derivative(&offset(x, &k1, 0.5 * h), a);
-        let k3 = self.derivative(&offset(x, &k2, 0.5 * h), a);
-        let k4 = self.derivative(&offset(x, &k3, h), a);
-        for i in 0..STATE_LEN {
-            x[i] += h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
+        rk4_from(x, h, k1, |stage| self.derivative(stage, a));
     }
-}
-
-/// x + h·k.
-fn offset(x: &[f64; STATE_LEN], k: &[f64; STATE_LEN], h: f64) -> [f64; STATE_LEN] {
-    let mut out = *x;
-    for i in 0..STATE_LEN {
-        out[i] += h * k[i];
-    }
-    out
 }

@@ -262,26 +262,40 @@ pub(crate) fn rk4_step(
     warm: &mut [f64; 2],
     h: f64,
 ) -> Loads {
-    // x_{n+1} = x_n + h/6 (k1 + 2k2 + 2k3 + k4)
     let (k1, loads) = model.derivative(x, pitch, wind, flags, warm);
-    let mut stage = [0.0; STATE_LEN];
-    for i in 0..STATE_LEN {
+    rk4_from(x, h, k1, |stage| {
+        model.derivative(stage, pitch, wind, flags, warm).0
+    });
+    loads
+}
+
+/// One classical RK4 step of ẋ = f(x) from `x`, given k1 = f(x) (the caller evaluates it,
+/// to keep what comes with it, e.g. the loads):
+/// x_{n+1} = x_n + h/6 (k1 + 2k2 + 2k3 + k4). The linearized plant steps with it too.
+#[inline]
+pub(crate) fn rk4_from<const N: usize>(
+    x: &mut [f64; N],
+    h: f64,
+    k1: [f64; N],
+    mut f: impl FnMut(&[f64; N]) -> [f64; N],
+) {
+    let mut stage = [0.0; N];
+    for i in 0..N {
         stage[i] = x[i] + 0.5 * h * k1[i];
     }
-    let (k2, _) = model.derivative(&stage, pitch, wind, flags, warm);
-    for i in 0..STATE_LEN {
+    let k2 = f(&stage);
+    for i in 0..N {
         stage[i] = x[i] + 0.5 * h * k2[i];
     }
-    let (k3, _) = model.derivative(&stage, pitch, wind, flags, warm);
-    for i in 0..STATE_LEN {
+    let k3 = f(&stage);
+    for i in 0..N {
         stage[i] = x[i] + h * k3[i];
     }
-    let (k4, _) = model.derivative(&stage, pitch, wind, flags, warm);
+    let k4 = f(&stage);
     let sixth_h = h * (1.0 / 6.0);
-    for i in 0..STATE_LEN {
+    for i in 0..N {
         x[i] += sixth_h * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
     }
-    loads
 }
 
 /// The simulator of one helicopter.
