@@ -24,7 +24,9 @@ pub struct PairResponse {
     pub coherence: Vec<f64>,
     /// Normalised random error εr = √(1−γ²)/(|γ|·√(2·n_d)).
     pub random_error: Vec<f64>,
-    /// Frequency band [lo, hi] rad/s where coherence ≥ the threshold, or null.
+    /// Frequency band [lo, hi] rad/s where coherence ≥ the threshold and, when
+    /// `max_random_error` is set, the random error is at most that (the widest such run),
+    /// or null.
     pub valid_range: Option<[f64; 2]>,
 }
 
