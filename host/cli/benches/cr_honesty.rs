@@ -38,10 +38,14 @@ struct Estimate {
     truth: f64,
 }
 
-/// Value, CR bound (absolute) and truth of each key parameter in a model.json.
-fn key_estimates(model_json: &Path) -> Vec<Estimate> {
+/// A model.json, parsed.
+fn read_model(model_json: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(model_json).expect("model.json written");
-    let document: serde_json::Value = serde_json::from_str(&text).expect("model.json parses");
+    serde_json::from_str(&text).expect("model.json parses")
+}
+
+/// Value, CR bound (absolute) and truth of each key parameter in a model.json.
+fn key_estimates(document: &serde_json::Value) -> Vec<Estimate> {
     let parameters = document["parameters"].as_array().expect("parameters");
     let truths = document["truth"]["parameters"]
         .as_array()
@@ -72,9 +76,7 @@ fn key_estimates(model_json: &Path) -> Vec<Estimate> {
 
 /// The free parameters of a reduced model.json that still break a guideline (Cramér–Rao
 /// bound above 20 % or insensitivity above 10 % of the value).
-fn flagged_free_parameters(model_json: &Path) -> Vec<String> {
-    let text = std::fs::read_to_string(model_json).expect("model.json written");
-    let document: serde_json::Value = serde_json::from_str(&text).expect("model.json parses");
+fn flagged_free_parameters(document: &serde_json::Value) -> Vec<String> {
     let percent = |p: &serde_json::Value, key: &str| p[key].as_f64().unwrap_or(f64::INFINITY);
     document["parameters"]
         .as_array()
@@ -91,9 +93,7 @@ fn flagged_free_parameters(model_json: &Path) -> Vec<String> {
 /// The angular-rate pair (output p, q or r) whose identified response is farthest from
 /// the truth's: its name and the cost J between the two over the pair's range (issue 7
 /// asks J ≤ 20 for every such pair).
-fn worst_rate_pair_truth_cost(model_json: &Path) -> Option<(String, f64)> {
-    let text = std::fs::read_to_string(model_json).expect("model.json written");
-    let document: serde_json::Value = serde_json::from_str(&text).expect("model.json parses");
+fn worst_rate_pair_truth_cost(document: &serde_json::Value) -> Option<(String, f64)> {
     document["truth"]["pairs"]
         .as_array()?
         .iter()
@@ -169,14 +169,15 @@ fn main() {
                 &m9,
             ],
         );
-        let keys = key_estimates(Path::new(&m9));
-        let flagged = flagged_free_parameters(Path::new(&m9));
+        let reduced_model = read_model(Path::new(&m9));
+        let keys = key_estimates(&reduced_model);
+        let flagged = flagged_free_parameters(&reduced_model);
         let all_within_ten = keys
             .iter()
             .all(|e| (e.value - e.truth).abs() <= 0.1 * e.truth.abs());
         seeds_all_within_ten += usize::from(all_within_ten);
         seeds_flagged += usize::from(!flagged.is_empty());
-        let worst_rate_pair = worst_rate_pair_truth_cost(Path::new(&m9));
+        let worst_rate_pair = worst_rate_pair_truth_cost(&reduced_model);
         seeds_rate_pairs_within_twenty +=
             usize::from(worst_rate_pair.as_ref().is_some_and(|(_, j)| *j <= 20.0));
         eprintln!(
