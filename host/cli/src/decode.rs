@@ -8,6 +8,7 @@ use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use sweephold_protocol::{DecodeStats, Decoder, Event, Frame, FrameError, Header};
 
+use crate::output::{refuse_inputs_as_outputs, AtomicFile};
 use crate::table::{axis_name, phase_name, RowWriter};
 
 /// Output format of `decode`.
@@ -198,7 +199,32 @@ pub fn event_text(event: &Event) -> String {
     }
 }
 
+/// Where the rows go: standard output, or a file that appears only when complete.
+enum Sink<'a> {
+    Stdout(io::StdoutLock<'a>),
+    File(AtomicFile),
+}
+
+impl Write for Sink<'_> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        match self {
+            Sink::Stdout(out) => out.write(buf),
+            Sink::File(file) => file.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match self {
+            Sink::Stdout(out) => out.flush(),
+            Sink::File(file) => file.flush(),
+        }
+    }
+}
+
 fn open(path: &Path) -> anyhow::Result<File> {
+    if path.is_dir() {
+        bail!("cannot open {}: it is a folder, not a dump", path.display());
+    }
     File::open(path).with_context(|| format!("cannot open {}", path.display()))
 }
 
@@ -210,11 +236,14 @@ pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
         .iter()
         .map(|p| open(p).map(|f| (p, f)))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let sink: Box<dyn Write> = match &args.output {
-        Some(path) => Box::new(
-            File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
-        ),
-        None => Box::new(io::stdout().lock()),
+    let input_paths: Vec<&Path> = args.dumps.iter().map(PathBuf::as_path).collect();
+    if let Some(path) = &args.output {
+        refuse_inputs_as_outputs(&input_paths, &[("--output", path)])?;
+    }
+    // The output file appears only when decoding succeeded (see `crate::output`).
+    let sink = match &args.output {
+        Some(path) => Sink::File(AtomicFile::create(path)?),
+        None => Sink::Stdout(io::stdout().lock()),
     };
     let sink = BufWriter::with_capacity(CHUNK, sink);
     let mut rows = match args.format {
@@ -242,9 +271,15 @@ pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
             print_summary(path, &summary, args.format == Format::Csv);
         }
     }
-    rows.into_inner().context("cannot write output")?;
     if !any_good {
         bail!("no valid frame in {}", empty.join(", "));
+    }
+    let sink = rows
+        .into_inner()
+        .and_then(|buffered| buffered.into_inner().map_err(|e| e.into_error()))
+        .context("cannot write output")?;
+    if let Sink::File(file) = sink {
+        file.commit()?;
     }
     if !args.quiet {
         for dump in &empty {

@@ -8,6 +8,8 @@ use std::fs;
 use std::io::{self, Write};
 use std::path::PathBuf;
 
+use crate::arg_values;
+use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use anyhow::{bail, Context};
 use clap::Args;
 use sysid::document::FrfDocument;
@@ -41,17 +43,17 @@ pub struct FitArgs {
     #[arg(long)]
     pub reduce: bool,
     /// Seed of the perturbed restarts (same seed, same result).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
     /// Take start values from a quasi-steady 6-DOF `model.json` (paper Eq. 26–27); the
     /// structure file's own start values are tried too, and the lower J_ave is kept.
     #[arg(long, value_name = "model6.json")]
     pub start_from: Option<PathBuf>,
-    /// Most optimizer starts (stops earlier once a minimum is found twice).
-    #[arg(long, default_value_t = 8)]
+    /// Most optimizer starts (stops earlier once a minimum is found twice), 1–64.
+    #[arg(long, default_value_t = 8, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
     pub max_starts: usize,
-    /// Fit frequencies per pair (n_ω).
-    #[arg(long, default_value_t = 20)]
+    /// Fit frequencies per pair (n_ω; CIFER uses 20), 2–200: the fit's time grows with it.
+    #[arg(long, default_value_t = 20, value_parser = arg_values::count::<2, 200>, allow_hyphen_values = true)]
     pub points: usize,
     /// Score the fit against a simulator's linearization at hover (`bo105`, `trex700l`):
     /// truth and error % per parameter, J against the truth model per pair.
@@ -85,6 +87,18 @@ fn parse_constant(text: &str) -> Result<(String, f64), String> {
 
 /// Run `sweephold fit`.
 pub fn run(args: &FitArgs) -> anyhow::Result<()> {
+    let mut inputs = vec![args.frf.as_path()];
+    inputs.extend(args.start_from.as_deref());
+    if args.model.is_file() {
+        inputs.push(args.model.as_path());
+    }
+    if let Some(out) = &args.out {
+        refuse_inputs_as_outputs(&inputs, &[("--out", out)])?;
+    }
+    check_input_file("--frf", &args.frf)?;
+    if let Some(path) = &args.start_from {
+        check_input_file("--start-from", path)?;
+    }
     let frf_text = fs::read_to_string(&args.frf)
         .with_context(|| format!("cannot read {}", args.frf.display()))?;
     let data: FrfDocument = serde_json::from_str(&frf_text).with_context(|| {
@@ -95,9 +109,6 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     })?;
     let constants: BTreeMap<String, f64> = args.constants.iter().cloned().collect();
     let structure = ModelStructure::from_path_with_constants(&args.model, &constants)?;
-    if args.points < 2 {
-        bail!("--points must be at least 2");
-    }
 
     // Everything goes to one report printed at the end (see `emit`).
     let mut report = String::new();
@@ -164,13 +175,20 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         None => None,
     };
     write_report(&mut report, &result, truth.as_ref()).expect("writing to a String cannot fail");
+    if !result.average_cost.is_finite() {
+        bail!(
+            "the fit's cost is not finite (J_ave {}): the responses in {} are not a plausible \
+             frequency response for this structure; no model written",
+            result.average_cost,
+            args.frf.display()
+        );
+    }
     if let Some(path) = &args.out {
         let document = ScoredModelDocument {
             model: result.to_document(),
             truth,
         };
-        let json = serde_json::to_string_pretty(&document)?;
-        fs::write(path, json + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+        write_json(path, &document)?;
         let _ = writeln!(report, "\nwrote {}", path.display());
     }
     emit(&report)

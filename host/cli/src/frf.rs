@@ -1,11 +1,10 @@
 //! `sweephold frf`: telemetry dumps or CSV logs → composite, MISO-conditioned frequency
 //! responses (`frf.json`) and, optionally, SVG Bode and cross-control coherence plots.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context};
+use crate::output::{check_input_file, check_output_folder, refuse_inputs_as_outputs, write_json};
+use anyhow::bail;
 use clap::Args;
 use sysid::frf::{
     analyse, group_by_primary, load_csv, load_dump, write_plots, CsvColumns, FrfAnalysis,
@@ -199,6 +198,14 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     let opts = args.options();
     opts.validate()?;
     let columns = args.csv_columns()?;
+    let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
+    refuse_inputs_as_outputs(&inputs, &[("--out", &args.out)])?;
+    if let Some(dir) = &args.plots {
+        check_output_folder("--plots", dir)?;
+    }
+    for path in &inputs {
+        check_input_file("input", path)?;
+    }
     let records: Vec<Record> = args
         .files
         .iter()
@@ -213,20 +220,12 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     let groups = group_by_primary(records)?;
     let analysis = analyse(&groups, &opts)?;
 
-    let file =
-        File::create(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let mut writer = BufWriter::new(file);
-    serde_json::to_writer_pretty(&mut writer, &analysis.document)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-    writeln!(writer)?;
-    writer
-        .flush()
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-
+    // Plots first: the document is the result, written last and whole.
     let plots = match &args.plots {
         Some(dir) => write_plots(&analysis, dir)?.len(),
         None => 0,
     };
+    write_json(&args.out, &analysis.document)?;
     if !args.quiet {
         eprint!("{}", summary(&analysis, &args.out, plots));
     }

@@ -3,11 +3,14 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod arg_values;
 pub mod campaign;
 pub mod decode;
 pub mod fit;
 pub mod fly;
 pub mod frf;
+pub mod interrupt;
+pub mod output;
 pub mod report;
 pub mod sim;
 pub mod table;

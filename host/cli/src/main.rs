@@ -1,21 +1,64 @@
 //! `sweephold`: see `sweephold --help`. Without arguments: `sweephold campaign`.
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
 use clap::Parser;
+
+/// Exit status of a command line that does not parse (clap's convention).
+const EXIT_USAGE: u8 = 2;
 
 fn main() -> ExitCode {
     // No arguments: the main job on its defaults.
-    let cli = if std::env::args_os().len() <= 1 {
-        sweephold::Cli::parse_from(["sweephold", "campaign"])
+    let parsed = if std::env::args_os().len() <= 1 {
+        sweephold::Cli::try_parse_from(["sweephold", "campaign"])
     } else {
-        sweephold::Cli::parse()
+        sweephold::Cli::try_parse()
+    };
+    let cli = match parsed {
+        Ok(cli) => cli,
+        Err(error) => return usage_error(&error),
     };
     match sweephold::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             // One line: the error and its causes, outermost first.
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", format!("{error:#}").replace('\n', " "));
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// `--help` and `--version` as clap prints them; a command-line error on one line (clap's
+/// first line, without its tips and usage block) and exit status 2.
+fn usage_error(error: &clap::Error) -> ExitCode {
+    match error.kind() {
+        ErrorKind::DisplayHelp
+        | ErrorKind::DisplayVersion
+        | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            let _ = error.print();
+            if error.use_stderr() {
+                ExitCode::from(EXIT_USAGE)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        _ => {
+            // clap's message is its first paragraph (a list of missing arguments
+            // continues it on indented lines); tips and usage follow a blank line.
+            let text = error.render().to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .skip_while(|line| line.trim().is_empty())
+                .take_while(|line| !line.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            let message = if message.is_empty() {
+                "error: bad command line".to_string()
+            } else {
+                message.join(" ")
+            };
+            eprintln!("{message} (see --help)");
+            ExitCode::from(EXIT_USAGE)
         }
     }
 }

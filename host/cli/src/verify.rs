@@ -7,7 +7,8 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context};
+use crate::output::{check_input_file, check_output_folder};
+use anyhow::{anyhow, Context};
 use clap::Args;
 use sysid::fit::verify::{verify_record_in_segments, write_verification_plots, Verification};
 use sysid::fit::ModelDocument;
@@ -35,12 +36,13 @@ pub struct VerifyArgs {
     /// Restart the simulation every SECONDS from the measured state (states named like
     /// recorded outputs; others at 0). Without it the model runs open loop over the whole
     /// record, which an unstable hover model cannot survive.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = crate::arg_values::positive_seconds, allow_hyphen_values = true)]
     pub segment: Option<f64>,
 }
 
 /// Run `sweephold verify`.
 pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
+    check_input_file("--model", &args.model)?;
     let text = fs::read_to_string(&args.model)
         .with_context(|| format!("cannot read {}", args.model.display()))?;
     let document: ModelDocument = serde_json::from_str(&text)
@@ -53,9 +55,10 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
     })?;
     // Check every file before simulating anything.
     for dump in &args.dumps {
-        if !dump.is_file() {
-            bail!("cannot read {}: no such file", dump.display());
-        }
+        check_input_file("dump", dump)?;
+    }
+    if let Some(dir) = &args.plots {
+        check_output_folder("--plots", dir)?;
     }
     let mut report = String::new();
     let _ = writeln!(

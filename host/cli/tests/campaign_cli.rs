@@ -228,6 +228,48 @@ fn quick_campaign_report_and_errors() {
     let again = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert_eq!(structure(&again), sections);
 
+    // Ctrl-C mid-way: the campaign stops after the current stage, names it, keeps its
+    // files with the error in DIR.failed, and leaves the previous campaign as it was.
+    let report_before = std::fs::read(out.join("report.html")).unwrap();
+    let summary_before = std::fs::read(out.join("summary.json")).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_sweephold"))
+        .args(["campaign", "--quick", "--quiet", "--seed", "4", "--out"])
+        .arg(&out)
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("the binary runs");
+    let flown = dir.join("campaign.partial/fly-cah/summary.json");
+    let waited = std::time::Instant::now();
+    while !flown.exists() && waited.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(flown.exists(), "the cah records were never written");
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let interrupted = child.wait_with_output().unwrap();
+    let message = one_line_failure(&interrupted);
+    assert!(message.contains("interrupted (Ctrl-C)"), "{message}");
+    assert!(message.contains("campaign.failed"), "{message}");
+    assert_eq!(
+        std::fs::read(out.join("report.html")).unwrap(),
+        report_before
+    );
+    assert_eq!(
+        std::fs::read(out.join("summary.json")).unwrap(),
+        summary_before
+    );
+    let stopped: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("campaign.failed/summary.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(stopped["error"]["message"], "interrupted (Ctrl-C)");
+    assert_eq!(stopped["seed"], 4);
+    assert!(!dir.join("campaign.partial").exists());
+
     // A corrupt file: one line naming it, non-zero exit.
     std::fs::write(out.join("model9.json"), "{ not json").unwrap();
     let message = one_line_failure(&sweephold(&["report", out.to_str().unwrap()]));
@@ -246,25 +288,24 @@ fn quick_campaign_report_and_errors() {
     ]));
     assert!(message.contains("`setup`"), "{message}");
 
-    // A stage failing mid-way: the fly folder is taken by a file. The stage is named,
-    // and summary.json keeps what completed plus the error.
-    let blocked = dir.join("blocked");
-    std::fs::create_dir_all(&blocked).unwrap();
-    std::fs::write(blocked.join("fly-cah"), "x").unwrap();
+    // A folder holding other files than a campaign's is refused before anything is
+    // written, its files untouched.
+    let foreign = dir.join("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), "mine").unwrap();
     let message = one_line_failure(&sweephold(&[
         "campaign",
         "--quick",
         "--quiet",
         "--out",
-        blocked.to_str().unwrap(),
+        foreign.to_str().unwrap(),
     ]));
-    assert!(message.contains("`fly_cah`"), "{message}");
-    let partial: Value =
-        serde_json::from_str(&std::fs::read_to_string(blocked.join("summary.json")).unwrap())
-            .unwrap();
-    assert_eq!(partial["error"]["stage"], "fly_cah");
-    assert!(partial["modes"]["cah"].is_null() && partial["fit"].is_null());
-    assert!(partial["timings_s"]["setup"].is_f64());
+    assert!(message.contains("not a sweephold run"), "{message}");
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert_eq!(std::fs::read_dir(&foreign).unwrap().count(), 1);
 
     std::fs::remove_dir_all(&dir).ok();
 }

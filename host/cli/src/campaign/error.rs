@@ -1,17 +1,22 @@
 //! The error of a campaign: which stage failed, and why.
 
 use std::fmt;
+use std::path::PathBuf;
 
 use super::stage::Stage;
 
-/// A campaign stopped at `stage`. Everything written before it is kept in the output
-/// folder, and `summary.json` records the error (when the folder is writable).
+/// A campaign stopped at `stage`. The output folder keeps the previous complete
+/// campaign; what this one wrote is kept in `DIR.failed`, whose `summary.json` records
+/// the error (when the folder is writable).
 #[derive(Debug)]
 pub struct CampaignError {
     /// The stage that failed.
     pub stage: Stage,
     /// The failure, causes included, on one line.
     pub message: String,
+    /// Where the stopped campaign's files were kept (`DIR.failed`), or why they could
+    /// not be; `None` when nothing was written yet.
+    pub kept: Option<Result<PathBuf, String>>,
 }
 
 impl CampaignError {
@@ -20,6 +25,7 @@ impl CampaignError {
         CampaignError {
             stage,
             message: format!("{error:#}").replace('\n', " "),
+            kept: None,
         }
     }
 }
@@ -30,7 +36,16 @@ impl fmt::Display for CampaignError {
             f,
             "campaign stage `{}` failed: {}",
             self.stage, self.message
-        )
+        )?;
+        match &self.kept {
+            Some(Ok(folder)) => write!(
+                f,
+                " (its files are in {}; the previous campaign, if any, is unchanged)",
+                folder.display()
+            ),
+            Some(Err(why)) => write!(f, " (its files could not be kept: {why})"),
+            None => Ok(()),
+        }
     }
 }
 

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{anyhow, Context};
+use anyhow::anyhow;
 use clap::Args;
 use sweephold_protocol::Axis;
 use sysid::document::FrfDocument;
@@ -27,7 +27,8 @@ use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions};
 
 use crate::fly::link::InProcessLink;
 use crate::fly::plan::PAPER_T_REC_S;
-use crate::fly::{self, write_json, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
+use crate::fly::{self, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
+use crate::output::{write_json, StagedFolder};
 use error::CampaignError;
 use stage::{Stage, StageProgress};
 use summary::{
@@ -75,8 +76,11 @@ pub mod files {
     after_help = "Writes into DIR: fly-cah/, fly-standard/, fly-noise/ (the sweep \
 dumps and fly's summary.json per mode), verify-doublet/ (held-out doublets), frf.json, \
 model6.json, model9.json, truth-model9.json, verify.json, summary.json (layout in the \
-README) and report.html. A failing stage stops the campaign with its name; what was \
-written is kept and summary.json records the error."
+README) and report.html. The campaign is built in DIR.partial and replaces DIR only \
+when it completes. A failing stage, or Ctrl-C (the campaign stops after the current \
+stage), stops it with the stage's name: DIR keeps the previous complete campaign, and \
+the stopped one's files, with the error in its summary.json, are kept in DIR.failed. \
+DIR must be new, empty or an earlier campaign's folder."
 )]
 pub struct CampaignArgs {
     /// Aircraft simulated.
@@ -86,7 +90,7 @@ pub struct CampaignArgs {
     #[arg(long, value_name = "DIR", default_value = "out/campaign")]
     pub out: PathBuf,
     /// Campaign seed (the held-out doublets use SEED + 1).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = crate::arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
     /// Short records (20 s instead of 90 s) for tests and a first look.
     #[arg(long)]
@@ -124,6 +128,7 @@ pub struct CampaignOutcome {
 
 /// Run `sweephold campaign`: the campaign, then the path of the report on stdout.
 pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
+    crate::interrupt::install();
     let outcome = campaign(args)?;
     if !args.quiet {
         eprint!("{}", headline(&outcome.summary));
@@ -179,11 +184,15 @@ struct Campaign<'a> {
     args: &'a CampaignArgs,
     summary: CampaignSummary,
     started: Instant,
+    /// Where the stages write: `DIR.partial` until the campaign completes.
+    staged: Option<StagedFolder>,
 }
 
 impl Campaign<'_> {
     fn dir(&self) -> &Path {
-        &self.args.out
+        self.staged
+            .as_ref()
+            .map_or(self.args.out.as_path(), StagedFolder::path)
     }
 
     /// Run one stage: progress, timing, and on failure the error in `summary.json`.
@@ -193,7 +202,11 @@ impl Campaign<'_> {
         work: impl FnOnce(&mut Self) -> anyhow::Result<(T, String)>,
     ) -> Result<T, CampaignError> {
         let progress = StageProgress::start(stage, self.args.quiet);
-        match work(self) {
+        // A Ctrl-C is honoured between stages: before this one and after it.
+        let result = crate::interrupt::check()
+            .and_then(|()| work(self))
+            .and_then(|done| crate::interrupt::check().map(|()| done));
+        match result {
             Ok((value, outcome)) => {
                 let seconds = progress.finish(&outcome);
                 self.summary
@@ -203,18 +216,27 @@ impl Campaign<'_> {
             }
             Err(error) => {
                 progress.finish("FAILED");
-                let error = CampaignError::new(stage, &error);
+                let mut error = CampaignError::new(stage, &error);
                 self.summary.error = Some(StageFailure {
                     stage: stage.name().to_string(),
                     message: error.message.clone(),
                 });
-                if stage != Stage::Setup {
+                if let Some(staged) = self.staged.take() {
                     // Best effort: the folder may be what failed.
-                    let _ = self.write_summary();
+                    let _ = write_json(&staged.path().join(files::SUMMARY), &self.summary);
+                    error.kept = Some(staged.fail().map_err(|e| format!("{e:#}")));
                 }
                 Err(error)
             }
         }
+    }
+
+    /// The setup stage: the staging folder, and a first summary to check it takes files.
+    fn set_up(&mut self) -> anyhow::Result<((), String)> {
+        // The previous campaign in DIR stays as it is until this one completes.
+        self.staged = Some(StagedFolder::begin(&self.args.out)?);
+        self.write_summary()?;
+        Ok(((), self.dir().display().to_string()))
     }
 
     fn write_summary(&mut self) -> anyhow::Result<()> {
@@ -301,49 +323,32 @@ pub fn flag_name(flag: &sysid::fit::AccuracyFlag) -> String {
     }
 }
 
+impl<'a> Campaign<'a> {
+    fn new(args: &'a CampaignArgs) -> Campaign<'a> {
+        Campaign {
+            args,
+            summary: CampaignSummary {
+                vehicle: args.vehicle.name().to_string(),
+                seed: args.seed,
+                verification_seed: args.verification_seed(),
+                t_rec_s: args.t_rec_s(),
+                quick: args.quick,
+                modes: Modes::default(),
+                fit: None,
+                verify: None,
+                timings_s: BTreeMap::new(),
+                error: None,
+            },
+            started: Instant::now(),
+            staged: None,
+        }
+    }
+}
+
 /// Run the whole campaign of `args` (see the module documentation).
 pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
-    let mut run = Campaign {
-        args,
-        summary: CampaignSummary {
-            vehicle: args.vehicle.name().to_string(),
-            seed: args.seed,
-            verification_seed: args.verification_seed(),
-            t_rec_s: args.t_rec_s(),
-            quick: args.quick,
-            modes: Modes::default(),
-            fit: None,
-            verify: None,
-            timings_s: BTreeMap::new(),
-            error: None,
-        },
-        started: Instant::now(),
-    };
-
-    run.stage(Stage::Setup, |run| {
-        std::fs::create_dir_all(run.dir())
-            .with_context(|| format!("cannot create output folder {}", run.dir().display()))?;
-        // A previous campaign's results must not pass for this one's if it stops early.
-        for name in [
-            files::FRF,
-            files::MODEL_6DOF,
-            files::MODEL_9DOF,
-            files::TRUTH_MODEL_9DOF,
-            files::VERIFY,
-            files::REPORT,
-        ] {
-            let path = run.dir().join(name);
-            match std::fs::remove_file(&path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(anyhow!("cannot remove the old {}: {e}", path.display()));
-                }
-                _ => {}
-            }
-        }
-        // Check that the folder takes files before anything is flown.
-        run.write_summary()?;
-        Ok(((), run.dir().display().to_string()))
-    })?;
+    let mut run = Campaign::new(args);
+    run.stage(Stage::Setup, Campaign::set_up)?;
 
     let mut cah_dumps = Vec::new();
     for (stage, mode) in [
@@ -532,15 +537,79 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
 
     run.write_summary()
         .map_err(|e| CampaignError::new(Stage::Report, &e))?;
-    let report = run.stage(Stage::Report, |run| {
-        let path = crate::report::write_report(run.dir())?;
-        let line = path.display().to_string();
-        Ok((path, line))
+    run.stage(Stage::Report, |run| {
+        crate::report::write_report(run.dir())?;
+        run.write_summary()?;
+        let staged = run
+            .staged
+            .take()
+            .ok_or_else(|| anyhow!("the campaign folder was not set up"))?;
+        staged.complete()?;
+        let line = run.args.out.join(files::REPORT).display().to_string();
+        Ok(((), line))
     })?;
+    // Again in the completed folder, with the report stage's time and the total.
     run.write_summary()
         .map_err(|e| CampaignError::new(Stage::Report, &e))?;
     Ok(CampaignOutcome {
         summary: run.summary,
-        report,
+        report: args.out.join(files::REPORT),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_stage_keeps_the_previous_campaign_and_its_own_files() {
+        let dir = std::env::temp_dir().join(format!("sweephold-stage-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let out = dir.join("campaign");
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::write(out.join(files::SUMMARY), "previous").unwrap();
+        std::fs::write(out.join(files::REPORT), "previous report").unwrap();
+        let args = CampaignArgs {
+            vehicle: VehicleArg::Bo105,
+            out: out.clone(),
+            seed: 7,
+            quick: true,
+            quiet: true,
+        };
+        let mut run = Campaign::new(&args);
+        run.stage(Stage::Setup, Campaign::set_up).unwrap();
+        std::fs::write(run.dir().join(files::FRF), "this run's").unwrap();
+        let error = run
+            .stage(Stage::Frf, |_| -> anyhow::Result<((), String)> {
+                Err(anyhow!("no coherent pair"))
+            })
+            .unwrap_err();
+        let message = error.to_string();
+        assert!(
+            message.contains("`frf` failed: no coherent pair"),
+            "{message}"
+        );
+        assert!(message.contains("campaign.failed"), "{message}");
+        assert_eq!(
+            std::fs::read_to_string(out.join(files::SUMMARY)).unwrap(),
+            "previous"
+        );
+        assert_eq!(
+            std::fs::read_to_string(out.join(files::REPORT)).unwrap(),
+            "previous report"
+        );
+        assert!(!out.join(files::FRF).exists());
+        let failed = dir.join("campaign.failed");
+        assert_eq!(
+            std::fs::read_to_string(failed.join(files::FRF)).unwrap(),
+            "this run's"
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(failed.join(files::SUMMARY)).unwrap())
+                .unwrap();
+        assert_eq!(summary["error"]["stage"], "frf");
+        assert_eq!(summary["seed"], 7);
+        assert!(!dir.join("campaign.partial").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -11,7 +11,7 @@ pub mod record;
 pub mod summary;
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 use anyhow::{bail, Context};
@@ -20,6 +20,8 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sweephold_firmware::Config;
 use sweephold_protocol::{Axis, ExcitationMode, InputKind};
 
+use crate::arg_values;
+use crate::output::{write_atomic, write_json, StagedFolder};
 use link::{FlightControllerLink, InProcessLink};
 use plan::{plan_records, RecordPlan};
 use record::{fly_record, Disturbances};
@@ -136,31 +138,40 @@ pub struct FlyArgs {
     #[arg(long, value_enum, default_value_t = InputArg::Sweep)]
     pub input: InputArg,
     /// Campaign seed (firmware noise, sensor noise, gusts).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
-    /// Sweep record length T_rec [s] (the paper: 90).
-    #[arg(long = "t-rec", value_name = "SECONDS", default_value_t = plan::PAPER_T_REC_S)]
+    /// Sweep record length T_rec [s] (the paper: 90), 5–1000: shorter records are too
+    /// short for the frequency responses of the sweep's upper band.
+    #[arg(long = "t-rec", value_name = "SECONDS", default_value_t = plan::PAPER_T_REC_S,
+          value_parser = parse_t_rec, allow_hyphen_values = true)]
     pub t_rec_s: f64,
     /// Control loop rate [Hz] (50–1000).
-    #[arg(long = "rate", value_name = "HZ", default_value_t = 200)]
+    #[arg(long = "rate", value_name = "HZ", default_value_t = 200, allow_hyphen_values = true,
+          value_parser = clap::value_parser!(u16).range(50..=1000))]
     pub rate_hz: u16,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/fly")]
     pub out: PathBuf,
-    /// Turbulence level [m/s RMS of the body-axis gust].
-    #[arg(long, value_name = "LEVEL", default_value_t = 0.0)]
+    /// Turbulence level [m/s RMS of the body-axis gust], >= 0.
+    #[arg(long, value_name = "LEVEL", default_value_t = 0.0, value_parser = arg_values::non_negative, allow_hyphen_values = true)]
     pub gust: f64,
-    /// Per-tick probability that the sensor sample is not refreshed.
-    #[arg(long = "sensor-dropout", value_name = "P", default_value_t = 0.0)]
+    /// Per-tick probability that the sensor sample is not refreshed, 0–1.
+    #[arg(long = "sensor-dropout", value_name = "P", default_value_t = 0.0, value_parser = arg_values::probability, allow_hyphen_values = true)]
     pub sensor_dropout: f64,
-    /// Per-tick probability of a sensor spike.
-    #[arg(long = "sensor-spike", value_name = "P", default_value_t = 0.0)]
+    /// Per-tick probability of a sensor spike, 0–1.
+    #[arg(long = "sensor-spike", value_name = "P", default_value_t = 0.0, value_parser = arg_values::probability, allow_hyphen_values = true)]
     pub sensor_spike: f64,
-    /// Seconds after arming at which the pilot moves the lateral stick 20 % off trim.
-    #[arg(long = "pilot-override", value_name = "AT_S")]
+    /// Seconds after arming at which the pilot moves the lateral stick 20 % off trim
+    /// (>= 0, and before the record ends).
+    #[arg(long = "pilot-override", value_name = "AT_S", value_parser = arg_values::non_negative, allow_hyphen_values = true)]
     pub pilot_override_at_s: Option<f64>,
-    /// RMS of the pilot's stick motion around trim, fraction of travel.
-    #[arg(long = "pilot-noise", value_name = "RMS", default_value_t = 0.0)]
+    /// RMS of the pilot's stick motion around trim, fraction of travel, 0 to < 0.5.
+    #[arg(
+        long = "pilot-noise",
+        value_name = "RMS",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
     pub pilot_noise: f64,
     /// Perfect sensors (no noise, bias or latency).
     #[arg(long = "perfect-sensors")]
@@ -216,6 +227,22 @@ pub fn parse_fc(text: &str) -> Result<FcArg, String> {
     }
 }
 
+/// Shortest `--t-rec` [s]: the upper-band record must hold two windows of ten periods
+/// of its ω_max for the cross-control coherence `fly` reports.
+pub const MIN_T_REC_S: f64 = 5.0;
+
+/// Longest `--t-rec` [s].
+pub const MAX_T_REC_S: f64 = 1000.0;
+
+fn parse_t_rec(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(t) if (MIN_T_REC_S..=MAX_T_REC_S).contains(&t) => Ok(t),
+        _ => Err(format!(
+            "expected a record length from {MIN_T_REC_S} to {MAX_T_REC_S} s"
+        )),
+    }
+}
+
 fn parse_axis(text: &str) -> Result<Axis, String> {
     Axis::ALL
         .into_iter()
@@ -227,6 +254,16 @@ impl FlyArgs {
     fn check(&self) -> anyhow::Result<()> {
         if self.axes.is_empty() {
             bail!("--axes names no axis");
+        }
+        for (i, axis) in self.axes.iter().enumerate() {
+            if self.axes[..i].contains(axis) {
+                bail!(
+                    "--axes names {} twice: each axis is flown once (its records are {}-1.bin, {}-2.bin)",
+                    axis.name(),
+                    axis.name(),
+                    axis.name()
+                );
+            }
         }
         for (name, p) in [
             ("--sensor-dropout", self.sensor_dropout),
@@ -248,11 +285,29 @@ impl FlyArgs {
         if !(self.pilot_noise >= 0.0 && self.pilot_noise < 0.5) {
             bail!("--pilot-noise {}: must be in [0, 0.5)", self.pilot_noise);
         }
-        if !(self.t_rec_s > 0.0 && self.t_rec_s.is_finite()) {
+        if !(MIN_T_REC_S..=MAX_T_REC_S).contains(&self.t_rec_s) {
             bail!(
-                "--t-rec {}: must be a positive number of seconds",
+                "--t-rec {}: expected a record length from {MIN_T_REC_S} to {MAX_T_REC_S} s",
                 self.t_rec_s
             );
+        }
+        if let Some(at) = self.pilot_override_at_s {
+            let shortest = plan_records(
+                &self.axes,
+                self.mode.mode(),
+                self.input.kind(),
+                self.t_rec_s,
+                self.seed,
+            )
+            .iter()
+            .map(|plan| expected_duration_s(&record_config(self.vehicle, plan, self.rate_hz)))
+            .fold(f64::INFINITY, f64::min);
+            if !(at >= 0.0 && at < shortest) {
+                bail!(
+                    "--pilot-override {at}: expected a time from 0 to {shortest:.1} s after arming \
+                     (the end of the shortest record)"
+                );
+            }
         }
         Ok(())
     }
@@ -282,34 +337,39 @@ pub struct FlyOutcome {
     pub dumps: Vec<PathBuf>,
 }
 
-/// Run `sweephold fly`.
+/// Run `sweephold fly`: the records are flown into `OUT.partial`, which replaces OUT
+/// only when every record was written (see [`crate::output::StagedFolder`]).
 pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
-    let outcome = match &args.fc {
-        FcArg::InProcess => fly(args, &|| Box::new(InProcessLink::new()))?,
-        FcArg::Qemu | FcArg::QemuUsart => {
+    validate(args)?;
+    // The board image is found (and checked) before anything is written.
+    let image = match (&args.fc, &args.elf) {
+        (FcArg::Qemu | FcArg::QemuUsart, elf) => {
             link_qemu::qemu_available()?;
-            let image = match &args.elf {
+            Some(match elf {
                 Some(path) => path.clone(),
                 None => link_qemu::default_image()?,
-            };
-            let extra = link_qemu::extra_args_from_env();
-            let transport = if args.fc == FcArg::Qemu {
-                link_qemu::QemuTransport::Semihosting
-            } else {
-                link_qemu::QemuTransport::Usart
-            };
-            fly(args, &|| {
-                Box::new(
-                    link_qemu::QemuLink::new(&image, transport, &extra).with_log_folder(&args.out),
-                )
-            })?
+            })
         }
-        // One port, one board: the records are flown one after the other.
-        FcArg::Serial(port) => fly_with_workers(
-            args,
-            &|| Box::new(link_serial::SerialLink::new(port.clone())),
-            1,
-        )?,
+        _ => None,
+    };
+    let staged = StagedFolder::begin(&args.out)?;
+    let mut staged_args = args.clone();
+    staged_args.out = staged.path().to_path_buf();
+    let outcome = match fly_on_link(&staged_args, image.as_deref()) {
+        Ok(outcome) => {
+            staged.complete()?;
+            outcome
+        }
+        Err(error) => {
+            let kept = match staged.fail() {
+                Ok(failed) => format!("its files are in {}", failed.display()),
+                Err(e) => format!("{e:#}"),
+            };
+            return Err(error.context(format!(
+                "fly failed ({kept}; {} is unchanged)",
+                args.out.display()
+            )));
+        }
     };
     if !args.quiet {
         for run in &outcome.summary.runs {
@@ -337,6 +397,57 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Fly `args` into `args.out` over the link `args.fc` names.
+fn fly_on_link(args: &FlyArgs, image: Option<&std::path::Path>) -> anyhow::Result<FlyOutcome> {
+    match &args.fc {
+        FcArg::InProcess => fly(args, &|| Box::new(InProcessLink::new())),
+        FcArg::Qemu | FcArg::QemuUsart => {
+            let image = image.ok_or_else(|| anyhow::anyhow!("no board image"))?;
+            let extra = link_qemu::extra_args_from_env();
+            let transport = if args.fc == FcArg::Qemu {
+                link_qemu::QemuTransport::Semihosting
+            } else {
+                link_qemu::QemuTransport::Usart
+            };
+            fly(args, &|| {
+                Box::new(
+                    link_qemu::QemuLink::new(image, transport, &extra).with_log_folder(&args.out),
+                )
+            })
+        }
+        // One port, one board: the records are flown one after the other.
+        FcArg::Serial(port) => fly_with_workers(
+            args,
+            &|| Box::new(link_serial::SerialLink::new(port.clone())),
+            1,
+        ),
+    }
+}
+
+/// Refuse a bad command line or a configuration the firmware would refuse, before
+/// anything is flown or written.
+pub fn validate(args: &FlyArgs) -> anyhow::Result<()> {
+    args.check()?;
+    let plans = plan_records(
+        &args.axes,
+        args.mode.mode(),
+        args.input.kind(),
+        args.t_rec_s,
+        args.seed,
+    );
+    for plan in &plans {
+        let config = record_config(args.vehicle, plan, args.rate_hz);
+        sweephold_firmware::FlightController::new(config).map_err(|e| {
+            anyhow::anyhow!(
+                "record {}: the firmware refuses this configuration: {}",
+                plan.file_name(),
+                e.message()
+            )
+        })?;
+    }
+    Ok(())
+}
+
 /// Fly every record of `args` with links made by `make_link` (one per worker thread),
 /// write the dumps and `summary.json`, and return the summary.
 pub fn fly(
@@ -353,7 +464,7 @@ pub fn fly_with_workers(
     make_link: &(dyn Fn() -> Box<dyn FlightControllerLink> + Sync),
     max_workers: usize,
 ) -> anyhow::Result<FlyOutcome> {
-    args.check()?;
+    validate(args)?;
     let heli = args.vehicle.sim().helicopter();
     let trim = bo105::trim(&heli, 0.0)
         .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
@@ -364,17 +475,6 @@ pub fn fly_with_workers(
         args.t_rec_s,
         args.seed,
     );
-    // Refuse a bad configuration before anything is flown or written.
-    for plan in &plans {
-        let config = record_config(args.vehicle, plan, args.rate_hz);
-        sweephold_firmware::FlightController::new(config).map_err(|e| {
-            anyhow::anyhow!(
-                "record {}: the firmware refuses this configuration: {}",
-                plan.file_name(),
-                e.message()
-            )
-        })?;
-    }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
 
@@ -495,9 +595,7 @@ fn finish_record(
     config: &Config,
     flown: record::FlownRecord,
 ) -> anyhow::Result<RunSummary> {
-    let path = args.out.join(plan.file_name());
-    std::fs::write(&path, &flown.dump)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    write_atomic(&args.out.join(plan.file_name()), &flown.dump)?;
     let cross_coherence = if plan.input == InputKind::Sweep && flown.abort.is_none() {
         record_cross_coherence(&flown.dump, &plan.file_name())?
     } else {
@@ -529,10 +627,4 @@ pub fn record_cross_coherence(dump: &[u8], name: &str) -> anyhow::Result<BTreeMa
         .into_iter()
         .map(|c| (if c.a == primary { c.b } else { c.a }, c.mean))
         .collect())
-}
-
-/// Write `value` as pretty JSON to `path`.
-pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
 }

@@ -1,0 +1,424 @@
+//! Where results go, by three rules every verb follows:
+//!
+//! 1. **No input is ever an output.** [`refuse_inputs_as_outputs`] runs before any work:
+//!    an output path that names one of the inputs (by path, symbolic link or hard link)
+//!    is refused, so `decode X.bin -o X.bin` cannot truncate the telemetry it reads.
+//! 2. **Files appear whole or not at all.** [`AtomicFile`] writes into a temporary file
+//!    in the destination's folder and renames it over the destination only when
+//!    everything was written and synced; a failure or an interruption leaves the earlier
+//!    file as it was and no half file.
+//! 3. **A folder of results is replaced whole.** [`StagedFolder`] builds a run's folder
+//!    beside the destination (`DIR.partial`) and swaps it in only when the run completes,
+//!    so a failed run leaves the previous complete one readable; the failed run's files
+//!    are kept as `DIR.failed` for inspection.
+
+use std::fs;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+
+/// Refuse, before anything is written, an output that is one of the inputs.
+///
+/// `inputs` and `outputs` are `(role, path)` pairs, e.g. `("--output", path)`; the
+/// message names the output's role. Outputs that do not exist yet cannot be an input
+/// (every input is opened before this is called) and are compared by their would-be
+/// canonical path. Hard links are caught by device and inode number.
+pub fn refuse_inputs_as_outputs(inputs: &[&Path], outputs: &[(&str, &Path)]) -> anyhow::Result<()> {
+    let inputs: Vec<(PathBuf, Option<FileId>)> = inputs
+        .iter()
+        .map(|p| (absolute(p), FileId::of(p)))
+        .collect();
+    for (role, output) in outputs {
+        let (path, id) = (absolute(output), FileId::of(output));
+        for (input, input_id) in &inputs {
+            let same_id = matches!((&id, input_id), (Some(a), Some(b)) if a == b);
+            if *input == path || same_id {
+                bail!(
+                    "{role} {} is one of the inputs: refusing to overwrite it",
+                    output.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `path` made absolute with every existing part resolved (links followed): its
+/// deepest existing ancestor canonicalized, the rest appended.
+fn absolute(path: &Path) -> PathBuf {
+    let joined = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir().map_or_else(|_| path.to_path_buf(), |cwd| cwd.join(path))
+    };
+    let mut missing = Vec::new();
+    let mut existing = joined.as_path();
+    loop {
+        if let Ok(canonical) = existing.canonicalize() {
+            return missing
+                .iter()
+                .rev()
+                .fold(canonical, |acc: PathBuf, part| acc.join(part));
+        }
+        match (existing.parent(), existing.file_name()) {
+            (Some(parent), Some(name)) => {
+                missing.push(name.to_os_string());
+                existing = parent;
+            }
+            _ => return joined,
+        }
+    }
+}
+
+/// The identity of an existing file: device and inode on Unix (hard links share it).
+#[derive(PartialEq, Eq)]
+struct FileId(u64, u64);
+
+impl FileId {
+    #[cfg(unix)]
+    fn of(path: &Path) -> Option<FileId> {
+        use std::os::unix::fs::MetadataExt;
+        fs::metadata(path).ok().map(|m| FileId(m.dev(), m.ino()))
+    }
+
+    #[cfg(not(unix))]
+    fn of(_path: &Path) -> Option<FileId> {
+        None
+    }
+}
+
+/// A file written atomically: bytes go to a temporary file in the destination's folder
+/// (same file system, so the final rename is atomic) and replace the destination only on
+/// [`AtomicFile::commit`]. Dropped without a commit, the temporary file is removed and
+/// the destination is untouched.
+pub struct AtomicFile {
+    destination: PathBuf,
+    file: BufWriter<tempfile::NamedTempFile>,
+}
+
+impl AtomicFile {
+    /// Start writing `destination` (its folder must exist).
+    pub fn create(destination: &Path) -> anyhow::Result<AtomicFile> {
+        let folder = match destination.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent,
+            _ => Path::new("."),
+        };
+        if destination.is_dir() {
+            bail!("cannot write {}: it is a folder", destination.display());
+        }
+        let name = destination
+            .file_name()
+            .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+        let file = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".tmp")
+            .tempfile_in(folder)
+            .with_context(|| format!("cannot create {}", destination.display()))?;
+        Ok(AtomicFile {
+            destination: destination.to_path_buf(),
+            file: BufWriter::with_capacity(256 * 1024, file),
+        })
+    }
+
+    /// Flush, sync and rename over the destination.
+    pub fn commit(self) -> anyhow::Result<()> {
+        let destination = self.destination;
+        let context = || format!("cannot write {}", destination.display());
+        let file = self
+            .file
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .with_context(context)?;
+        file.as_file().sync_all().with_context(context)?;
+        file.persist(&destination)
+            .map_err(|e| e.error)
+            .with_context(context)?;
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.file.write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.flush()
+    }
+}
+
+/// Write `bytes` to `path` atomically.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(bytes)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    file.commit()
+}
+
+/// Write `value` as pretty JSON (and a final newline) to `path`, atomically.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
+    let mut text = serde_json::to_string_pretty(value)?;
+    text.push('\n');
+    write_atomic(path, text.as_bytes())
+}
+
+/// Refuse a `--plots`-style output folder that exists as something else than a folder,
+/// before any work is done.
+pub fn check_output_folder(role: &str, dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{role} {}: exists and is not a folder", dir.display());
+    }
+    Ok(())
+}
+
+/// Refuse an input that is missing, a folder or unreadable, with a one-line message
+/// naming its role (e.g. `--model`).
+pub fn check_input_file(role: &str, path: &Path) -> anyhow::Result<()> {
+    match fs::metadata(path) {
+        Ok(meta) if meta.is_dir() => bail!("{role} {} is a folder, not a file", path.display()),
+        Ok(_) => Ok(()),
+        Err(e) => bail!("cannot read {role} {}: {}", path.display(), io_reason(&e)),
+    }
+}
+
+/// An I/O error's reason without the "(os error N)" suffix.
+pub fn io_reason(error: &io::Error) -> String {
+    match error.kind() {
+        io::ErrorKind::NotFound => "no such file".to_string(),
+        io::ErrorKind::PermissionDenied => "permission denied".to_string(),
+        _ => {
+            let text = error.to_string();
+            text.split(" (os error").next().unwrap_or(&text).to_string()
+        }
+    }
+}
+
+/// A results folder built beside its destination and swapped in whole.
+///
+/// `DIR.partial` is where the run writes ([`StagedFolder::path`]). On
+/// [`StagedFolder::complete`] the previous `DIR` (if any) is moved aside, `DIR.partial`
+/// renamed to `DIR`, and the previous one removed. On [`StagedFolder::fail`] the staging
+/// folder becomes `DIR.failed` (replacing an older one) and `DIR` is left as it was.
+/// A staging folder left by a run that was killed is cleared by the next run: one run
+/// at a time per destination.
+///
+/// Only a folder that holds a previous run (its `summary.json`) or nothing is replaced:
+/// a destination holding other files is refused, so a mistyped `--out ~` cannot remove
+/// a home folder.
+pub struct StagedFolder {
+    destination: PathBuf,
+    staging: PathBuf,
+}
+
+/// The file whose presence marks a folder as a previous run's.
+const RUN_MARKER: &str = "summary.json";
+
+impl StagedFolder {
+    /// Prepare `DIR.partial` (empty) for a run whose results go to `destination`.
+    pub fn begin(destination: &Path) -> anyhow::Result<StagedFolder> {
+        if destination.exists() {
+            if !destination.is_dir() {
+                bail!(
+                    "output folder {}: exists and is not a folder",
+                    destination.display()
+                );
+            }
+            let empty = fs::read_dir(destination)
+                .with_context(|| format!("cannot read output folder {}", destination.display()))?
+                .next()
+                .is_none();
+            if !empty && !destination.join(RUN_MARKER).is_file() {
+                bail!(
+                    "output folder {} holds files that are not a sweephold run (no {RUN_MARKER}): \
+                     choose a new or empty folder",
+                    destination.display()
+                );
+            }
+        }
+        let staging = sibling(destination, "partial")?;
+        remove_if_present(&staging)?;
+        fs::create_dir_all(&staging)
+            .with_context(|| format!("cannot create output folder {}", staging.display()))?;
+        Ok(StagedFolder {
+            destination: destination.to_path_buf(),
+            staging,
+        })
+    }
+
+    /// Where the run writes its files.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// The folder the results end up in.
+    pub fn destination(&self) -> &Path {
+        &self.destination
+    }
+
+    /// Swap the completed run in for the previous one.
+    pub fn complete(self) -> anyhow::Result<()> {
+        let previous = sibling(&self.destination, "previous")?;
+        remove_if_present(&previous)?;
+        let had_previous = self.destination.exists();
+        if had_previous {
+            fs::rename(&self.destination, &previous).with_context(|| {
+                format!(
+                    "cannot move the previous {} aside",
+                    self.destination.display()
+                )
+            })?;
+        }
+        if let Err(error) = fs::rename(&self.staging, &self.destination) {
+            if had_previous {
+                // Put the previous results back: the run's stay in DIR.partial.
+                let _ = fs::rename(&previous, &self.destination);
+            }
+            return Err(error).with_context(|| {
+                format!(
+                    "cannot move {} to {}",
+                    self.staging.display(),
+                    self.destination.display()
+                )
+            });
+        }
+        if had_previous {
+            remove_if_present(&previous)?;
+        }
+        Ok(())
+    }
+
+    /// Keep the failed run's files as `DIR.failed`; returns that path.
+    pub fn fail(self) -> anyhow::Result<PathBuf> {
+        let failed = sibling(&self.destination, "failed")?;
+        remove_if_present(&failed)?;
+        fs::rename(&self.staging, &failed).with_context(|| {
+            format!(
+                "cannot move {} to {}",
+                self.staging.display(),
+                failed.display()
+            )
+        })?;
+        Ok(failed)
+    }
+}
+
+/// `DIR.<suffix>` beside `dir`.
+fn sibling(dir: &Path, suffix: &str) -> anyhow::Result<PathBuf> {
+    let name = dir
+        .file_name()
+        .filter(|n| !n.is_empty() && *n != "." && *n != "..")
+        .ok_or_else(|| anyhow::anyhow!("output folder {}: needs a folder name", dir.display()))?;
+    let mut sibling = name.to_os_string();
+    sibling.push(format!(".{suffix}"));
+    Ok(dir.with_file_name(sibling))
+}
+
+fn remove_if_present(dir: &Path) -> anyhow::Result<()> {
+    match fs::remove_dir_all(dir) {
+        Err(e) if e.kind() != io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("cannot remove {}", dir.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("sweephold-output-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn an_input_named_as_output_is_refused_by_path_link_or_hard_link() {
+        let dir = scratch("same");
+        let input = dir.join("a.bin");
+        fs::write(&input, b"telemetry").unwrap();
+        let relative = dir.join("sub/../a.bin");
+        fs::create_dir_all(dir.join("sub")).unwrap();
+        let hard = dir.join("hard.bin");
+        fs::hard_link(&input, &hard).unwrap();
+        for output in [&input, &relative, &hard] {
+            let error = refuse_inputs_as_outputs(&[&input], &[("-o", output)]).unwrap_err();
+            assert!(
+                error.to_string().contains("is one of the inputs"),
+                "{error}"
+            );
+        }
+        #[cfg(unix)]
+        {
+            let link = dir.join("link.bin");
+            std::os::unix::fs::symlink(&input, &link).unwrap();
+            assert!(refuse_inputs_as_outputs(&[&input], &[("-o", &link)]).is_err());
+        }
+        let other = dir.join("new/out.csv");
+        refuse_inputs_as_outputs(&[&input], &[("-o", &other)]).unwrap();
+        assert_eq!(fs::read(&input).unwrap(), b"telemetry");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_atomic_file_replaces_only_on_commit() {
+        let dir = scratch("atomic");
+        let path = dir.join("frf.json");
+        fs::write(&path, b"earlier").unwrap();
+        {
+            let mut file = AtomicFile::create(&path).unwrap();
+            file.write_all(b"half").unwrap();
+            // dropped: no commit
+        }
+        assert_eq!(fs::read(&path).unwrap(), b"earlier");
+        write_atomic(&path, b"new").unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"new");
+        // No temporary file is left behind.
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
+        assert!(write_atomic(&dir, b"x").is_err());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_staged_folder_replaces_the_previous_run_only_when_complete() {
+        let dir = scratch("staged");
+        let out = dir.join("run");
+        // First run completes.
+        let stage = StagedFolder::begin(&out).unwrap();
+        fs::write(stage.path().join(RUN_MARKER), b"one").unwrap();
+        fs::write(stage.path().join("stale.bin"), b"old").unwrap();
+        stage.complete().unwrap();
+        assert_eq!(fs::read(out.join(RUN_MARKER)).unwrap(), b"one");
+        // Second run fails: the first stays, the failed one is kept beside it.
+        let stage = StagedFolder::begin(&out).unwrap();
+        fs::write(stage.path().join(RUN_MARKER), b"two").unwrap();
+        let failed = stage.fail().unwrap();
+        assert_eq!(fs::read(out.join(RUN_MARKER)).unwrap(), b"one");
+        assert_eq!(fs::read(failed.join(RUN_MARKER)).unwrap(), b"two");
+        // Third run completes: its folder replaces the first whole (no stale file).
+        let stage = StagedFolder::begin(&out).unwrap();
+        fs::write(stage.path().join(RUN_MARKER), b"three").unwrap();
+        stage.complete().unwrap();
+        assert_eq!(fs::read(out.join(RUN_MARKER)).unwrap(), b"three");
+        assert!(!out.join("stale.bin").exists());
+        assert!(!dir.join("run.partial").exists() && !dir.join("run.previous").exists());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_folder_of_other_files_is_not_replaced() {
+        let dir = scratch("foreign");
+        let out = dir.join("home");
+        fs::create_dir_all(&out).unwrap();
+        fs::write(out.join("thesis.tex"), b"precious").unwrap();
+        let error = StagedFolder::begin(&out).err().unwrap();
+        assert!(error.to_string().contains("not a sweephold run"), "{error}");
+        assert_eq!(fs::read(out.join("thesis.tex")).unwrap(), b"precious");
+        fs::write(dir.join("file"), b"x").unwrap();
+        assert!(StagedFolder::begin(&dir.join("file")).is_err());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
