@@ -35,10 +35,15 @@ pub struct FrfArgs {
     pub plots: Option<PathBuf>,
     /// Frequency band [rad/s] of the grid; default: the sweep band of the dump Header
     /// (required for CSV).
-    #[arg(long, value_name = "WMIN,WMAX", value_parser = parse_band)]
+    #[arg(long, value_name = "WMIN,WMAX", value_parser = parse_band, allow_hyphen_values = true)]
     pub band: Option<Band>,
-    /// Coherence γ² at or above which a frequency is valid.
-    #[arg(long, value_name = "G2", default_value_t = 0.6)]
+    /// Coherence γ² at or above which a frequency is valid, 0–1.
+    #[arg(
+        long,
+        value_name = "G2",
+        default_value_t = 0.6,
+        allow_hyphen_values = true
+    )]
     pub coherence_threshold: f64,
     /// Largest random error ε_r = √(1−γ²)/(|γ|·√(2·n_d)) a valid frequency may have, besides
     /// the coherence threshold; `none`: the coherence alone decides. The
@@ -46,16 +51,31 @@ pub struct FrfArgs {
     /// bottom of the band only the longest window resolves a frequency, and γ² = 0.65 there
     /// scatters three times as much as from the shorter windows. What it does to a fit is
     /// measured in the README ("`sweephold frf`").
-    #[arg(long, value_name = "E|none", default_value = "0.15", value_parser = parse_max_random_error)]
+    #[arg(long, value_name = "E|none", default_value = "0.15", value_parser = parse_max_random_error, allow_hyphen_values = true)]
     pub max_random_error: MaxRandomError,
-    /// Number of window lengths (from 20π/ω_max to half the record).
-    #[arg(long, value_name = "N", default_value_t = 5)]
+    /// Number of window lengths (from 20π/ω_max to half the record), 1–20.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 5,
+        allow_hyphen_values = true
+    )]
     pub windows: usize,
-    /// Overlap of consecutive windows, 0..0.95.
-    #[arg(long, value_name = "FRACTION", default_value_t = 0.8)]
+    /// Overlap of consecutive windows, 0–0.95.
+    #[arg(
+        long,
+        value_name = "FRACTION",
+        default_value_t = 0.8,
+        allow_hyphen_values = true
+    )]
     pub overlap: f64,
-    /// Number of log-spaced frequencies.
-    #[arg(long, value_name = "N", default_value_t = 200)]
+    /// Number of log-spaced frequencies, 2–100000.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 200,
+        allow_hyphen_values = true
+    )]
     pub points: usize,
     /// How the conditioned responses are estimated.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Cross)]

@@ -38,9 +38,9 @@ pub fn write_report(dir: &Path) -> Result<PathBuf, ReportError> {
     let inputs = ReportInputs::load(dir)?;
     let html = render(&inputs);
     let path = dir.join(files::REPORT);
-    std::fs::write(&path, html).map_err(|e| ReportError::Write {
+    crate::output::write_atomic(&path, html.as_bytes()).map_err(|e| ReportError::Write {
         path: path.clone(),
-        message: e.to_string(),
+        message: e.root_cause().to_string(),
     })?;
     Ok(path)
 }
