@@ -2,7 +2,9 @@
 //!
 //! Feed it byte chunks of any size, split anywhere. It yields every good frame; a frame
 //! that fails COBS, CRC or postcard decoding is counted and skipped, and decoding
-//! resynchronises at the next 0x00. Missing Sample tick numbers are counted as gaps.
+//! resynchronises at the next 0x00. Missing Sample tick numbers are counted as gaps, and
+//! a Sample whose tick does not move forward (a step back or a repeat) as a backward step
+//! (see [`tick_step`] for how a counter wrap at 2³² is told from a step back).
 //! No allocation: a partial frame that straddles two chunks is kept in a fixed buffer of
 //! [`MAX_FRAME_LEN`] bytes.
 
@@ -65,8 +67,34 @@ pub struct DecodeStats {
     pub good_frames: u64,
     /// Frames rejected (COBS, CRC, postcard, too long, truncated tail, version).
     pub corrupt_frames: u64,
-    /// Sample ticks missing between consecutive good Samples.
+    /// Sample ticks missing between consecutive good Samples that move forward.
     pub tick_gaps: u64,
+    /// Good Samples whose tick does not move forward from the previous good Sample's: a
+    /// step back or a repeat (a restarted counter, spliced or reordered data). Not gaps.
+    pub tick_steps_back: u64,
+}
+
+/// How a Sample's tick relates to the previous Sample's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TickStep {
+    /// The tick moves forward by this many (≥ 1; 1 is the next tick, more means gaps).
+    Forward(u32),
+    /// The tick is the same as or before the previous one.
+    Back,
+}
+
+/// Classify the step from tick `previous` to tick `next` of a u32 counter that wraps at
+/// 2³²: the forward distance `next − previous` (mod 2³²) is a step forward when it is
+/// in 1..2³¹ — across a wrap too, so 4 294 967 295 → 0 is the next tick — and a step back
+/// otherwise: 0 is a repeat, 2³¹ or more is read as `next` lying before `previous`
+/// (102 → 50 is a step back of 52, not 4 294 967 244 ticks forward).
+pub const fn tick_step(previous: u32, next: u32) -> TickStep {
+    let forward = next.wrapping_sub(previous);
+    if forward == 0 || forward >= 1 << 31 {
+        TickStep::Back
+    } else {
+        TickStep::Forward(forward)
+    }
 }
 
 /// Streaming decoder; see the module documentation.
@@ -99,6 +127,7 @@ impl Decoder {
                 good_frames: 0,
                 corrupt_frames: 0,
                 tick_gaps: 0,
+                tick_steps_back: 0,
             },
         }
     }
@@ -145,8 +174,11 @@ impl Decoder {
                 self.stats.good_frames += 1;
                 if let Frame::Sample(sample) = frame {
                     if let Some(last) = self.last_tick {
-                        if sample.tick > last {
-                            self.stats.tick_gaps += u64::from(sample.tick - last - 1);
+                        match tick_step(last, sample.tick) {
+                            TickStep::Forward(step) => {
+                                self.stats.tick_gaps += u64::from(step.saturating_sub(1));
+                            }
+                            TickStep::Back => self.stats.tick_steps_back += 1,
                         }
                     }
                     self.last_tick = Some(sample.tick);

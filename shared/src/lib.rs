@@ -29,5 +29,5 @@ pub mod frames;
 pub mod synthetic;
 
 pub use codec::{encode, MAX_FRAME_LEN};
-pub use decoder::{DecodeStats, Decoder, FrameError};
+pub use decoder::{tick_step, DecodeStats, Decoder, FrameError, TickStep};
 pub use frames::*;

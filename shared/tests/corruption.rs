@@ -213,6 +213,10 @@ fn corrupted_stream_recovers_every_untouched_frame() {
             stats.tick_gaps, expected_gaps as u64,
             "seed {seed}: tick gaps"
         );
+        assert_eq!(
+            stats.tick_steps_back, 0,
+            "seed {seed}: lost frames are no steps back"
+        );
 
         // 3. Every run of touched frames and every garbage burst is counted corrupt.
         let touched_runs =

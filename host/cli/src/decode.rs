@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
-use sweephold_protocol::{DecodeStats, Decoder, Event, Frame, FrameError, Header};
+use sweephold_protocol::{
+    tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, TickStep,
+};
 
 use crate::output::{refuse_inputs_as_outputs, AtomicFile};
 use crate::table::{axis_name, phase_name, RowWriter};
@@ -25,8 +27,9 @@ pub enum Format {
 #[derive(Args, Debug)]
 #[command(
     after_help = "Columns are listed in the README (section `decode`). A summary goes to \
-stderr: good frames, corrupt frames skipped, tick gaps, duration, vehicle, protocol version; \
-with CSV output the events are listed there too.\n\nExit status: 0 when at least one good \
+stderr: good frames, corrupt frames skipped, tick gaps, tick steps back (a Sample whose tick \
+is not after the previous one's), duration, vehicle, protocol version; with CSV output the \
+events are listed there too.\n\nExit status: 0 when at least one good \
 frame was read; 1 on a missing or unreadable file, a dump of another protocol major version, \
 or no valid frame at all."
 )]
@@ -56,16 +59,21 @@ pub struct DumpSummary {
     pub samples: u64,
     /// Ticks of the first and last Sample.
     pub tick_span: Option<(u32, u32)>,
+    /// Ticks elapsed from the first Sample to the last, counted over the steps that move
+    /// forward (`sweephold_protocol::tick_step`): a step back or a repeat adds nothing, a
+    /// wrap of the counter at 2³² counts as the step forward it is.
+    pub forward_ticks: u64,
     /// Events in stream order.
     pub events: Vec<Event>,
 }
 
 impl DumpSummary {
-    /// Seconds between the first and last Sample, when the rate is known.
+    /// Seconds from the first to the last Sample over the ticks that moved forward
+    /// ([`Self::forward_ticks`]), when the rate is known.
     pub fn duration_s(&self) -> Option<f64> {
-        let (first, last) = self.tick_span?;
+        self.tick_span?;
         let rate = f64::from(self.header?.rate_hz);
-        (rate > 0.0).then(|| f64::from(last.wrapping_sub(first)) / rate)
+        (rate > 0.0).then(|| self.forward_ticks as f64 / rate)
     }
 }
 
@@ -108,12 +116,20 @@ fn handle_frame<W: Write>(
 ) -> anyhow::Result<()> {
     match frame {
         Frame::Sample(sample) => {
-            let first = summary.tick_span.map_or(sample.tick, |(first, _)| first);
+            let first = match summary.tick_span {
+                Some((first, last)) => {
+                    if let TickStep::Forward(step) = tick_step(last, sample.tick) {
+                        summary.forward_ticks += u64::from(step);
+                    }
+                    first
+                }
+                None => sample.tick,
+            };
             summary.tick_span = Some((first, sample.tick));
             let time = summary
                 .header
                 .filter(|h| h.rate_hz > 0)
-                .map(|h| f64::from(sample.tick.wrapping_sub(first)) / f64::from(h.rate_hz));
+                .map(|h| summary.forward_ticks as f64 / f64::from(h.rate_hz));
             rows.sample(&sample, time)?;
             summary.samples += 1;
         }
@@ -310,13 +326,14 @@ fn print_summary(path: &Path, s: &DumpSummary, list_events: bool) {
         .map_or("unknown".to_string(), |d| format!("{d:.3} s"));
     eprintln!("{}:", path.display());
     eprintln!(
-        "  {} bytes, {} good frames ({} samples, {} events), {} corrupt frames skipped, {} tick gaps",
+        "  {} bytes, {} good frames ({} samples, {} events), {} corrupt frames skipped, {} tick gaps, {} tick steps back",
         st.bytes,
         st.good_frames,
         s.samples,
         s.events.len(),
         st.corrupt_frames,
-        st.tick_gaps
+        st.tick_gaps,
+        st.tick_steps_back
     );
     eprintln!(
         "  duration {duration}, vehicle {vehicle}, rate {rate}, protocol {protocol}, firmware {firmware}"

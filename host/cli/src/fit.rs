@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs;
 use std::io::{self, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::arg_values;
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
@@ -24,17 +24,20 @@ use sysid::fit::{
 /// Arguments of `sweephold fit`.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Structure files and the model.json layout are described in \
-host/sysid/models/README.md. Shipped structures: host/sysid/models/bo105-6dof.toml and \
-bo105-9dof-hybrid.toml.\n\nGuidelines (paper, Tischler & Remple): J_ave <= 100 acceptable, \
+    after_help = "Shipped structures (compiled in; --model NAME): bo105-6dof (quasi-steady \
+6-DOF with equivalent delays), bo105-9dof-hybrid (rigid body + first-order flapping, the \
+paper's Table 2), trex700l-6dof and trex700l-9dof-hybrid (the same structures with the TREX \
+700L's geometry, flap cross-coupling and hover trim). The structure file format and the \
+model.json layout are described in the models README of the sysid crate.\n\nGuidelines (paper, Tischler & Remple): J_ave <= 100 acceptable, \
 <= 50 excellent; Cramér–Rao bound <= 20 %, insensitivity <= 10 %, |correlation| <= 0.9."
 )]
 pub struct FitArgs {
     /// Frequency responses to fit (`frf.json` as `sweephold frf` writes it).
     #[arg(long, value_name = "FILE")]
     pub frf: PathBuf,
-    /// Model structure file (TOML).
-    #[arg(long, value_name = "STRUCTURE.toml")]
+    /// Model structure: a structure file (TOML), or the name of a shipped structure
+    /// (listed below). An existing file wins over a name.
+    #[arg(long, value_name = "NAME|FILE")]
     pub model: PathBuf,
     /// Write the fitted model here (`model.json`).
     #[arg(long, value_name = "FILE")]
@@ -85,6 +88,26 @@ fn parse_constant(text: &str) -> Result<(String, f64), String> {
     Ok((name.to_string(), value))
 }
 
+/// `--model`: an existing path is read as a structure file; anything else must be the
+/// name of a shipped structure.
+fn model_structure(
+    model: &Path,
+    constants: &BTreeMap<String, f64>,
+) -> anyhow::Result<ModelStructure> {
+    if model.exists() {
+        check_input_file("--model", model)?;
+        return Ok(ModelStructure::from_path_with_constants(model, constants)?);
+    }
+    let name = model.to_string_lossy();
+    crate::campaign::structures::shipped(&name, constants).unwrap_or_else(|| {
+        bail!(
+            "--model {}: no such file, and no shipped structure of that name ({})",
+            model.display(),
+            sysid::models::shipped_names()
+        )
+    })
+}
+
 /// Run `sweephold fit`.
 pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let mut inputs = vec![args.frf.as_path()];
@@ -108,7 +131,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         )
     })?;
     let constants: BTreeMap<String, f64> = args.constants.iter().cloned().collect();
-    let structure = ModelStructure::from_path_with_constants(&args.model, &constants)?;
+    let structure = model_structure(&args.model, &constants)?;
 
     // Everything goes to one report printed at the end (see `emit`).
     let mut report = String::new();

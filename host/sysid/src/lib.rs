@@ -5,4 +5,5 @@
 pub mod document;
 pub mod fit;
 pub mod frf;
+pub mod models;
 pub mod random;

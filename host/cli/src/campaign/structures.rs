@@ -1,24 +1,52 @@
-//! The model structures a campaign fits, compiled into the binary so that `sweephold
-//! campaign` works from any directory.
+//! The model structures a campaign fits and `sweephold fit --model NAME` resolves: the
+//! structures shipped in sysid ([`sysid::models`]), with the flown vehicle's numbers put in
+//! where the file carries the Bo-105's.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::Context;
+use anyhow::{anyhow, Context};
 use sweephold_protocol::{Decoder, Event, Frame};
 
 use sysid::fit::structure::ParameterKind;
 use sysid::fit::{ModelStructure, StructureError};
+use sysid::models::{self, ShippedStructure, VehicleData};
 
-/// `host/sysid/models/bo105-6dof.toml`: the quasi-steady 6-DOF structure.
-pub const SIX_DOF_TOML: &str = include_str!("../../../sysid/models/bo105-6dof.toml");
-
-/// `host/sysid/models/bo105-9dof-hybrid.toml`: the paper's Table 2 hybrid structure.
-pub const NINE_DOF_HYBRID_TOML: &str = include_str!("../../../sysid/models/bo105-9dof-hybrid.toml");
-
-/// The quasi-steady 6-DOF structure (both vehicles: no TREX-specific structure exists).
+/// The quasi-steady 6-DOF structure (both vehicles: it has no vehicle constants).
 pub fn six_dof() -> Result<ModelStructure, StructureError> {
-    ModelStructure::parse(SIX_DOF_TOML, "bo105-6dof.toml (built in)")
+    models::BO105_6DOF.parse()
+}
+
+/// The shipped structure called `name` (see [`sysid::models::SHIPPED`]) with
+/// `overrides` of its constants applied last, or None when no structure has that name.
+/// A `trex700l-*` structure gets the TREX's numbers ([`with_vehicle_data`]) and its
+/// simulator's hover trim attitude, the file's Bo-105 numbers being of no use for it.
+pub fn shipped(
+    name: &str,
+    overrides: &BTreeMap<String, f64>,
+) -> Option<anyhow::Result<ModelStructure>> {
+    let shipped = models::shipped(name)?;
+    Some(match shipped.vehicle_data {
+        VehicleData::InFile => shipped.parse_with_constants(overrides).map_err(Into::into),
+        VehicleData::FromCaller => shipped_for_its_vehicle(shipped, overrides),
+    })
+}
+
+fn shipped_for_its_vehicle(
+    shipped: &ShippedStructure,
+    overrides: &BTreeMap<String, f64>,
+) -> anyhow::Result<ModelStructure> {
+    let vehicle: bo105::Vehicle = shipped
+        .vehicle
+        .parse()
+        .map_err(|e| anyhow!("{}: {e}", shipped.name))?;
+    let trim = bo105::trim(&vehicle.helicopter(), 0.0)
+        .map_err(|e| anyhow!("{} does not trim in hover: {e}", vehicle.name()))?;
+    let trim = TrimAttitude {
+        phi: trim.phi,
+        theta: trim.theta,
+    };
+    Ok(with_vehicle_data(shipped, vehicle, Some(trim), overrides)?)
 }
 
 /// The trim attitude a flight controller captured before its excitation \[rad\].
@@ -80,6 +108,20 @@ pub fn nine_dof_hybrid(
     vehicle: bo105::Vehicle,
     trim: Option<TrimAttitude>,
 ) -> Result<ModelStructure, StructureError> {
+    with_vehicle_data(&models::BO105_9DOF_HYBRID, vehicle, trim, &BTreeMap::new())
+}
+
+/// A shipped structure with the data of `vehicle` in it: of the constants `hub_height`,
+/// `hub_forward`, `shaft_tilt_sine`, `gravity` and (with `trim`) the trim attitude's, those
+/// the file declares; a fixed `Kcs` (the flap cross-coupling, rotor data) if it has one;
+/// then `overrides` of its constants. A file without any of them (the 6-DOF) is unchanged.
+pub fn with_vehicle_data(
+    shipped: &ShippedStructure,
+    vehicle: bo105::Vehicle,
+    trim: Option<TrimAttitude>,
+    overrides: &BTreeMap<String, f64>,
+) -> Result<ModelStructure, StructureError> {
+    let declared = shipped.parse()?.constants;
     let helicopter = vehicle.helicopter();
     // The hub is at body (x, z) = (hub[0], hub[2]) from the CG, z down: its height above
     // the CG is −hub[2].
@@ -95,11 +137,9 @@ pub fn nine_dof_hybrid(
             constants.insert(name.to_string(), value);
         }
     }
-    let mut structure = ModelStructure::parse_with_constants(
-        NINE_DOF_HYBRID_TOML,
-        "bo105-9dof-hybrid.toml (built in)",
-        &constants,
-    )?;
+    constants.retain(|name, _| declared.contains_key(name));
+    constants.extend(overrides.iter().map(|(name, &value)| (name.clone(), value)));
+    let mut structure = shipped.parse_with_constants(&constants)?;
     if let Some(index) = structure.parameter_index("Kcs") {
         let parameter = &mut structure.parameters[index];
         // Only a fixed entry is a rotor-data prior; a free one stays the fit's to find.
@@ -130,7 +170,7 @@ mod tests {
             assert_eq!(structure.parameters[index].kind, ParameterKind::Fixed);
             structure.parameters[index].value
         };
-        let file = ModelStructure::parse(NINE_DOF_HYBRID_TOML, "file").unwrap();
+        let file = models::BO105_9DOF_HYBRID.parse().unwrap();
         let in_file = file.parameters[file.parameter_index("Kcs").unwrap()].value;
         let bo105_rotor = bo105::Helicopter::bo105().flap_cross_coupling();
         // The file's number is the Bo-105 rotor's, rounded to the digits written.
@@ -144,6 +184,53 @@ mod tests {
         assert!(
             (trex - bo105_rotor).abs() > 0.01,
             "TREX {trex}, Bo-105 {bo105_rotor}"
+        );
+    }
+
+    #[test]
+    fn shipped_names_resolve_to_the_structures_the_campaign_fits() {
+        let none = BTreeMap::new();
+        let by_name = |name: &str| shipped(name, &none).unwrap().unwrap();
+        assert_eq!(by_name("bo105-6dof"), six_dof().unwrap());
+        assert_eq!(by_name("trex700l-6dof"), six_dof().unwrap());
+        assert_eq!(
+            by_name("bo105-9dof-hybrid"),
+            models::BO105_9DOF_HYBRID.parse().unwrap()
+        );
+        assert!(shipped("bo105-7dof", &none).is_none());
+
+        // The TREX's hybrid: its geometry and rotor, and its simulator's hover trim.
+        let trex = by_name("trex700l-9dof-hybrid");
+        let heli = bo105::Helicopter::trex700l();
+        let hover = bo105::trim(&heli, 0.0).unwrap();
+        let campaign = nine_dof_hybrid(
+            bo105::Vehicle::Trex700l,
+            Some(TrimAttitude {
+                phi: hover.phi,
+                theta: hover.theta,
+            }),
+        )
+        .unwrap();
+        assert_eq!(trex, campaign);
+        assert_eq!(trex.constants["hub_height"], -heli.main_rotor.hub[2]);
+        assert_eq!(trex.constants["sin_phi0"], hover.phi.sin());
+        assert!(
+            (trex.constants["sin_phi0"] - by_name("bo105-9dof-hybrid").constants["sin_phi0"]).abs()
+                > 0.01
+        );
+        let kcs = trex.parameters[trex.parameter_index("Kcs").unwrap()].value;
+        assert_eq!(kcs, heli.flap_cross_coupling());
+
+        // --constant overrides come last, and must name a declared constant.
+        let overrides = BTreeMap::from([("hub_height".to_string(), 0.5)]);
+        for name in ["bo105-9dof-hybrid", "trex700l-9dof-hybrid"] {
+            let structure = shipped(name, &overrides).unwrap().unwrap();
+            assert_eq!(structure.constants["hub_height"], 0.5, "{name}");
+        }
+        let error = shipped("trex700l-6dof", &overrides).unwrap().unwrap_err();
+        assert!(
+            error.to_string().contains("unknown constant `hub_height`"),
+            "{error}"
         );
     }
 
@@ -210,7 +297,7 @@ mod tests {
 
     #[test]
     fn the_geometry_constants_are_the_flown_vehicles() {
-        let file = ModelStructure::parse(NINE_DOF_HYBRID_TOML, "file").unwrap();
+        let file = models::BO105_9DOF_HYBRID.parse().unwrap();
         let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
         let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l, None).unwrap();
         // The file's numbers are the Bo-105's geometry (to the digits written).

@@ -37,6 +37,18 @@ pub enum StructureProblem {
         /// What is wrong.
         reason: String,
     },
+    /// A number that must be finite is NaN or infinite: a parameter's start, fixed value
+    /// or bound, a matrix entry or a delay.
+    NotFinite {
+        /// What the number is, e.g. ``parameter `Xu` `` or ``parameter `Xu`: min``.
+        what: String,
+        /// The number.
+        value: f64,
+    },
+    /// Parameters declared under `[parameters]` that no matrix entry or delay uses (or
+    /// only with a coefficient of 0): the fit cannot move them, and their Cramér–Rao
+    /// bounds would make every bound infinite.
+    UnusedParameters(Vec<String>),
     /// A pair range that is neither `"auto"` nor `[lo, hi]` with 0 < lo < hi.
     BadRange(String),
     /// The file could not be read.
@@ -60,6 +72,25 @@ impl fmt::Display for StructureProblem {
                 write!(f, "constrained parameter `{name}` depends on itself")
             }
             Self::BadParameter { name, reason } => write!(f, "parameter `{name}`: {reason}"),
+            Self::NotFinite { what, value } => write!(f, "{what} = {value} is not a finite number"),
+            Self::UnusedParameters(names) => {
+                let listed = names
+                    .iter()
+                    .map(|name| format!("`{name}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                if names.len() == 1 {
+                    write!(
+                        f,
+                        "parameter {listed} is declared but used in no matrix entry or delay"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "parameters {listed} are declared but used in no matrix entry or delay"
+                    )
+                }
+            }
             Self::BadRange(reason) => write!(f, "bad range: {reason}"),
             Self::Io(message) => write!(f, "cannot read: {message}"),
         }

@@ -6,7 +6,7 @@
 //! `toml::de::Error` carries, semantic errors (unknown state, undefined parameter, …)
 //! through `toml::Spanned` values.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::Path;
 
 use serde::Deserialize;
@@ -455,8 +455,20 @@ impl ModelStructure {
                     },
                 )
             };
+            let not_finite = |what: String, number: f64| {
+                context.error(
+                    key.span(),
+                    StructureProblem::NotFinite {
+                        what,
+                        value: number,
+                    },
+                )
+            };
             match value.get_ref() {
                 RawParameter::Start(start) => {
+                    if !start.is_finite() {
+                        return Err(not_finite(format!("parameter `{name}`"), *start));
+                    }
                     base_index.insert(name.clone(), parameters.len());
                     parameters.push(Parameter {
                         name,
@@ -473,6 +485,16 @@ impl ModelStructure {
                         + usize::from(table.expr.is_some());
                     if given != 1 {
                         return Err(bad("give exactly one of `start`, `fixed`, `expr`"));
+                    }
+                    for (label, number) in [
+                        ("", table.start),
+                        ("", table.fixed),
+                        (": min", table.min),
+                        (": max", table.max),
+                    ] {
+                        if let Some(number) = number.filter(|n| !n.is_finite()) {
+                            return Err(not_finite(format!("parameter `{name}`{label}"), number));
+                        }
                     }
                     if let (Some(lo), Some(hi)) = (table.min, table.max) {
                         if lo >= hi {
@@ -538,30 +560,40 @@ impl ModelStructure {
             });
         }
 
-        let resolve_value =
-            |value: &Spanned<RawValue>| -> Result<ParameterExpression, StructureError> {
-                match value.get_ref() {
-                    RawValue::Number(number) => Ok(ParameterExpression {
-                        constant: *number,
-                        terms: Vec::new(),
-                    }),
-                    RawValue::Expression(text) => {
-                        let form =
-                            parse_linear_with_constants(text, &constants).map_err(|reason| {
-                                context.error(
-                                    value.span(),
-                                    StructureProblem::BadExpression {
-                                        expression: text.clone(),
-                                        reason,
-                                    },
-                                )
-                            })?;
-                        resolver
-                            .resolve(&form, &mut Vec::new())
-                            .map_err(|problem| context.error(value.span(), problem))
-                    }
+        // Parameter names the matrix entries and delays refer to (constrained ones too).
+        let mut referenced: BTreeSet<String> = BTreeSet::new();
+        let mut resolve_value = |value: &Spanned<RawValue>,
+                                 what: &dyn Fn() -> String|
+         -> Result<ParameterExpression, StructureError> {
+            match value.get_ref() {
+                RawValue::Number(number) if !number.is_finite() => Err(context.error(
+                    value.span(),
+                    StructureProblem::NotFinite {
+                        what: what(),
+                        value: *number,
+                    },
+                )),
+                RawValue::Number(number) => Ok(ParameterExpression {
+                    constant: *number,
+                    terms: Vec::new(),
+                }),
+                RawValue::Expression(text) => {
+                    let form = parse_linear_with_constants(text, &constants).map_err(|reason| {
+                        context.error(
+                            value.span(),
+                            StructureProblem::BadExpression {
+                                expression: text.clone(),
+                                reason,
+                            },
+                        )
+                    })?;
+                    referenced.extend(form.terms.keys().cloned());
+                    resolver
+                        .resolve(&form, &mut Vec::new())
+                        .map_err(|problem| context.error(value.span(), problem))
                 }
-            };
+            }
+        };
 
         // Matrix entries.
         let mut entries = Vec::new();
@@ -586,11 +618,19 @@ impl ModelStructure {
                 }
                 for (column_key, value) in columns {
                     let column = context.index_of(column_names, column_key, column_kind)?;
+                    let what = || {
+                        format!(
+                            "entry {}[{}, {}]",
+                            matrix.as_str(),
+                            row_key.get_ref(),
+                            column_key.get_ref()
+                        )
+                    };
                     entries.push(MatrixEntry {
                         matrix,
                         row,
                         column,
-                        expression: resolve_value(value)?,
+                        expression: resolve_value(value, &what)?,
                         line: context.line(column_key.span()),
                     });
                 }
@@ -614,8 +654,16 @@ impl ModelStructure {
         let mut delays = vec![ParameterExpression::default(); controls.len()];
         for (key, value) in &raw.delays {
             let control = context.index_of(&controls, key, "control")?;
-            delays[control] = resolve_value(value)?;
+            delays[control] = resolve_value(value, &|| format!("delay of `{}`", key.get_ref()))?;
         }
+        check_every_parameter_is_used(
+            context,
+            &raw_parameters,
+            &base_index,
+            &derived_forms,
+            referenced,
+            entries.iter().map(|entry| &entry.expression).chain(&delays),
+        )?;
 
         let auto_range_limit = match &raw.auto_range_limit {
             None => None,
@@ -773,6 +821,61 @@ impl ModelStructure {
             parameter.value = value;
         }
         Ok(copy)
+    }
+}
+
+/// Refuse parameters that no matrix entry or delay uses: a free one would leave the
+/// Hessian singular (every Cramér–Rao bound infinite, and no way to tell which parameter
+/// is to blame), a fixed or constrained one says something the model does not. A base
+/// parameter is used when some entry or delay depends on it with a non-zero coefficient
+/// (through constrained parameters too); a constrained one when an entry, a delay or a
+/// used constrained parameter names it. The error names them all, at the first one's line.
+fn check_every_parameter_is_used<'e>(
+    context: &Context<'_>,
+    declared: &[(Spanned<String>, Spanned<RawParameter>)],
+    base_index: &HashMap<String, usize>,
+    derived_forms: &HashMap<String, LinearForm>,
+    mut referenced: BTreeSet<String>,
+    expressions: impl Iterator<Item = &'e ParameterExpression>,
+) -> Result<(), StructureError> {
+    let mut used_base = vec![false; base_index.len()];
+    for expression in expressions {
+        for &(index, _) in &expression.terms {
+            if let Some(slot) = used_base.get_mut(index) {
+                *slot = true;
+            }
+        }
+    }
+    // Constrained parameters named by used constrained parameters are used too.
+    let mut pending: Vec<String> = referenced.iter().cloned().collect();
+    while let Some(name) = pending.pop() {
+        if let Some(form) = derived_forms.get(&name) {
+            for inner in form.terms.keys() {
+                if referenced.insert(inner.clone()) {
+                    pending.push(inner.clone());
+                }
+            }
+        }
+    }
+    let unused: Vec<&Spanned<String>> = declared
+        .iter()
+        .map(|(key, _)| key)
+        .filter(|key| {
+            let name = key.get_ref();
+            match base_index.get(name) {
+                Some(&index) => !used_base.get(index).copied().unwrap_or(false),
+                None => !referenced.contains(name),
+            }
+        })
+        .collect();
+    match unused.first() {
+        None => Ok(()),
+        Some(first) => Err(context.error(
+            first.span(),
+            StructureProblem::UnusedParameters(
+                unused.iter().map(|key| key.get_ref().clone()).collect(),
+            ),
+        )),
     }
 }
 
@@ -1019,6 +1122,151 @@ input = "u"
             StructureProblem::UndefinedParameter("Zq".into())
         );
         assert!(error.to_string().contains("undefined parameter `Zq`"));
+    }
+
+    #[test]
+    fn non_finite_numbers_are_refused_naming_the_parameter_and_line() {
+        for (from, to, line, message) in [
+            (
+                "b = 3.0",
+                "b = nan",
+                9,
+                "parameter `b` = NaN is not a finite number",
+            ),
+            (
+                "b = 3.0",
+                "b = -inf",
+                9,
+                "parameter `b` = -inf is not a finite number",
+            ),
+            (
+                "a = { start = -2.0, max = 0.0 }",
+                "a = { start = inf, max = 0.0 }",
+                8,
+                "parameter `a` = inf is not a finite number",
+            ),
+            (
+                "c = { fixed = 0.5 }",
+                "c = { fixed = nan }",
+                10,
+                "parameter `c` = NaN is not a finite number",
+            ),
+            (
+                "tau = { start = 0.01, min = 0.0 }",
+                "tau = { start = 0.01, min = nan }",
+                12,
+                "parameter `tau`: min = NaN is not a finite number",
+            ),
+            (
+                "a = { start = -2.0, max = 0.0 }",
+                "a = { start = -2.0, max = inf }",
+                8,
+                "parameter `a`: max = inf is not a finite number",
+            ),
+            (
+                "[F.x]\nx = \"a\"",
+                "[F.x]\nx = nan",
+                15,
+                "entry F[x, x] = NaN is not a finite number",
+            ),
+            (
+                "u = \"tau\"",
+                "u = inf",
+                27,
+                "delay of `u` = inf is not a finite number",
+            ),
+        ] {
+            let text = SMALL.replace(from, to);
+            assert_ne!(text, SMALL, "{from}");
+            let error = error_of(&text);
+            assert_eq!(error.line, Some(line), "{error}");
+            assert_eq!(
+                error.to_string(),
+                format!("test.toml, line {line}: {message}")
+            );
+        }
+    }
+
+    #[test]
+    fn bounds_must_be_ordered_and_hold_the_start() {
+        for (from, to, reason) in [
+            (
+                "a = { start = -2.0, max = 0.0 }",
+                "a = { start = -2.0, min = 0.0, max = -3.0 }",
+                "`min` must be below `max`",
+            ),
+            (
+                "a = { start = -2.0, max = 0.0 }",
+                "a = { start = -2.0, min = 1.0, max = 1.0 }",
+                "`min` must be below `max`",
+            ),
+            (
+                "a = { start = -2.0, max = 0.0 }",
+                "a = { start = 1.0, max = 0.0 }",
+                "outside [min, max]",
+            ),
+            (
+                "c = { fixed = 0.5 }",
+                "c = { fixed = 0.5, min = 1.0 }",
+                "outside [min, max]",
+            ),
+            (
+                "d = { expr = \"-2*b + 1\" }",
+                "d = { expr = \"-2*b + 1\", max = 1.0 }",
+                "cannot have bounds",
+            ),
+        ] {
+            let error = error_of(&SMALL.replace(from, to));
+            assert!(
+                matches!(error.problem, StructureProblem::BadParameter { .. }),
+                "{error}"
+            );
+            assert!(error.to_string().contains(reason), "{error}");
+        }
+    }
+
+    #[test]
+    fn a_parameter_no_entry_uses_is_refused_naming_it() {
+        let tau = "tau = { start = 0.01, min = 0.0 }";
+        let error = error_of(&SMALL.replace(tau, &format!("{tau}\nFoo = 1.0")));
+        assert_eq!(error.line, Some(13), "{error}");
+        assert_eq!(
+            error.to_string(),
+            "test.toml, line 13: parameter `Foo` is declared but used in no matrix entry or delay"
+        );
+        // Fixed and constrained ones too, all named at once; a base parameter that only an
+        // unused constrained one names is unused.
+        let text = SMALL.replace(
+            tau,
+            &format!("{tau}\ne = {{ fixed = 1.0 }}\nf = {{ expr = \"2*e\" }}"),
+        );
+        let error = error_of(&text);
+        assert_eq!(error.line, Some(13), "{error}");
+        assert_eq!(
+            error.problem,
+            StructureProblem::UnusedParameters(vec!["e".into(), "f".into()])
+        );
+        assert!(
+            error
+                .to_string()
+                .contains("parameters `e`, `f` are declared"),
+            "{error}"
+        );
+        // A parameter whose coefficients cancel has no effect: unused.
+        let text = SMALL
+            .replace("[F.x]\nx = \"a\"", "[F.x]\nx = \"a + c - c\"")
+            .replace("[H0.y]\nx = \"c\"", "[H0.y]\nx = 0.5");
+        let error = error_of(&text);
+        assert_eq!(
+            error.problem,
+            StructureProblem::UnusedParameters(vec!["c".into()])
+        );
+        assert_eq!(error.line, Some(10));
+        // Used through a constrained parameter (and a delay) is used.
+        let text = SMALL
+            .replace(tau, &format!("{tau}\ng = {{ expr = \"a\" }}"))
+            .replace("\"-2*b + 1\"", "\"g - 2*b + 1\"");
+        ModelStructure::parse(&text, "chain.toml").unwrap();
     }
 
     #[test]

@@ -7,9 +7,9 @@ use super::model::Model;
 use crate::document::{FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
 
 /// The shipped 9-DOF hybrid structure file (`models/bo105-9dof-hybrid.toml`).
-pub const BO105_HYBRID_STRUCTURE: &str = include_str!("../../models/bo105-9dof-hybrid.toml");
+pub const BO105_HYBRID_STRUCTURE: &str = crate::models::BO105_9DOF_HYBRID_TOML;
 /// The shipped quasi-steady 6-DOF structure file (`models/bo105-6dof.toml`).
-pub const BO105_SIX_DOF_STRUCTURE: &str = include_str!("../../models/bo105-6dof.toml");
+pub const BO105_SIX_DOF_STRUCTURE: &str = crate::models::BO105_6DOF_TOML;
 
 /// Frequency ranges with acceptable coherence in the paper's Table 1 (Bo-105 hover):
 /// (output, input, [lo, hi] rad/s). Pairs marked "None" there are absent.

@@ -7,11 +7,15 @@
 //! what the firmware injected into each control (`sweep` + `noise`). The rate and the
 //! swept axis come from the Header, the sweep band from its ω_min..ω_max. Ticks lost in
 //! transmission are filled by linear interpolation (and noted); a record missing more
-//! than 10 % of its ticks is refused.
+//! than 10 % of its ticks is refused, and so is one whose ticks step back (a tick not
+//! after the previous Sample's, see [`sweephold_protocol::tick_step`]; a wrap of the
+//! counter at 2³² is a step forward).
 
 use std::path::Path;
 
-use sweephold_protocol::{Decoder, Frame, FrameError, Header, InputKind, Phase, Sample};
+use sweephold_protocol::{
+    tick_step, Decoder, Frame, FrameError, Header, InputKind, Phase, Sample, TickStep,
+};
 
 use super::records::{Channel, Record};
 use super::FrfError;
@@ -124,8 +128,8 @@ fn load_dump_bytes_with(
     let stats = decoder.stats();
     let chosen = segments
         .iter()
-        .find(|(_, samples)| samples.iter().any(|s| is_excitation(s.phase)));
-    let Some((record_header, all)) = chosen else {
+        .position(|(_, samples)| samples.iter().any(|s| is_excitation(s.phase)));
+    let Some((record_header, all)) = chosen.map(|index| &segments[index]) else {
         let any_header = segments.iter().any(|(h, _)| h.is_some());
         return Err(if stats.good_frames == 0 {
             FrfError::NoSweep {
@@ -146,7 +150,12 @@ fn load_dump_bytes_with(
     let header = record_header.ok_or_else(|| FrfError::NoHeader {
         path: source.into(),
     })?;
-    record_from_samples_with(&header, all, source, excitation)
+    // Samples of the dump before the chosen test's: messages count from the dump's first.
+    let offset = segments[..chosen.unwrap_or(0)]
+        .iter()
+        .map(|(_, samples)| samples.len())
+        .sum();
+    record_from_samples_at(&header, all, offset, source, excitation)
 }
 
 /// The excitation record of one test from its Header and its Samples in stream order
@@ -158,7 +167,7 @@ pub fn record_from_samples(
     all: &[Sample],
     source: &str,
 ) -> Result<Record, FrfError> {
-    record_from_samples_with(header, all, source, Excitation::Sweep)
+    record_from_samples_at(header, all, 0, source, Excitation::Sweep)
 }
 
 /// Like [`record_from_samples`] for any excitation (doublet, 3-2-1-1 or sweep): the
@@ -168,12 +177,22 @@ pub fn test_record_from_samples(
     all: &[Sample],
     source: &str,
 ) -> Result<Record, FrfError> {
-    record_from_samples_with(header, all, source, Excitation::Any)
+    record_from_samples_at(header, all, 0, source, Excitation::Any)
 }
 
-fn record_from_samples_with(
+/// The first step back of `samples`: its index in `samples` and the two ticks.
+fn first_step_back(samples: &[Sample]) -> Option<(usize, u32, u32)> {
+    samples
+        .windows(2)
+        .position(|pair| tick_step(pair[0].tick, pair[1].tick) == TickStep::Back)
+        .map(|at| (at + 1, samples[at].tick, samples[at + 1].tick))
+}
+
+/// `all[0]` is the dump's Sample number `offset` (0-based), for messages.
+fn record_from_samples_at(
     header: &Header,
     all: &[Sample],
+    offset: usize,
     source: &str,
     excitation: Excitation,
 ) -> Result<Record, FrfError> {
@@ -214,11 +233,22 @@ fn record_from_samples_with(
         });
     }
 
-    let first_tick = samples[0].tick;
+    // A tick that does not move forward cannot be put on the time grid: refuse the record
+    // rather than drop samples (or read a step back as ~4·10⁹ missing ticks).
+    if let Some((at, before_tick, tick)) = first_step_back(samples) {
+        let index = offset + (first - before) + at;
+        return Err(FrfError::InvalidRecord {
+            source: source.into(),
+            message: format!("ticks step back at sample {index} (tick {before_tick} → {tick})"),
+        });
+    }
+    // Every step moves forward by less than 2³¹: the span is their sum (+1).
     let span = samples
-        .last()
-        .map_or(0, |s| s.tick.wrapping_sub(first_tick) as usize)
-        + 1;
+        .windows(2)
+        .map(|pair| u64::from(pair[1].tick.wrapping_sub(pair[0].tick)))
+        .sum::<u64>()
+        .saturating_add(1);
+    let span = usize::try_from(span).unwrap_or(usize::MAX);
     let missing = span.saturating_sub(samples.len());
     if missing as f64 > MAX_MISSING_FRACTION * span as f64 {
         return Err(FrfError::InvalidRecord {
@@ -236,11 +266,8 @@ fn record_from_samples_with(
         let row = input_row(sample);
         let output = outputs_of(sample);
         if let Some((tick, last_in, last_out)) = previous {
+            // Forward: steps back were refused above.
             let step = sample.tick.wrapping_sub(tick);
-            if step == 0 || step > span as u32 {
-                // A repeated or backwards tick (firmware restart): ignore the sample.
-                continue;
-            }
             for k in 1..step {
                 let t = f64::from(k) / f64::from(step);
                 for (channel, (&a, &b)) in inputs.iter_mut().zip(last_in.iter().zip(&row)) {
@@ -361,6 +388,94 @@ mod tests {
         for pair in p.windows(2) {
             assert!((pair[1] - pair[0] - 1.0).abs() < 1e-3);
         }
+    }
+
+    /// `bytes` with every Sample's tick replaced by `tick(index, tick)`, `index` counting
+    /// the dump's Samples from 0.
+    fn with_ticks(bytes: &[u8], tick: impl Fn(usize, u32) -> u32) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut index = 0;
+        for frame in Decoder::new().feed(bytes).flatten() {
+            let frame = match frame {
+                Frame::Sample(mut sample) => {
+                    sample.tick = tick(index, sample.tick);
+                    index += 1;
+                    Frame::Sample(sample)
+                }
+                other => other,
+            };
+            let mut buffer = [0u8; sweephold_protocol::MAX_FRAME_LEN];
+            let n = sweephold_protocol::encode(&frame, &mut buffer).unwrap();
+            out.extend_from_slice(&buffer[..n]);
+        }
+        out
+    }
+
+    #[test]
+    fn refuses_ticks_that_step_back() {
+        let spec = DumpSpec::default();
+        let bytes = dump_bytes(&spec);
+        // 30 idle Samples come before the Header; the sweep starts at tick 1030.
+        let first = spec.first_sweep_tick();
+        assert_eq!(first, 1030);
+        // One Sample 60 ticks early: 1032 → 972 at the dump's Sample 33.
+        let early = with_ticks(&bytes, |i, t| if i == 33 { t - 60 } else { t });
+        for error in [
+            load_dump_bytes(&early, "early.bin").unwrap_err(),
+            load_dump_bytes_with(&early, "early.bin", Excitation::Any).unwrap_err(),
+        ] {
+            assert_eq!(
+                error.to_string(),
+                "early.bin: ticks step back at sample 33 (tick 1032 → 973)"
+            );
+        }
+        // A repeated tick is no step forward either.
+        let repeat = with_ticks(&bytes, |i, t| if i == 40 { t - 1 } else { t });
+        let error = load_dump_bytes(&repeat, "repeat.bin").unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .ends_with("at sample 40 (tick 1039 → 1039)"),
+            "{error}"
+        );
+        // Reversed ticks: refused at their first step, not read as 4·10⁹ missing ticks.
+        let reversed = with_ticks(&bytes, |i, _| 5000 - i as u32);
+        let error = load_dump_bytes(&reversed, "reversed.bin").unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .ends_with("at sample 31 (tick 4970 → 4969)"),
+            "{error}"
+        );
+        // A step back outside the record (in the idle Samples before the test) is no
+        // business of the record's.
+        let idle = with_ticks(&bytes, |i, t| if i == 5 { 1 } else { t });
+        assert_eq!(
+            load_dump_bytes(&idle, "idle.bin").unwrap().len(),
+            spec.sweep_samples
+        );
+    }
+
+    #[test]
+    fn a_tick_counter_wrapping_at_2_pow_32_is_no_step_back() {
+        let spec = DumpSpec::default();
+        let plain = load_dump_bytes(&dump_bytes(&spec), "plain.bin").unwrap();
+        // The counter passes u32::MAX → 0 in the middle of the sweep.
+        let shift = u32::MAX - spec.first_sweep_tick() - 300;
+        let bytes = with_ticks(&dump_bytes(&spec), |_, t| t.wrapping_add(shift));
+        let wrapped = load_dump_bytes(&bytes, "wrapped.bin").unwrap();
+        assert_eq!(wrapped.len(), plain.len());
+        assert!(wrapped.notes.is_empty(), "{:?}", wrapped.notes);
+        assert_eq!(wrapped.input("lat"), plain.input("lat"));
+        // Lost ticks across the wrap are filled as anywhere else.
+        let lossy = DumpSpec {
+            drop_every: Some(50),
+            ..DumpSpec::default()
+        };
+        let bytes = with_ticks(&dump_bytes(&lossy), |_, t| t.wrapping_add(shift));
+        let record = load_dump_bytes(&bytes, "lossy.bin").unwrap();
+        assert_eq!(record.len(), lossy.sweep_samples);
+        assert_eq!(record.notes.len(), 1);
     }
 
     #[test]
