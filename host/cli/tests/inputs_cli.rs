@@ -268,6 +268,12 @@ fn refused_command_lines_and_outputs_that_are_inputs() {
             "names lat twice",
         ),
         (&["fly", "--bogus"], 2, "unexpected argument '--bogus'"),
+        // A board image that is not one: refused at once, before QEMU is looked for.
+        (
+            &["fly", "--fc", "qemu", "--elf", "not-a-folder", "--out", "o"],
+            1,
+            "not an ELF file",
+        ),
         (&["fit"], 2, "--frf <FILE>"),
         // Folders where files are expected, and files where folders are.
         (&["decode", "data"], 1, "is a folder"),

@@ -193,7 +193,9 @@ pub struct FlyArgs {
     /// default 460800 Bd; records flown one at a time).
     #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_fc)]
     pub fc: FcArg,
-    /// Board image for `--fc qemu` [default: target/thumbv7em-none-eabihf/firmware/sweephold-fc].
+    /// Board image for `--fc qemu` (a 32-bit ARM ELF, checked before QEMU starts) [default:
+    /// $SWEEPHOLD_FC_ELF, else target/thumbv7em-none-eabihf/firmware/sweephold-fc of the
+    /// workspace this binary was built in, else of the current folder].
     #[arg(long, value_name = "PATH")]
     pub elf: Option<PathBuf>,
 }
@@ -344,11 +346,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     // The board image is found (and checked) before anything is written.
     let image = match (&args.fc, &args.elf) {
         (FcArg::Qemu | FcArg::QemuUsart, elf) => {
-            link_qemu::qemu_available()?;
-            Some(match elf {
+            let image = match elf {
                 Some(path) => path.clone(),
                 None => link_qemu::default_image()?,
-            })
+            };
+            link_qemu::check_image(&image)?;
+            link_qemu::qemu_available()?;
+            Some(image)
         }
         _ => None,
     };
