@@ -20,7 +20,9 @@
 
 use num_complex::Complex64;
 
-use crate::document::{CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
+use crate::document::{
+    CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VERSION, MAX_PLAUSIBLE_MAG_DB,
+};
 
 use super::coherence::{accurate_range, debiased_coherence, random_error};
 use super::composite::{blend, Estimate};
@@ -538,7 +540,7 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
         let (siso_pair, siso_dropped) = pair_response(&input, output, &siso, opts);
         if dropped + siso_dropped > 0 {
             notes.push(format!(
-                "{input}→{output}: {} non-finite points left out",
+                "{input}→{output}: {} non-finite points (or beyond ±{MAX_PLAUSIBLE_MAG_DB} dB) left out",
                 dropped + siso_dropped
             ));
         }
@@ -668,7 +670,8 @@ fn rounded(omega: f64) -> f64 {
 }
 
 /// Magnitude, unwrapped phase, coherence, random error and valid range of composite
-/// estimates; non-finite points are left out (their count is returned). The valid range
+/// estimates; non-finite points, and those beyond ±[`MAX_PLAUSIBLE_MAG_DB`] (which
+/// every reader of `frf.json` refuses), are left out (their count is returned). The valid range
 /// takes the coherence threshold and, when set, the largest random error of `opts`.
 fn pair_response(
     input: &str,
@@ -690,11 +693,15 @@ fn pair_response(
     let mut previous_wrapped: Option<f64> = None;
     for &(omega, e) in points {
         let magnitude = e.response.norm();
+        let mag_db = 20.0 * magnitude.max(1e-300).log10();
+        // What `FrfDocument::validate` would refuse is left out here: a reader must
+        // accept every document this writes.
         let finite = omega.is_finite()
             && e.response.re.is_finite()
             && e.response.im.is_finite()
             && e.coherence.is_finite()
-            && e.random_error.is_finite();
+            && e.random_error.is_finite()
+            && mag_db.abs() <= MAX_PLAUSIBLE_MAG_DB;
         if !finite {
             dropped += 1;
             continue;
@@ -714,7 +721,7 @@ fn pair_response(
         };
         previous_wrapped = Some(wrapped);
         pair.omega.push(omega);
-        pair.mag_db.push(20.0 * magnitude.max(1e-300).log10());
+        pair.mag_db.push(mag_db);
         pair.phase_deg.push(phase);
         pair.coherence.push(e.coherence.clamp(0.0, 1.0));
         pair.random_error.push(e.random_error);
