@@ -9,7 +9,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 use sysid::frf::{
     analyse, group_by_primary, load_csv, load_dump, write_plots, CsvColumns, FrfAnalysis,
-    FrfOptions, Record, ResponseEstimator,
+    FrfOptions, Record, ResponseEstimator, ResponseInputs,
 };
 
 /// Arguments of `sweephold frf`.
@@ -22,7 +22,14 @@ are read as CSV with a header row (columns chosen with --time, --inputs, --outpu
 anything else as a telemetry dump.\n\nThe swept input of a CSV file is, in this order: \
 --swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
 must be the same on every row kept; else the input with the largest RMS about its trend \
-line. A dump's Header names its swept axis.\n\nExit status: 0 when frf.json was written; 1 on an \
+line. A dump's Header names its swept axis.\n\nWhich inputs get responses \
+(--excited): `swept`, the swept input of each group; `all`, also every other input whose \
+RMS is at least 10 % of the group's largest input RMS (all from the same MISO solve, each \
+with its partial coherence; the pairs carry `group` and the output's \
+`multiple_coherence`); `auto` (default), `all` for CSV files whose swept input nothing \
+names (no --swept, no primary column) and `swept` otherwise (dumps, decoded CSV). When two \
+groups give the same pair, the one from the group that sweeps its input is kept, else the \
+one with the higher mean partial coherence.\n\nExit status: 0 when frf.json was written; 1 on an \
 unreadable file, a dump without a sweep, a record too short for the band, a swept input \
 without excitation, or a bad option."
 )]
@@ -64,6 +71,9 @@ pub struct FrfArgs {
     /// How the conditioned responses are estimated.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Cross)]
     pub estimator: EstimatorArg,
+    /// Which inputs get responses (see below).
+    #[arg(long, value_enum, default_value_t = ExcitedArg::Auto)]
+    pub excited: ExcitedArg,
     /// CSV: the time column [s].
     #[arg(long, value_name = "COLUMN", default_value = "time_s")]
     pub time: String,
@@ -115,6 +125,27 @@ impl From<EstimatorArg> for ResponseEstimator {
         match arg {
             EstimatorArg::Cross => ResponseEstimator::CrossSpectral,
             EstimatorArg::SweepReference => ResponseEstimator::SweepReference,
+        }
+    }
+}
+
+/// `--excited`: see [`ResponseInputs`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExcitedArg {
+    /// `all` for CSV files whose swept input nothing names, `swept` otherwise
+    Auto,
+    /// The swept input of each group only
+    Swept,
+    /// Every input with RMS ≥ 10 % of the group's largest (cross estimator only)
+    All,
+}
+
+impl From<ExcitedArg> for ResponseInputs {
+    fn from(arg: ExcitedArg) -> ResponseInputs {
+        match arg {
+            ExcitedArg::Auto => ResponseInputs::Auto,
+            ExcitedArg::Swept => ResponseInputs::Swept,
+            ExcitedArg::All => ResponseInputs::Excited,
         }
     }
 }
@@ -182,6 +213,7 @@ impl FrfArgs {
             coherence_threshold: self.coherence_threshold,
             max_random_error: self.max_random_error.0,
             estimator: self.estimator.into(),
+            responses: self.excited.into(),
             ..FrfOptions::default()
         }
     }
@@ -259,8 +291,13 @@ fn summary(analysis: &FrfAnalysis, out: &Path, plots: usize) -> String {
     let document = &analysis.document;
     for group in &analysis.groups {
         let windows: Vec<String> = group.windows.iter().map(|w| format!("{w:.1}")).collect();
+        let responses = if group.responses.len() > 1 {
+            format!(", responses to {}", group.responses.join(", "))
+        } else {
+            String::new()
+        };
         text += &format!(
-            "{} sweep: {} record(s), {:.1} s, {:.3}–{:.2} rad/s, windows {} s, conditioned on {}\n",
+            "{} sweep: {} record(s), {:.1} s, {:.3}–{:.2} rad/s, windows {} s, conditioned on {}{responses}\n",
             group.axis,
             group.records,
             group.seconds,
@@ -275,8 +312,12 @@ fn summary(analysis: &FrfAnalysis, out: &Path, plots: usize) -> String {
             Some([lo, hi]) => format!("{lo:.2}–{hi:.2} rad/s"),
             None => "none".to_string(),
         };
+        let from = match &pair.group {
+            Some(group) if *group != pair.input => format!(" ({group} records)"),
+            _ => String::new(),
+        };
         text += &format!(
-            "  {:>4} → {:<5} valid (γ² ≥ {}): {range}\n",
+            "  {:>4} → {:<5} valid (γ² ≥ {}): {range}{from}\n",
             pair.input, pair.output, document.coherence_threshold
         );
     }
@@ -477,9 +518,10 @@ mod tests {
         };
         frf(&[]).unwrap();
         assert_eq!(swept_inputs(&out), ["lat"]);
-        // Without its primary column the file would be read as a pedal sweep.
+        // Without its primary column the file would be read as a pedal sweep (and, with
+        // nothing naming the swept input, give responses to the lateral stick as well).
         frf(&["--primary-column", "no_such_column"]).unwrap();
-        assert_eq!(swept_inputs(&out), ["ped"]);
+        assert_eq!(swept_inputs(&out), ["ped", "lat"]);
         // --swept (and its alias --primary) overrides the column.
         for flag in ["--swept", "--primary"] {
             frf(&[flag, "ped"]).unwrap();

@@ -51,6 +51,18 @@ pub struct PairResponse {
     /// `max_random_error` is set, the random error is at most that (the widest such run),
     /// or null.
     pub valid_range: Option<[f64; 2]>,
+    /// Swept axis of the record group this pair was computed from, written for every pair
+    /// of a group whose responses to all its excited inputs were computed (`frf --excited
+    /// all`, or CSV records whose swept input nothing named). Absent: the group that
+    /// sweeps `input`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub group: Option<String>,
+    /// Multiple coherence γ²_y:u of the output with all the conditioning inputs of the
+    /// group, one per `omega` (composited with the same weights as the response): how
+    /// much of the output the excited inputs explain together, where `coherence` is the
+    /// share of this input alone. Written with `group` (MISO pairs only); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub multiple_coherence: Vec<f64>,
 }
 
 /// Average cross-control coherence between two controls for one record group.
@@ -209,12 +221,15 @@ impl PairResponse {
             return Err("empty input or output name".into());
         }
         let n = self.omega.len();
-        let arrays: [(&str, &[f64]); 4] = [
+        let mut arrays: Vec<(&str, &[f64])> = vec![
             ("mag_db", &self.mag_db),
             ("phase_deg", &self.phase_deg),
             ("coherence", &self.coherence),
             ("random_error", &self.random_error),
         ];
+        if !self.multiple_coherence.is_empty() {
+            arrays.push(("multiple_coherence", &self.multiple_coherence));
+        }
         for (field, values) in &arrays {
             if values.len() != n {
                 return Err(format!("{field} has {} values, omega {n}", values.len()));
@@ -235,7 +250,7 @@ impl PairResponse {
             }
         }
         // (field, lowest, highest, what a value outside means)
-        let limits: [(&str, &[f64], f64, f64, &str); 4] = [
+        let mut limits: Vec<(&str, &[f64], f64, f64, &str)> = vec![
             (
                 "mag_db",
                 &self.mag_db,
@@ -259,6 +274,15 @@ impl PairResponse {
                 "not a random error",
             ),
         ];
+        if !self.multiple_coherence.is_empty() {
+            limits.push((
+                "multiple_coherence",
+                &self.multiple_coherence,
+                0.0,
+                1.0,
+                "not a coherence",
+            ));
+        }
         for (field, values, lowest, highest, meaning) in limits {
             if let Some(k) = values
                 .iter()
@@ -314,6 +338,8 @@ mod tests {
             coherence: vec![0.9; 5],
             random_error: vec![0.05; 5],
             valid_range: Some([1.0, 5.0]),
+            group: None,
+            multiple_coherence: Vec::new(),
             omega,
         }
     }
@@ -361,6 +387,13 @@ mod tests {
             serde_json::from_str::<FrfDocument>(&json).unwrap(),
             document()
         );
+        // The fields of multi-input groups are absent unless set, and read back.
+        assert!(!json.contains("group") && !json.contains("multiple_coherence"));
+        let mut multi = document();
+        multi.pairs[1].group = Some("lat".into());
+        multi.pairs[1].multiple_coherence = vec![0.95; 5];
+        let json = serde_json::to_string(&multi).unwrap();
+        assert_eq!(FrfDocument::from_json(&json).unwrap(), multi);
     }
 
     #[test]
@@ -393,6 +426,11 @@ mod tests {
             assert!(message.contains("siso pair lon→q: "), "{message}");
             assert!(message.contains(expected), "{message}");
         }
+        let message = refusal(|d| d.pairs[1].multiple_coherence = vec![0.9; 3]);
+        assert!(
+            message.ends_with("pair lon→q: multiple_coherence has 3 values, omega 5"),
+            "{message}"
+        );
     }
 
     #[test]
@@ -437,6 +475,8 @@ mod tests {
         assert!(message.contains("coherence[1] = 1.5"), "{message}");
         let message = refusal(|d| d.pairs[0].random_error[1] = -0.1);
         assert!(message.contains("random_error[1] = -0.1"), "{message}");
+        let message = refusal(|d| d.pairs[1].multiple_coherence = vec![0.9, 0.9, 1.2, 0.9, 0.9]);
+        assert!(message.contains("multiple_coherence[2] = 1.2"), "{message}");
         // In memory (a document built by code, not parsed) NaN is caught as well.
         let mut in_memory = document();
         in_memory.pairs[0].phase_deg[2] = f64::NAN;

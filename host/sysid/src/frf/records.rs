@@ -228,6 +228,12 @@ impl RecordGroup {
         &self.records[0].primary
     }
 
+    /// `true` when every record's swept input is only guessed
+    /// ([`Record::primary_guessed`]).
+    pub fn primary_guessed(&self) -> bool {
+        self.records.iter().all(|r| r.primary_guessed)
+    }
+
     /// Sample rate \[Hz\].
     pub fn sample_rate_hz(&self) -> f64 {
         self.records[0].sample_rate_hz
