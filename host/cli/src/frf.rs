@@ -17,7 +17,8 @@ use sysid::frf::{
 #[command(
     after_help = "Records of the same swept axis are joined (each detrended, tapered \
 to zero at the joins). The response of output y to control x comes from the records in \
-which x is swept, conditioned on the other controls excited there. Files ending in .csv \
+which x is swept (or, see --excited, in which x moves with the swept control), conditioned \
+on the other controls excited there. Files ending in .csv \
 are read as CSV with a header row (columns chosen with --time, --inputs, --outputs); \
 anything else as a telemetry dump.\n\nThe swept input of a CSV file is, in this order: \
 --swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
