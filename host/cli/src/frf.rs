@@ -8,7 +8,7 @@ use anyhow::bail;
 use clap::Args;
 use sysid::frf::{
     analyse, group_by_primary, load_csv, load_dump, write_plots, CsvColumns, FrfAnalysis,
-    FrfOptions, Record, ResponseEstimator,
+    FrfOptions, Record, ResponseEstimator, ResponseInputs,
 };
 
 /// Arguments of `sweephold frf`.
@@ -16,9 +16,20 @@ use sysid::frf::{
 #[command(
     after_help = "Records of the same swept axis are joined (each detrended, tapered \
 to zero at the joins). The response of output y to control x comes from the records in \
-which x is swept, conditioned on the other controls excited there. Files ending in .csv \
+which x is swept (or, see --excited, in which x moves with the swept control), conditioned \
+on the other controls excited there. Files ending in .csv \
 are read as CSV with a header row (columns chosen with --time, --inputs, --outputs); \
-anything else as a telemetry dump.\n\nExit status: 0 when frf.json was written; 1 on an \
+anything else as a telemetry dump.\n\nThe swept input of a CSV file is, in this order: \
+--swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
+must be the same on every row kept; else the input with the largest RMS about its trend \
+line. A dump's Header names its swept axis.\n\nWhich inputs get responses \
+(--excited): `swept`, the swept input of each group; `all`, also every other input whose \
+RMS is at least 10 % of the group's largest input RMS (all from the same MISO solve, each \
+with its partial coherence; the pairs carry `group` and the output's \
+`multiple_coherence`); `auto` (default), `all` for CSV files whose swept input nothing \
+names (no --swept, no primary column) and `swept` otherwise (dumps, decoded CSV). When two \
+groups give the same pair, the one from the group that sweeps its input is kept, else the \
+one with the higher mean partial coherence.\n\nExit status: 0 when frf.json was written; 1 on an \
 unreadable file, a dump without a sweep, a record too short for the band, a swept input \
 without excitation, or a bad option."
 )]
@@ -80,6 +91,9 @@ pub struct FrfArgs {
     /// How the conditioned responses are estimated.
     #[arg(long, value_enum, default_value_t = EstimatorArg::Cross)]
     pub estimator: EstimatorArg,
+    /// Which inputs get responses (see below).
+    #[arg(long, value_enum, default_value_t = ExcitedArg::Auto)]
+    pub excited: ExcitedArg,
     /// CSV: the time column [s].
     #[arg(long, value_name = "COLUMN", default_value = "time_s")]
     pub time: String,
@@ -97,9 +111,15 @@ pub struct FrfArgs {
         default_value = "u,v,w,p,q,r,ax,ay,az,phi,theta"
     )]
     pub output_columns: String,
-    /// CSV: the swept input (a name from --inputs); default: the most active input.
-    #[arg(long, value_name = "NAME")]
-    pub primary: Option<String>,
+    /// CSV: the swept input (a name from --inputs); overrides the file's primary column.
+    /// Default: the primary column, else the most active input. `--primary` is an alias.
+    #[arg(long = "swept", alias = "primary", value_name = "NAME")]
+    pub swept: Option<String>,
+    /// CSV: column naming the swept axis on each row (`decode` writes `primary`), by an
+    /// input name or the axis of a `cmd_AXIS` input column; read when the file has it and
+    /// --swept is not given.
+    #[arg(long, value_name = "COLUMN", default_value = "primary")]
+    pub primary_column: String,
     /// CSV: column whose value keeps a row only in the fade_in, sweep and fade_out
     /// phases (ignored when the file has no such column).
     #[arg(long, value_name = "COLUMN", default_value = "phase")]
@@ -125,6 +145,27 @@ impl From<EstimatorArg> for ResponseEstimator {
         match arg {
             EstimatorArg::Cross => ResponseEstimator::CrossSpectral,
             EstimatorArg::SweepReference => ResponseEstimator::SweepReference,
+        }
+    }
+}
+
+/// `--excited`: see [`ResponseInputs`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExcitedArg {
+    /// `all` for CSV files whose swept input nothing names, `swept` otherwise
+    Auto,
+    /// The swept input of each group only
+    Swept,
+    /// Every input with RMS ≥ 10 % of the group's largest (cross estimator only)
+    All,
+}
+
+impl From<ExcitedArg> for ResponseInputs {
+    fn from(arg: ExcitedArg) -> ResponseInputs {
+        match arg {
+            ExcitedArg::Auto => ResponseInputs::Auto,
+            ExcitedArg::Swept => ResponseInputs::Swept,
+            ExcitedArg::All => ResponseInputs::Excited,
         }
     }
 }
@@ -192,16 +233,28 @@ impl FrfArgs {
             coherence_threshold: self.coherence_threshold,
             max_random_error: self.max_random_error.0,
             estimator: self.estimator.into(),
+            responses: self.excited.into(),
             ..FrfOptions::default()
         }
     }
 
     fn csv_columns(&self) -> anyhow::Result<CsvColumns> {
+        let inputs = parse_columns(&self.input_columns, "--inputs")?;
+        if let Some(swept) = &self.swept {
+            if !inputs.iter().any(|(name, _)| name == swept) {
+                let names: Vec<&str> = inputs.iter().map(|(name, _)| name.as_str()).collect();
+                bail!(
+                    "--swept `{swept}`: not one of the --inputs names ({})",
+                    names.join(", ")
+                );
+            }
+        }
         Ok(CsvColumns {
             time: self.time.clone(),
-            inputs: parse_columns(&self.input_columns, "--inputs")?,
+            inputs,
             outputs: parse_columns(&self.output_columns, "--outputs")?,
-            primary: self.primary.clone(),
+            primary: self.swept.clone(),
+            primary_column: Some(self.primary_column.clone()),
             phase_column: Some(self.phase_column.clone()),
             sweep_band: self.band.map(|b| b.0),
         })
@@ -258,8 +311,13 @@ fn summary(analysis: &FrfAnalysis, out: &Path, plots: usize) -> String {
     let document = &analysis.document;
     for group in &analysis.groups {
         let windows: Vec<String> = group.windows.iter().map(|w| format!("{w:.1}")).collect();
+        let responses = if group.responses.len() > 1 {
+            format!(", responses to {}", group.responses.join(", "))
+        } else {
+            String::new()
+        };
         text += &format!(
-            "{} sweep: {} record(s), {:.1} s, {:.3}–{:.2} rad/s, windows {} s, conditioned on {}\n",
+            "{} sweep: {} record(s), {:.1} s, {:.3}–{:.2} rad/s, windows {} s, conditioned on {}{responses}\n",
             group.axis,
             group.records,
             group.seconds,
@@ -274,8 +332,12 @@ fn summary(analysis: &FrfAnalysis, out: &Path, plots: usize) -> String {
             Some([lo, hi]) => format!("{lo:.2}–{hi:.2} rad/s"),
             None => "none".to_string(),
         };
+        let from = match &pair.group {
+            Some(group) if *group != pair.input => format!(" ({group} records)"),
+            _ => String::new(),
+        };
         text += &format!(
-            "  {:>4} → {:<5} valid (γ² ≥ {}): {range}\n",
+            "  {:>4} → {:<5} valid (γ² ≥ {}): {range}{from}\n",
             pair.input, pair.output, document.coherence_threshold
         );
     }
@@ -333,6 +395,12 @@ mod tests {
     /// rate is a discrete first-order lag of the lateral command; `sweep` false gives a
     /// dump that never leaves the idle phase.
     fn dump(seconds: f64, sweep: bool) -> Vec<u8> {
+        dump_with_pedal(seconds, sweep, 0.0)
+    }
+
+    /// [`dump`] with the pedal moving as a 0.7 rad/s sine of `pedal` amplitude (not
+    /// reaching the roll rate).
+    fn dump_with_pedal(seconds: f64, sweep: bool, pedal: f64) -> Vec<u8> {
         let rate = 50u16;
         let header = Header {
             protocol: PROTOCOL_VERSION,
@@ -392,6 +460,7 @@ mod tests {
                 hold: [HoldState::Released; 3],
                 command: Controls {
                     lat: lat as f32,
+                    ped: (pedal * (0.7 * time).sin()) as f32,
                     ..Controls::default()
                 },
                 sweep: Controls::default(),
@@ -434,6 +503,55 @@ mod tests {
         assert!(plots.join("frf_lat_p.svg").exists());
         let svg = std::fs::read_to_string(plots.join("frf_lat_p.svg")).unwrap();
         assert!(svg.starts_with("<svg") || svg.contains("<svg"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The swept axes of a document's pairs, in order, without repeats.
+    fn swept_inputs(out: &Path) -> Vec<String> {
+        let document: sysid::document::FrfDocument =
+            serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
+        let mut inputs: Vec<String> = document.pairs.iter().map(|p| p.input.clone()).collect();
+        inputs.dedup();
+        inputs
+    }
+
+    #[test]
+    fn a_decoded_csv_is_analysed_for_the_axis_its_primary_column_names() {
+        let dir = scratch_dir("csv-primary");
+        // A lateral sweep during which the pedal moves more than the lateral stick.
+        let dump_path = dir.join("lat.dump");
+        std::fs::write(&dump_path, dump_with_pedal(60.0, true, 0.2)).unwrap();
+        let csv = dir.join("lat.csv");
+        crate::decode::run(&crate::decode::DecodeArgs {
+            dumps: vec![dump_path],
+            format: crate::decode::Format::Csv,
+            output: Some(csv.clone()),
+            quiet: true,
+        })
+        .unwrap();
+        let out = dir.join("frf.json");
+        let frf = |extra: &[&str]| {
+            let mut argv = vec![csv.to_str().unwrap(), "--out", out.to_str().unwrap()];
+            argv.extend_from_slice(&["--band", "0.5,12", "--points", "40", "-q"]);
+            argv.extend_from_slice(extra);
+            run(&parse(&argv))
+        };
+        frf(&[]).unwrap();
+        assert_eq!(swept_inputs(&out), ["lat"]);
+        // Without its primary column the file would be read as a pedal sweep (and, with
+        // nothing naming the swept input, give responses to the lateral stick as well).
+        frf(&["--primary-column", "no_such_column"]).unwrap();
+        assert_eq!(swept_inputs(&out), ["ped", "lat"]);
+        // --swept (and its alias --primary) overrides the column.
+        for flag in ["--swept", "--primary"] {
+            frf(&[flag, "ped"]).unwrap();
+            assert_eq!(swept_inputs(&out), ["ped"], "{flag}");
+        }
+        let message = format!("{:#}", frf(&["--swept", "roll"]).unwrap_err());
+        assert_eq!(
+            message,
+            "--swept `roll`: not one of the --inputs names (lat, lon, ped, col)"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

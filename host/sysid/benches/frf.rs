@@ -77,6 +77,7 @@ fn record(primary: usize, seed: u64) -> Record {
         source: format!("bench-{}", names[primary]),
         sample_rate_hz: RATE,
         primary: names[primary].into(),
+        primary_guessed: false,
         sweep_band: Some([0.3, 31.4]),
         inputs: names
             .iter()

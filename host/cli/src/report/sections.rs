@@ -850,6 +850,8 @@ mod tests {
             coherence: vec![1.0; omega.len()],
             random_error: vec![0.0; omega.len()],
             valid_range: None,
+            group: None,
+            multiple_coherence: Vec::new(),
         };
         let (magnitude, phase) = model_response(&model, &pair, Some(0.5)).unwrap();
         let gain_db = 20.0 * (3.0 / (omega[0].powi(2) + 4.0).sqrt()).log10();

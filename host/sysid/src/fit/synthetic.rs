@@ -178,6 +178,8 @@ pub fn exact_frf_document(model: &Model, bands: &[PairBand], grid: SyntheticGrid
                 random_error: vec![0.0; omega.len()],
                 omega,
                 valid_range: Some(band.range),
+                group: None,
+                multiple_coherence: Vec::new(),
             })
         })
         .collect();

@@ -774,6 +774,7 @@ mod tests {
             source: "synthetic".into(),
             sample_rate_hz: rate,
             primary: "lat".into(),
+            primary_guessed: false,
             sweep_band: None,
             inputs: inputs
                 .iter()

@@ -8,11 +8,22 @@
 //! would make the input matrix singular, so it is left out of that group's conditioning
 //! and a note says so.
 //!
+//! **Responses to every excited input.** The MISO solve gives the conditioned response
+//! of every input of the group at once; where the group's records excite several inputs
+//! together ([`ResponseInputs`]: a multisine, a simultaneous-axis test, a CSV log whose
+//! swept input nothing names) each input reaching [`FrfOptions::response_ratio`] of the
+//! largest input RMS gets its pairs, with its partial coherence and the output's multiple
+//! coherence, and the pairs say which group they came from. When two groups give the
+//! same (input, output) pair, the one from the group that sweeps that input is kept; if
+//! neither does, the one with the higher mean partial coherence (the earlier group on a
+//! tie); a note names the one left out.
+//!
 //! Per group: join the records ([`RecordGroup::joined`]), choose the grid and window
 //! lengths ([`spectra`](super::spectra)), compute the spectral matrices of every window
-//! length once, then for every output and every window length the MISO-conditioned
-//! response of the primary input ([`miso`](super::miso)) and the plain SISO H1
-//! estimate, and blend the window lengths ([`composite`](super::composite)).
+//! length once, then for every responding input (the primary, or every excited input),
+//! every output and every window length the MISO-conditioned response
+//! ([`miso`](super::miso)) and the plain SISO H1 estimate, and blend the window lengths
+//! ([`composite`](super::composite)).
 //!
 //! Nothing non-finite reaches the document: frequencies where no window length gives a
 //! well-conditioned estimate are left out of that pair (each pair has its own `omega`)
@@ -20,12 +31,14 @@
 
 use num_complex::Complex64;
 
-use crate::document::{CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
+use crate::document::{
+    CrossCoherence, FrfDocument, PairResponse, FRF_DOCUMENT_VERSION, MAX_PLAUSIBLE_MAG_DB,
+};
 
 use super::coherence::{accurate_range, debiased_coherence, random_error};
 use super::composite::{blend, Estimate};
 use super::miso::{InputFactor, MAX_INPUTS};
-use super::options::{FrfOptions, ResponseEstimator};
+use super::options::{FrfOptions, ResponseEstimator, ResponseInputs};
 use super::records::{rms, JoinedRecord, RecordGroup};
 use super::reference::ReferenceSolve;
 use super::spectra::{
@@ -62,7 +75,7 @@ impl CoherenceCurve {
 /// Multiple coherence of one output with the conditioning inputs of its group.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MultipleCoherence {
-    /// Swept input of the group.
+    /// Input of the pair it belongs to (its weights are that pair's).
     pub input: String,
     /// Output.
     pub output: String,
@@ -87,6 +100,8 @@ pub struct GroupSummary {
     pub windows: Vec<f64>,
     /// Controls in the conditioning (primary last).
     pub conditioned_on: Vec<String>,
+    /// Inputs whose responses were computed (the primary first).
+    pub responses: Vec<String>,
 }
 
 /// The document plus what the plots and the command-line summary need.
@@ -105,9 +120,9 @@ pub struct FrfAnalysis {
     pub multiple_coherence: Vec<MultipleCoherence>,
 }
 
-/// Composite MISO-conditioned and SISO frequency responses of every (swept input,
-/// output) pair, and the cross-control coherences, of the given record groups (one per
-/// swept axis).
+/// Composite MISO-conditioned and SISO frequency responses of every (responding input,
+/// output) pair (the swept input of each group, or every excited one: [`ResponseInputs`]),
+/// and the cross-control coherences, of the given record groups (one per swept axis).
 pub fn compute_frequency_responses(
     groups: &[RecordGroup],
     opts: &FrfOptions,
@@ -147,7 +162,84 @@ pub fn analyse(groups: &[RecordGroup], opts: &FrfOptions) -> Result<FrfAnalysis,
         let prepared = prepare_group(group, opts, true)?;
         analyse_group(&prepared, opts, &mut analysis);
     }
+    keep_one_estimate_per_pair(&mut analysis);
     Ok(analysis)
+}
+
+/// `true` when `pair` came from the group that sweeps its input.
+fn from_its_sweep(pair: &PairResponse) -> bool {
+    pair.group
+        .as_deref()
+        .is_none_or(|group| group == pair.input)
+}
+
+/// Mean partial coherence over a pair's frequencies (0 without any).
+fn mean_coherence(pair: &PairResponse) -> f64 {
+    if pair.coherence.is_empty() {
+        0.0
+    } else {
+        pair.coherence.iter().sum::<f64>() / pair.coherence.len() as f64
+    }
+}
+
+/// Where several groups gave the same (input, output) pair, keep one (module docs): the
+/// estimate from the group that sweeps the input, else the one with the higher mean
+/// partial coherence, the earlier on a tie. Its SISO and multiple-coherence companions
+/// (same index) go with it; a note names each estimate left out.
+fn keep_one_estimate_per_pair(analysis: &mut FrfAnalysis) {
+    let pairs = &analysis.document.pairs;
+    let group_of = |pair: &PairResponse| pair.group.clone().unwrap_or(pair.input.clone());
+    let mut left_out = vec![false; pairs.len()];
+    let mut notes = Vec::new();
+    for i in 0..pairs.len() {
+        for j in i + 1..pairs.len() {
+            if left_out[i] {
+                break;
+            }
+            let (a, b) = (&pairs[i], &pairs[j]);
+            if left_out[j] || a.input != b.input || a.output != b.output {
+                continue;
+            }
+            let (kept, dropped, why) = if from_its_sweep(a) {
+                (i, j, format!("it sweeps `{}`", a.input))
+            } else if from_its_sweep(b) {
+                (j, i, format!("it sweeps `{}`", b.input))
+            } else {
+                let (ma, mb) = (mean_coherence(a), mean_coherence(b));
+                let why =
+                    |high: f64, low: f64| format!("mean partial γ² {high:.2} against {low:.2}");
+                if mb > ma {
+                    (j, i, why(mb, ma))
+                } else {
+                    (i, j, why(ma, mb))
+                }
+            };
+            left_out[dropped] = true;
+            notes.push(format!(
+                "{}→{}: the estimate from the {} records kept ({why}), the one from the {} records left out",
+                a.input,
+                a.output,
+                group_of(&pairs[kept]),
+                group_of(&pairs[dropped])
+            ));
+        }
+    }
+    let mut index = 0;
+    analysis.document.pairs.retain(|_| {
+        index += 1;
+        !left_out[index - 1]
+    });
+    index = 0;
+    analysis.document.siso.retain(|_| {
+        index += 1;
+        !left_out[index - 1]
+    });
+    index = 0;
+    analysis.multiple_coherence.retain(|_| {
+        index += 1;
+        !left_out[index - 1]
+    });
+    analysis.document.notes.extend(notes);
 }
 
 /// A group ready for spectra: joined, with grid, windows and channel selection.
@@ -159,6 +251,14 @@ pub(crate) struct PreparedGroup {
     /// Inputs in conditioning order (other excited controls, primary last), as indices
     /// into `joined.inputs`.
     pub conditioning: Vec<usize>,
+    /// Inputs whose responses are computed, as positions in `conditioning`: the primary
+    /// (position n − 1) first, then, when `every_excited`, the others that reach
+    /// [`FrfOptions::response_ratio`], in conditioning order.
+    pub responding: Vec<usize>,
+    /// Whether the responses to every excited input are computed
+    /// ([`ResponseInputs`]); the group's pairs then carry `group` and
+    /// `multiple_coherence`.
+    pub every_excited: bool,
     /// Outputs with any variation, as indices into `joined.outputs`.
     pub outputs: Vec<usize>,
     /// With the reference estimator: the swept control's recorded excitation, as an
@@ -263,6 +363,38 @@ pub(crate) fn prepare_group(
     let mut conditioning = others;
     conditioning.push(primary_index);
 
+    // Which inputs get responses (ResponseInputs).
+    let every_excited = match opts.responses {
+        ResponseInputs::Swept => false,
+        ResponseInputs::Excited => true,
+        ResponseInputs::Auto => {
+            group.primary_guessed() && opts.estimator == ResponseEstimator::CrossSpectral
+        }
+    };
+    let mut responding = vec![conditioning.len() - 1];
+    if every_excited {
+        let largest = input_rms.iter().copied().fold(0.0, f64::max);
+        let mut names = vec![axis.clone()];
+        for (position, &i) in conditioning[..conditioning.len() - 1].iter().enumerate() {
+            let name = &joined.inputs[i].name;
+            if input_rms[i] >= opts.response_ratio * largest {
+                responding.push(position);
+                names.push(name.clone());
+            } else {
+                notes.push(format!(
+                    "{axis} records: no responses to `{name}`: its RMS is {:.1} % of the largest input's (below {} %)",
+                    100.0 * input_rms[i] / largest,
+                    100.0 * opts.response_ratio
+                ));
+            }
+        }
+        notes.push(format!(
+            "{axis} records: responses to every excited input (RMS ≥ {} % of the largest): {}",
+            100.0 * opts.response_ratio,
+            names.join(", ")
+        ));
+    }
+
     let mut outputs = Vec::new();
     if with_outputs {
         for (o, channel) in joined.outputs.iter().enumerate() {
@@ -300,6 +432,8 @@ pub(crate) fn prepare_group(
         grid,
         windows,
         conditioning,
+        responding,
+        every_excited,
         outputs,
         sweep_reference,
         records: group.records().len(),
@@ -345,19 +479,29 @@ fn spectra_of(
     )
 }
 
-/// The conditioning inputs' n×n block of a window's input matrix at grid index k.
+/// The conditioning inputs' n×n block of a window's input matrix at grid index k, in
+/// `order` (positions in the spectra; n = `order.len()`).
 fn conditioning_block(
     s: &WindowSpectra,
     k: usize,
-    n: usize,
+    order: &[usize],
 ) -> [Complex64; MAX_INPUTS * MAX_INPUTS] {
+    let n = order.len();
     let mut block = [Complex64::new(0.0, 0.0); MAX_INPUTS * MAX_INPUTS];
-    for i in 0..n {
-        for j in 0..n {
-            block[i * n + j] = s.input_input(k, i, j);
+    for (i, &a) in order.iter().enumerate() {
+        for (j, &b) in order.iter().enumerate() {
+            block[i * n + j] = s.input_input(k, a, b);
         }
     }
     block
+}
+
+/// The conditioning positions `0..n` with `last` moved to the end. The factorisation
+/// then gives, in its last pivot, that input's autospectrum conditioned on all the others,
+/// which its partial coherence needs ([`miso`](super::miso)); the other positions keep
+/// their order, so for the swept input (already last) this is the group's own order.
+fn order_with_last(n: usize, last: usize) -> Vec<usize> {
+    (0..n).filter(|&i| i != last).chain([last]).collect()
 }
 
 /// Instrument j of the conditioning inputs (module docs of [`reference`]): the recorded
@@ -399,19 +543,15 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
     let grid = &prepared.grid;
     let n_in = prepared.conditioning.len();
     let primary = n_in - 1;
+    let mut notes = prepared.notes.clone();
+    let input_name = |i: usize| {
+        prepared.joined.inputs[prepared.conditioning[i]]
+            .name
+            .clone()
+    };
 
-    // Factor every window's input matrix once; all outputs share it.
-    let factors: Vec<Vec<Option<InputFactor>>> = spectra
-        .iter()
-        .map(|s| {
-            (s.valid_from.min(grid.len())..grid.len())
-                .map(|k| {
-                    InputFactor::new(&conditioning_block(s, k, n_in), n_in, opts.min_pivot).ok()
-                })
-                .collect()
-        })
-        .collect();
-    // With the sweep-reference estimator, its solve per window and frequency as well.
+    // With the sweep-reference estimator (swept input only), its solve per window and
+    // frequency.
     let with_references = prepared.sweep_reference.is_some();
     let reference_solves: Vec<Vec<Option<ReferenceSolve>>> = if with_references {
         spectra
@@ -425,126 +565,153 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
     } else {
         Vec::new()
     };
-    let factor_at = |w: usize, k: usize| -> Option<&InputFactor> {
-        let s = &spectra[w];
-        (k >= s.valid_from)
-            .then(|| factors[w][k - s.valid_from].as_ref())
-            .flatten()
-    };
-    let unconditioned: Vec<f64> = (0..grid.len())
-        .filter(|&k| (0..spectra.len()).all(|w| factor_at(w, k).is_none()))
-        .map(|k| grid[k])
-        .collect();
-    let mut notes = prepared.notes.clone();
-    if let (Some(first), Some(last)) = (unconditioned.first(), unconditioned.last()) {
-        notes.push(format!(
-            "{axis} sweep: MISO responses left out at {} of {} frequencies ({first:.3}–{last:.3} rad/s): the excited controls are nearly collinear there (normalised pivot < {:e})",
-            unconditioned.len(),
-            grid.len(),
-            opts.min_pivot
-        ));
-    }
 
-    let input_name = |i: usize| {
-        prepared.joined.inputs[prepared.conditioning[i]]
-            .name
-            .clone()
-    };
-    for (o_local, &o) in prepared.outputs.iter().enumerate() {
-        let output = &prepared.joined.outputs[o].name;
-        let mut miso = Vec::with_capacity(grid.len());
-        let mut multiple = MultipleCoherence {
-            input: input_name(primary),
-            output: output.clone(),
-            omega: Vec::with_capacity(grid.len()),
-            coherence: Vec::with_capacity(grid.len()),
+    for &responding in &prepared.responding {
+        let order = order_with_last(n_in, responding);
+        let input = input_name(responding);
+        // Factor every window's input matrix once, with this input last; all outputs
+        // share it.
+        let factors: Vec<Vec<Option<InputFactor>>> = spectra
+            .iter()
+            .map(|s| {
+                (s.valid_from.min(grid.len())..grid.len())
+                    .map(|k| {
+                        InputFactor::new(&conditioning_block(s, k, &order), n_in, opts.min_pivot)
+                            .ok()
+                    })
+                    .collect()
+            })
+            .collect();
+        let factor_at = |w: usize, k: usize| -> Option<&InputFactor> {
+            let s = &spectra[w];
+            (k >= s.valid_from)
+                .then(|| factors[w][k - s.valid_from].as_ref())
+                .flatten()
         };
-        let mut siso = Vec::with_capacity(grid.len());
-        let mut guy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
-        let mut gzy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
-        for (k, &omega) in grid.iter().enumerate() {
-            let mut miso_estimates = Vec::with_capacity(spectra.len());
-            let mut multiple_estimates = Vec::with_capacity(spectra.len());
-            let mut siso_estimates = Vec::with_capacity(spectra.len());
-            for (w, s) in spectra.iter().enumerate() {
-                if k < s.valid_from {
-                    continue;
-                }
-                let gyy = s.output_auto(k, o_local);
-                if gyy.is_nan() || gyy <= 0.0 {
-                    continue;
-                }
-                if let Some(factor) = factor_at(w, k) {
-                    for (i, g) in guy.iter_mut().enumerate().take(n_in) {
-                        *g = s.input_output(k, i, o_local);
+        let unconditioned: Vec<f64> = (0..grid.len())
+            .filter(|&k| (0..spectra.len()).all(|w| factor_at(w, k).is_none()))
+            .map(|k| grid[k])
+            .collect();
+        if let (Some(first), Some(last)) = (unconditioned.first(), unconditioned.last()) {
+            let which = if responding == primary {
+                String::new()
+            } else {
+                format!(" to `{input}`")
+            };
+            notes.push(format!(
+                "{axis} sweep: MISO responses{which} left out at {} of {} frequencies ({first:.3}–{last:.3} rad/s): the excited controls are nearly collinear there (normalised pivot < {:e})",
+                unconditioned.len(),
+                grid.len(),
+                opts.min_pivot
+            ));
+        }
+
+        for (o_local, &o) in prepared.outputs.iter().enumerate() {
+            let output = &prepared.joined.outputs[o].name;
+            let mut miso = Vec::with_capacity(grid.len());
+            // The multiple coherence at each `miso` point (same windows and weights).
+            let mut miso_multiple = Vec::with_capacity(grid.len());
+            let mut multiple = MultipleCoherence {
+                input: input.clone(),
+                output: output.clone(),
+                omega: Vec::with_capacity(grid.len()),
+                coherence: Vec::with_capacity(grid.len()),
+            };
+            let mut siso = Vec::with_capacity(grid.len());
+            let mut guy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
+            let mut gzy = [Complex64::new(0.0, 0.0); MAX_INPUTS];
+            for (k, &omega) in grid.iter().enumerate() {
+                let mut miso_estimates = Vec::with_capacity(spectra.len());
+                let mut multiple_estimates = Vec::with_capacity(spectra.len());
+                let mut siso_estimates = Vec::with_capacity(spectra.len());
+                for (w, s) in spectra.iter().enumerate() {
+                    if k < s.valid_from {
+                        continue;
                     }
-                    let c = factor.condition(&guy[..n_in], gyy);
-                    let error = random_error(c.partial_coherence, s.independent);
-                    if with_references {
-                        // Reference estimate: this window counts only where the
-                        // recorded sweep drives the swept control.
-                        let solve = reference_solves
-                            .get(w)
-                            .and_then(|solves| solves.get(k - s.valid_from))
-                            .and_then(Option::as_ref);
-                        if let Some(solve) = solve {
-                            for (i, g) in gzy.iter_mut().enumerate().take(n_in) {
-                                *g = s.input_output(k, instrument(i, n_in), o_local);
+                    let gyy = s.output_auto(k, o_local);
+                    if gyy.is_nan() || gyy <= 0.0 {
+                        continue;
+                    }
+                    if let Some(factor) = factor_at(w, k) {
+                        for (g, &position) in guy.iter_mut().zip(&order) {
+                            *g = s.input_output(k, position, o_local);
+                        }
+                        let c = factor.condition(&guy[..n_in], gyy);
+                        let error = random_error(c.partial_coherence, s.independent);
+                        if with_references {
+                            // Reference estimate: this window counts only where the
+                            // recorded sweep drives the swept control.
+                            let solve = reference_solves
+                                .get(w)
+                                .and_then(|solves| solves.get(k - s.valid_from))
+                                .and_then(Option::as_ref);
+                            if let Some(solve) = solve {
+                                for (i, g) in gzy.iter_mut().enumerate().take(n_in) {
+                                    *g = s.input_output(k, instrument(i, n_in), o_local);
+                                }
+                                miso_estimates.push(Estimate {
+                                    response: solve.solve(&gzy[..n_in])[primary],
+                                    coherence: c.partial_coherence,
+                                    random_error: error
+                                        * solve.variance_ratio(factor.conditioned_primary()).sqrt(),
+                                });
                             }
+                        } else {
                             miso_estimates.push(Estimate {
-                                response: solve.solve(&gzy[..n_in])[primary],
+                                response: c.response,
                                 coherence: c.partial_coherence,
-                                random_error: error
-                                    * solve.variance_ratio(factor.conditioned_primary()).sqrt(),
+                                random_error: error,
                             });
                         }
-                    } else {
-                        miso_estimates.push(Estimate {
-                            response: c.response,
-                            coherence: c.partial_coherence,
+                        multiple_estimates.push(Estimate {
+                            response: Complex64::new(0.0, 0.0),
+                            coherence: c.multiple_coherence,
                             random_error: error,
                         });
                     }
-                    multiple_estimates.push(Estimate {
-                        response: Complex64::new(0.0, 0.0),
-                        coherence: c.multiple_coherence,
-                        random_error: error,
-                    });
+                    let gpp = s.input_input(k, responding, responding).re;
+                    if gpp > 0.0 {
+                        let gpy = s.input_output(k, responding, o_local);
+                        let coherence = (gpy.norm_sqr() / (gpp * gyy)).clamp(0.0, 1.0);
+                        siso_estimates.push(Estimate {
+                            response: gpy / gpp,
+                            coherence,
+                            random_error: random_error(coherence, s.independent),
+                        });
+                    }
                 }
-                let gpp = s.input_input(k, primary, primary).re;
-                if gpp > 0.0 {
-                    let gpy = s.input_output(k, primary, o_local);
-                    let coherence = (gpy.norm_sqr() / (gpp * gyy)).clamp(0.0, 1.0);
-                    siso_estimates.push(Estimate {
-                        response: gpy / gpp,
-                        coherence,
-                        random_error: random_error(coherence, s.independent),
-                    });
+                let multiple_here = blend(multiple_estimates)
+                    .map(|e| e.coherence)
+                    .filter(|c| c.is_finite());
+                if let Some(e) = blend(miso_estimates) {
+                    miso.push((omega, e));
+                    miso_multiple.push(multiple_here.map_or(f64::NAN, |c| c.clamp(0.0, 1.0)));
+                }
+                if let Some(coherence) = multiple_here {
+                    multiple.omega.push(omega);
+                    multiple.coherence.push(coherence.clamp(0.0, 1.0));
+                }
+                if let Some(e) = blend(siso_estimates) {
+                    siso.push((omega, e));
                 }
             }
-            if let Some(e) = blend(miso_estimates) {
-                miso.push((omega, e));
+            let multiple_kept = prepared.every_excited.then_some(miso_multiple.as_slice());
+            let (mut pair, dropped) = pair_response(&input, output, &miso, multiple_kept, opts);
+            let (mut siso_pair, siso_dropped) = pair_response(&input, output, &siso, None, opts);
+            if dropped + siso_dropped > 0 {
+                notes.push(format!(
+                    "{input}→{output}: {} non-finite points (or beyond ±{MAX_PLAUSIBLE_MAG_DB} dB) left out",
+                    dropped + siso_dropped
+                ));
             }
-            if let Some(e) = blend(multiple_estimates).filter(|e| e.coherence.is_finite()) {
-                multiple.omega.push(omega);
-                multiple.coherence.push(e.coherence.clamp(0.0, 1.0));
+            if prepared.every_excited {
+                pair.group = Some(axis.clone());
+                siso_pair.group = Some(axis.clone());
             }
-            if let Some(e) = blend(siso_estimates) {
-                siso.push((omega, e));
-            }
+            analysis.document.pairs.push(pair);
+            analysis.multiple_coherence.push(multiple);
+            analysis.document.siso.push(siso_pair);
         }
-        let input = input_name(primary);
-        let (pair, dropped) = pair_response(&input, output, &miso, opts);
-        let (siso_pair, siso_dropped) = pair_response(&input, output, &siso, opts);
-        if dropped + siso_dropped > 0 {
-            notes.push(format!(
-                "{input}→{output}: {} non-finite points left out",
-                dropped + siso_dropped
-            ));
-        }
-        analysis.document.pairs.push(pair);
-        analysis.multiple_coherence.push(multiple);
-        analysis.document.siso.push(siso_pair);
     }
 
     let curves = curves_from_spectra(prepared, &spectra);
@@ -565,6 +732,7 @@ fn analyse_group(prepared: &PreparedGroup, opts: &FrfOptions, analysis: &mut Frf
         band: [grid[0], grid[grid.len() - 1]],
         windows: spectra.iter().map(|s| s.seconds).collect(),
         conditioned_on: (0..n_in).map(input_name).collect(),
+        responses: prepared.responding.iter().map(|&i| input_name(i)).collect(),
     });
 }
 
@@ -667,13 +835,15 @@ fn rounded(omega: f64) -> f64 {
     (omega * 1e4).round() / 1e4
 }
 
-/// Magnitude, unwrapped phase, coherence, random error and valid range of composite
-/// estimates; non-finite points are left out (their count is returned). The valid range
+/// Magnitude, unwrapped phase, coherence, random error, valid range and, when given (one
+/// value per point), multiple coherence of composite estimates; non-finite points, and those beyond ±[`MAX_PLAUSIBLE_MAG_DB`] (which
+/// every reader of `frf.json` refuses), are left out (their count is returned). The valid range
 /// takes the coherence threshold and, when set, the largest random error of `opts`.
 fn pair_response(
     input: &str,
     output: &str,
     points: &[(f64, Estimate)],
+    multiple: Option<&[f64]>,
     opts: &FrfOptions,
 ) -> (PairResponse, usize) {
     let mut pair = PairResponse {
@@ -685,16 +855,24 @@ fn pair_response(
         coherence: Vec::with_capacity(points.len()),
         random_error: Vec::with_capacity(points.len()),
         valid_range: None,
+        group: None,
+        multiple_coherence: Vec::new(),
     };
     let mut dropped = 0;
     let mut previous_wrapped: Option<f64> = None;
-    for &(omega, e) in points {
+    for (index, &(omega, e)) in points.iter().enumerate() {
+        let multiple_here = multiple.map(|m| m[index]);
         let magnitude = e.response.norm();
+        let mag_db = 20.0 * magnitude.max(1e-300).log10();
+        // What `FrfDocument::validate` would refuse is left out here: a reader must
+        // accept every document this writes.
         let finite = omega.is_finite()
             && e.response.re.is_finite()
             && e.response.im.is_finite()
             && e.coherence.is_finite()
-            && e.random_error.is_finite();
+            && e.random_error.is_finite()
+            && mag_db.abs() <= MAX_PLAUSIBLE_MAG_DB
+            && multiple_here.is_none_or(f64::is_finite);
         if !finite {
             dropped += 1;
             continue;
@@ -714,10 +892,13 @@ fn pair_response(
         };
         previous_wrapped = Some(wrapped);
         pair.omega.push(omega);
-        pair.mag_db.push(20.0 * magnitude.max(1e-300).log10());
+        pair.mag_db.push(mag_db);
         pair.phase_deg.push(phase);
         pair.coherence.push(e.coherence.clamp(0.0, 1.0));
         pair.random_error.push(e.random_error);
+        if let Some(m) = multiple_here {
+            pair.multiple_coherence.push(m);
+        }
     }
     pair.valid_range = accurate_range(
         &pair.omega,

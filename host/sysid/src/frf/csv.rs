@@ -9,6 +9,12 @@
 //! A CSV written by `sweephold decode` holds every phase of a test; when the file has a
 //! column named by [`CsvColumns::phase_column`] (default `phase`), only rows whose phase
 //! is `fade_in`, `sweep` or `fade_out` are kept, as for dumps.
+//!
+//! **Which input was swept**, in order of precedence: [`CsvColumns::primary`] (`frf
+//! --swept`); else the file's [`CsvColumns::primary_column`] (default `primary`, which
+//! `sweephold decode` writes on every row), whose value must be the same on every kept
+//! row; else the input with the largest RMS about its trend line, and the record is
+//! marked [`Record::primary_guessed`].
 
 use std::path::Path;
 
@@ -24,9 +30,15 @@ pub struct CsvColumns {
     pub inputs: Vec<(String, String)>,
     /// Outputs as (channel name, column name).
     pub outputs: Vec<(String, String)>,
-    /// The swept input (a channel name); `None`: the input with the largest RMS about
-    /// its trend line.
+    /// The swept input (a channel name, `frf --swept`); it overrides the file's primary
+    /// column. `None`: the primary column names it, else the input with the largest RMS
+    /// about its trend line does.
     pub primary: Option<String>,
+    /// Column naming the swept axis on each row, read when the file has it and `primary`
+    /// is `None`. Its value must be the same on every kept row and name an input, by its
+    /// channel name or by the decode command column it is read from (`lat` names the
+    /// input read from `cmd_lat`, whatever that input is called).
+    pub primary_column: Option<String>,
     /// Phase column used to keep only excitation rows, when the file has it.
     pub phase_column: Option<String>,
     /// Sweep band [rad/s], if known.
@@ -54,11 +66,15 @@ impl Default for CsvColumns {
                 "u", "v", "w", "p", "q", "r", "ax", "ay", "az", "phi", "theta",
             ]),
             primary: None,
+            primary_column: Some(PRIMARY_COLUMN.into()),
             phase_column: Some("phase".into()),
             sweep_band: None,
         }
     }
 }
+
+/// The column `sweephold decode` writes the swept axis into.
+pub const PRIMARY_COLUMN: &str = "primary";
 
 /// Phases kept when the file has a phase column.
 const EXCITATION_PHASES: [&str; 3] = ["fade_in", "sweep", "fade_out"];
@@ -119,6 +135,34 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
         .phase_column
         .as_deref()
         .and_then(|c| names.iter().position(|n| *n == c));
+    let input_names = || {
+        columns
+            .inputs
+            .iter()
+            .map(|(name, _)| name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some(name) = &columns.primary {
+        if !columns.inputs.iter().any(|(n, _)| n == name) {
+            return Err(error(
+                0,
+                format!(
+                    "swept input `{name}` is not among the inputs ({})",
+                    input_names()
+                ),
+            ));
+        }
+    }
+    // The primary column, read only when no swept input was named.
+    let primary_column = columns
+        .primary
+        .is_none()
+        .then_some(columns.primary_column.as_deref())
+        .flatten()
+        .and_then(|c| names.iter().position(|n| *n == c).map(|i| (c, i)));
+    // Its value and the first and last kept lines that carried it.
+    let mut named_axis: Option<(String, usize, usize)> = None;
 
     let mut time = Vec::new();
     let mut inputs = vec![Vec::new(); input_index.len()];
@@ -135,6 +179,29 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
         if let Some(p) = phase_index {
             if !EXCITATION_PHASES.contains(&fields[p]) {
                 continue;
+            }
+        }
+        if let Some((column, index)) = primary_column {
+            let value = fields[index];
+            match &mut named_axis {
+                None if value.is_empty() => {
+                    return Err(error(line_number, format!("column `{column}` is empty")));
+                }
+                None => named_axis = Some((value.to_string(), line_number, line_number)),
+                Some((axis, _, last)) if axis == value => *last = line_number,
+                Some((axis, first, last)) => {
+                    let kept = if phase_index.is_some() {
+                        " (rows in the fade-in, sweep and fade-out phases)"
+                    } else {
+                        ""
+                    };
+                    return Err(error(
+                        line_number,
+                        format!(
+                            "column `{column}` names `{value}` here but `{axis}` on lines {first}–{last}: one swept axis per file{kept}; split the file or name the swept input (--swept)"
+                        ),
+                    ));
+                }
             }
         }
         let number = |index: usize| {
@@ -194,8 +261,32 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
     }
 
     let mut notes = Vec::new();
-    let primary = match &columns.primary {
-        Some(name) => name.clone(),
+    let named = match (&columns.primary, &named_axis, primary_column) {
+        (Some(name), _, _) => Some(name.clone()),
+        (None, Some((axis, _, _)), Some((column, _))) => {
+            // By channel name, or by the decode command column (`cmd_lat` for `lat`).
+            let command_column = format!("cmd_{axis}");
+            let input = columns
+                .inputs
+                .iter()
+                .find(|(name, _)| name == axis)
+                .or_else(|| columns.inputs.iter().find(|(_, c)| *c == command_column))
+                .map(|(name, _)| name.clone());
+            Some(input.ok_or_else(|| {
+                error(
+                    0,
+                    format!(
+                        "column `{column}` names `{axis}`, which is not among the inputs ({}); name the swept input (--swept)",
+                        input_names()
+                    ),
+                )
+            })?)
+        }
+        _ => None,
+    };
+    let primary_guessed = named.is_none();
+    let primary = match named {
+        Some(name) => name,
         None => {
             // The most active input about its trend line.
             let activity = |values: &Vec<f64>| {
@@ -219,6 +310,7 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
         source: source.into(),
         sample_rate_hz: 1.0 / step,
         primary,
+        primary_guessed,
         sweep_band: columns.sweep_band,
         inputs: columns
             .inputs
@@ -252,6 +344,7 @@ mod tests {
             ],
             outputs: vec![("p".into(), "p".into())],
             primary: None,
+            primary_column: Some(PRIMARY_COLUMN.into()),
             phase_column: Some("phase".into()),
             sweep_band: Some([1.0, 10.0]),
         }
@@ -268,8 +361,107 @@ mod tests {
         assert_eq!(record.len(), 50);
         assert!((record.sample_rate_hz - 50.0).abs() < 1e-9);
         assert_eq!(record.primary, "lat");
+        assert!(record.primary_guessed);
         assert_eq!(record.input("lon").unwrap()[10], 0.001 * 0.2);
         assert_eq!(record.notes.len(), 1);
+    }
+
+    /// A lateral sweep as `decode` lays it out: idle rows, then excitation rows whose
+    /// `primary` is `lat`, while the longitudinal stick moves more than the lateral one.
+    fn decoded_lateral_sweep(primary_of_row: impl Fn(usize) -> &'static str) -> String {
+        let mut text = String::from("t,phase,primary,cmd_lat,cmd_lon,p\n");
+        for k in 0..60 {
+            let t = k as f64 * 0.02;
+            let phase = if k < 10 { "idle" } else { "sweep" };
+            let (lat, lon) = (0.01 * (3.0 * t).sin(), 0.2 * (1.3 * t).cos());
+            text += &format!("{t},{phase},{},{lat},{lon},{}\n", primary_of_row(k), lat);
+        }
+        text
+    }
+
+    fn decode_columns() -> CsvColumns {
+        CsvColumns {
+            inputs: vec![
+                ("lat".into(), "cmd_lat".into()),
+                ("lon".into(), "cmd_lon".into()),
+            ],
+            ..columns()
+        }
+    }
+
+    #[test]
+    fn the_swept_axis_comes_from_the_option_then_the_primary_column_then_activity() {
+        let text = decoded_lateral_sweep(|_| "lat");
+        // The primary column names `lat`, though `lon` is the most active.
+        let record = parse_csv(&text, "d.csv", &decode_columns()).unwrap();
+        assert_eq!(record.primary, "lat");
+        assert!(!record.primary_guessed && record.notes.is_empty());
+        // Without the column the most active input is taken.
+        let no_column = CsvColumns {
+            primary_column: None,
+            ..decode_columns()
+        };
+        let record = parse_csv(&text, "d.csv", &no_column).unwrap();
+        assert_eq!(record.primary, "lon");
+        assert!(record.primary_guessed);
+        // A named swept input overrides the column.
+        let named = CsvColumns {
+            primary: Some("lon".into()),
+            ..decode_columns()
+        };
+        let record = parse_csv(&text, "d.csv", &named).unwrap();
+        assert_eq!(
+            (record.primary.as_str(), record.primary_guessed),
+            ("lon", false)
+        );
+        // Inputs renamed: the column's `lat` still finds the input read from `cmd_lat`.
+        let renamed = CsvColumns {
+            inputs: vec![
+                ("roll".into(), "cmd_lat".into()),
+                ("pitch".into(), "cmd_lon".into()),
+            ],
+            ..decode_columns()
+        };
+        assert_eq!(parse_csv(&text, "d.csv", &renamed).unwrap().primary, "roll");
+        // Idle rows may name another axis: only the kept rows must agree.
+        let idle_other = decoded_lateral_sweep(|k| if k < 10 { "ped" } else { "lat" });
+        assert_eq!(
+            parse_csv(&idle_other, "d.csv", &decode_columns())
+                .unwrap()
+                .primary,
+            "lat"
+        );
+    }
+
+    #[test]
+    fn a_primary_column_that_changes_or_names_no_input_is_refused() {
+        let text = decoded_lateral_sweep(|k| if k < 40 { "lat" } else { "lon" });
+        let err = parse_csv(&text, "d.csv", &decode_columns()).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "d.csv:42: column `primary` names `lon` here but `lat` on lines 12–41: one swept axis per file (rows in the fade-in, sweep and fade-out phases); split the file or name the swept input (--swept)"
+        );
+        // Naming the swept input sets the column aside.
+        let named = CsvColumns {
+            primary: Some("lat".into()),
+            ..decode_columns()
+        };
+        assert_eq!(parse_csv(&text, "d.csv", &named).unwrap().primary, "lat");
+        let text = decoded_lateral_sweep(|_| "col");
+        let err = parse_csv(&text, "d.csv", &decode_columns()).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "d.csv: column `primary` names `col`, which is not among the inputs (lat, lon); name the swept input (--swept)"
+        );
+        let unknown = CsvColumns {
+            primary: Some("ped".into()),
+            ..decode_columns()
+        };
+        let err = parse_csv(&text, "d.csv", &unknown).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "d.csv: swept input `ped` is not among the inputs (lat, lon)"
+        );
     }
 
     #[test]

@@ -298,6 +298,7 @@ fn record_from_samples_at(
         source: source.into(),
         sample_rate_hz: f64::from(header.rate_hz),
         primary: test.primary.name().to_string(),
+        primary_guessed: false,
         sweep_band: Some([
             f64::from(test.sweep.omega_min),
             f64::from(test.sweep.omega_max),

@@ -65,7 +65,7 @@ pub use csv::{load_csv, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };
-pub use options::{FrfOptions, ResponseEstimator};
+pub use options::{FrfOptions, ResponseEstimator, ResponseInputs};
 pub use plots::write_plots;
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
 

@@ -38,6 +38,44 @@ pub struct FrfOptions {
     pub oversampling: usize,
     /// How the conditioned responses are estimated (default [`ResponseEstimator::CrossSpectral`]).
     pub estimator: ResponseEstimator,
+    /// Which inputs of a record group get conditioned responses (default
+    /// [`ResponseInputs::Auto`]).
+    pub responses: ResponseInputs,
+    /// An input other than the swept one counts as excited, and gets responses where
+    /// [`responses`](Self::responses) asks for every excited input, when its RMS (about
+    /// each record's trend line, over the joined records) is at least this fraction of
+    /// the largest input RMS of the group (default 0.1, i.e. 20 dB below). The controls
+    /// are compared in their own units, so CSV inputs should share one (stick fraction,
+    /// degrees, …). An input below it still conditions the others when it reaches
+    /// [`excitation_ratio`](Self::excitation_ratio) of the swept one's RMS.
+    pub response_ratio: f64,
+}
+
+/// Which inputs of a record group get MISO-conditioned responses.
+///
+/// All of them come from the same solve `H = G_uu⁻¹·G_uy`: with the inputs u of a group
+/// and output y, H_i is the response to input i with the other inputs accounted for,
+/// whichever input was swept. Its partial coherence needs G_ii·(others), the autospectrum
+/// of input i conditioned on the others, so each responding input is ordered last in its
+/// own factorisation of G_uu ([`miso`](super::miso)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ResponseInputs {
+    /// [`Excited`](Self::Excited) for a group whose every record has its swept input
+    /// only guessed ([`Record::primary_guessed`](super::Record::primary_guessed): CSV
+    /// without a `primary` column or `frf --swept`), where nothing says one input was
+    /// swept while the others stayed small; [`Swept`](Self::Swept) otherwise (telemetry
+    /// dumps, decoded CSV, a named swept input) and with the sweep-reference estimator.
+    #[default]
+    Auto,
+    /// The swept input of each group only: in a flight-test sweep the other controls move
+    /// only by the holds' corrections and the off-axis noise, conditioning inputs rather
+    /// than responses of their own.
+    Swept,
+    /// Every excited input of each group (the swept one and each input reaching
+    /// [`FrfOptions::response_ratio`]): records in which several inputs are excited at
+    /// once (multisines, simultaneous-axis tests, another logger's flight). Not with the
+    /// sweep-reference estimator, which instruments the swept input only.
+    Excited,
 }
 
 /// How the conditioned (MISO) responses are estimated from the spectra.
@@ -70,6 +108,8 @@ impl Default for FrfOptions {
             min_pivot: 1e-3,
             oversampling: 8,
             estimator: ResponseEstimator::CrossSpectral,
+            responses: ResponseInputs::Auto,
+            response_ratio: 0.1,
         }
     }
 }
@@ -114,6 +154,20 @@ impl FrfOptions {
         }
         if !(1..=64).contains(&self.oversampling) {
             return bad(format!("oversampling {}: need 1..=64", self.oversampling));
+        }
+        if !(self.response_ratio > 0.0 && self.response_ratio <= 1.0) {
+            return bad(format!(
+                "response ratio {}: need 0 < r ≤ 1",
+                self.response_ratio
+            ));
+        }
+        if self.responses == ResponseInputs::Excited
+            && self.estimator == ResponseEstimator::SweepReference
+        {
+            return bad(
+                "the sweep-reference estimator gives only the swept input's response: responses to every excited input need the cross-spectral estimator"
+                    .into(),
+            );
         }
         Ok(())
     }

@@ -42,6 +42,11 @@ pub struct Record {
     pub sample_rate_hz: f64,
     /// Name of the swept input (one of `inputs`), e.g. `lat`.
     pub primary: String,
+    /// `true` when nothing named the swept input and `primary` is only the most active
+    /// one (a CSV file without a `primary` column, read without `frf --swept`): such a
+    /// record may excite several inputs at once. `false` for telemetry dumps (their
+    /// Header names the swept axis).
+    pub primary_guessed: bool,
     /// Sweep band [ω_min, ω_max] rad/s, when known (from the dump Header).
     pub sweep_band: Option<[f64; 2]>,
     /// Input channels (controls), e.g. `lat lon ped col`.
@@ -223,6 +228,12 @@ impl RecordGroup {
         &self.records[0].primary
     }
 
+    /// `true` when every record's swept input is only guessed
+    /// ([`Record::primary_guessed`]).
+    pub fn primary_guessed(&self) -> bool {
+        self.records.iter().all(|r| r.primary_guessed)
+    }
+
     /// Sample rate \[Hz\].
     pub fn sample_rate_hz(&self) -> f64 {
         self.records[0].sample_rate_hz
@@ -399,6 +410,7 @@ mod tests {
             source: source.into(),
             sample_rate_hz: 100.0,
             primary: primary.into(),
+            primary_guessed: false,
             sweep_band: Some([1.0, 10.0]),
             inputs: vec![Channel::new("lat", lat)],
             outputs: vec![Channel::new("p", p)],

@@ -202,6 +202,7 @@ pub fn record(
         source: "synthetic".into(),
         sample_rate_hz: rate,
         primary: inputs[0].0.to_string(),
+        primary_guessed: false,
         sweep_band: Some(band),
         inputs: inputs
             .into_iter()

@@ -5,7 +5,7 @@ use num_complex::Complex64;
 use super::*;
 use crate::frf::records::Channel;
 use crate::frf::testing::{add_noise, dump_bytes, record, sample, Block, DumpSpec, Noise, Sweep};
-use crate::frf::{load_dump_bytes, RecordGroup};
+use crate::frf::{load_dump_bytes, Record, RecordGroup};
 
 const RATE: f64 = 200.0;
 
@@ -428,6 +428,8 @@ fn phase_branch_is_anchored_at_the_low_end_of_the_valid_range() {
         coherence: vec![0.3, 0.4, 0.9, 0.95, 0.9],
         random_error: vec![0.1; 5],
         valid_range: Some([0.5, 2.0]),
+        group: None,
+        multiple_coherence: Vec::new(),
     };
     anchor_phase_branch(&mut pair);
     assert_eq!(pair.phase_deg, vec![220.0, 110.0, -5.0, -10.0, -60.0]);
@@ -530,4 +532,198 @@ fn the_reference_estimator_needs_references() {
         .to_string();
     assert!(error.contains("sweep-reference estimator needs"), "{error}");
     assert!(!error.contains('\n'));
+}
+
+/// A sum of 60 sines log-spaced over 0.3–31.4 rad/s with random phases (`seed`), scaled
+/// so that its amplitude per tone is `amplitude`.
+fn multisine(seed: u64, amplitude: f64) -> impl Fn(f64) -> f64 + Clone {
+    let mut phases = Noise::new(seed);
+    let tones: Vec<(f64, f64)> = (0..60)
+        .map(|j| {
+            let omega = 0.3 * (31.4f64 / 0.3).powf(j as f64 / 59.0);
+            (omega, std::f64::consts::TAU * phases.gaussian())
+        })
+        .collect();
+    move |t: f64| {
+        amplitude
+            * tones
+                .iter()
+                .map(|&(w, phi)| (w * t + phi).sin())
+                .sum::<f64>()
+    }
+}
+
+/// A 60 s record (framed by trim) whose `inputs` all drive `p` through first-order lags
+/// (input i: gain 1 + i, time constant 0.1·(i + 1) s), plus 2 % noise: the first input is
+/// swept (the record's primary), the others are multisines with the given amplitude per
+/// tone.
+fn multi_input_record(inputs: &[(&str, f64)], guessed: bool) -> Record {
+    let sweep = paper_sweep(60.0);
+    let len = ((60.0 + 2.0 * TRIM_S) * RATE) as usize;
+    let mut p = vec![0.0; len];
+    let mut channels = Vec::new();
+    for (i, &(name, amplitude)) in inputs.iter().enumerate() {
+        let signal: Box<dyn Fn(f64) -> f64> = if i == 0 {
+            Box::new(move |t: f64| sweep.value(t - TRIM_S))
+        } else {
+            Box::new(multisine(11 + i as u64, amplitude))
+        };
+        let block = Block::first_order(1.0 + i as f64, 0.1 * (i + 1) as f64, 0.0);
+        for (y, v) in p.iter_mut().zip(block.simulate(&signal, RATE, len, 4)) {
+            *y += v;
+        }
+        channels.push((name, sample(&signal, RATE, len)));
+    }
+    add_noise(&mut p, 0.02, &mut Noise::new(3));
+    let mut rec = record(RATE, [0.3, 31.4], channels, vec![("p", p)]);
+    rec.primary_guessed = guessed;
+    rec
+}
+
+fn with_responses(responses: ResponseInputs) -> FrfOptions {
+    FrfOptions {
+        responses,
+        points: 60,
+        ..FrfOptions::default()
+    }
+}
+
+fn pair_names(document: &FrfDocument) -> Vec<String> {
+    document
+        .pairs
+        .iter()
+        .map(|p| format!("{}→{}", p.input, p.output))
+        .collect()
+}
+
+#[test]
+fn responses_to_every_excited_input_follow_the_option() {
+    // lat swept (RMS ≈ 0.033 with the trim); lon a multisine of RMS 0.003·√30 ≈ 0.016,
+    // about half of that; ped ≈ 5 %: it conditions the others (≥ 1 %) but gets no
+    // responses (< 10 %).
+    let inputs = [("lat", 0.0), ("lon", 0.003), ("ped", 0.0003)];
+    let group = |guessed| RecordGroup::new(vec![multi_input_record(&inputs, guessed)]).unwrap();
+    let run = |guessed, responses| analyse(&[group(guessed)], &with_responses(responses)).unwrap();
+
+    let swept = run(false, ResponseInputs::Swept);
+    assert_eq!(pair_names(&swept.document), ["lat→p"]);
+    assert!(swept.document.pairs[0].group.is_none());
+    assert!(swept.document.pairs[0].multiple_coherence.is_empty());
+    assert_eq!(swept.groups[0].responses, ["lat"]);
+
+    let all = run(false, ResponseInputs::Excited);
+    assert_eq!(pair_names(&all.document), ["lat→p", "lon→p"]);
+    assert_eq!(all.groups[0].responses, ["lat", "lon"]);
+    assert_eq!(all.groups[0].conditioned_on, ["lon", "ped", "lat"]);
+    for (pair, siso) in all.document.pairs.iter().zip(&all.document.siso) {
+        assert_eq!(pair.group.as_deref(), Some("lat"));
+        assert_eq!(siso.group.as_deref(), Some("lat"));
+        assert_eq!(pair.multiple_coherence.len(), pair.omega.len());
+        assert_eq!((&siso.input, &siso.output), (&pair.input, &pair.output));
+    }
+    // The swept input's response is the same computation either way.
+    assert_eq!(all.document.pairs[0].mag_db, swept.document.pairs[0].mag_db);
+    assert_eq!(
+        all.multiple_coherence
+            .iter()
+            .map(|m| m.input.as_str())
+            .collect::<Vec<_>>(),
+        ["lat", "lon"]
+    );
+    // The lon response is lon's lag, 2/(0.2 s + 1), not lat's: ≈ 6 dB at 1 rad/s.
+    let lon = all.document.pair("lon", "p").unwrap();
+    let k = lon.omega.iter().position(|&w| w >= 1.0).unwrap();
+    let exact = 20.0 * (2.0 / (1.0 + (0.2 * lon.omega[k]).powi(2)).sqrt()).log10();
+    assert!(
+        (lon.mag_db[k] - exact).abs() < 0.5,
+        "{} vs {exact}",
+        lon.mag_db[k]
+    );
+    assert!(
+        all.document
+            .notes
+            .iter()
+            .any(|n| n.starts_with("lat records: no responses to `ped`: its RMS is")),
+        "{:?}",
+        all.document.notes
+    );
+
+    // Auto: every excited input only where the swept input was guessed.
+    assert_eq!(run(false, ResponseInputs::Auto).document, swept.document);
+    assert_eq!(
+        pair_names(&run(true, ResponseInputs::Auto).document),
+        ["lat→p", "lon→p"]
+    );
+}
+
+#[test]
+fn a_pair_given_by_two_groups_is_kept_once() {
+    // A lat sweep with lon excited, and a lon sweep with lat excited: each group gives
+    // lat→p and lon→p; the one from the group sweeping the input is kept.
+    let lat_group = multi_input_record(&[("lat", 0.0), ("lon", 0.003)], false);
+    let lon_group = multi_input_record(&[("lon", 0.0), ("lat", 0.003)], false);
+    let groups = vec![
+        RecordGroup::new(vec![lat_group]).unwrap(),
+        RecordGroup::new(vec![lon_group]).unwrap(),
+    ];
+    let analysis = analyse(&groups, &with_responses(ResponseInputs::Excited)).unwrap();
+    let document = &analysis.document;
+    assert_eq!(pair_names(document), ["lat→p", "lon→p"]);
+    let groups: Vec<_> = document.pairs.iter().map(|p| p.group.as_deref()).collect();
+    assert_eq!(groups, [Some("lat"), Some("lon")]);
+    assert_eq!(document.siso.len(), 2);
+    assert_eq!(analysis.multiple_coherence.len(), 2);
+    for (pair, siso) in document.pairs.iter().zip(&document.siso) {
+        assert_eq!((&siso.input, &siso.group), (&pair.input, &pair.group));
+    }
+    assert!(
+        document.notes.iter().any(|n| n
+            == "lon→p: the estimate from the lon records kept (it sweeps `lon`), the one from the lat records left out"),
+        "{:?}",
+        document.notes
+    );
+    document.validate().unwrap();
+
+    // Neither group sweeps ped: the better-explained estimate is kept. ped moves 10×
+    // more in the lon records, so its partial coherence is higher there.
+    let groups = vec![
+        RecordGroup::new(vec![multi_input_record(
+            &[("lat", 0.0), ("ped", 0.0006)],
+            false,
+        )])
+        .unwrap(),
+        RecordGroup::new(vec![multi_input_record(
+            &[("lon", 0.0), ("ped", 0.006)],
+            false,
+        )])
+        .unwrap(),
+    ];
+    let document = analyse(&groups, &with_responses(ResponseInputs::Excited))
+        .unwrap()
+        .document;
+    assert_eq!(pair_names(&document), ["lat→p", "lon→p", "ped→p"]);
+    assert_eq!(document.pairs[2].group.as_deref(), Some("lon"));
+    assert!(
+        document.notes.iter().any(
+            |n| n.starts_with("ped→p: the estimate from the lon records kept (mean partial γ²")
+        ),
+        "{:?}",
+        document.notes
+    );
+}
+
+#[test]
+fn every_excited_input_needs_the_cross_spectral_estimator() {
+    let options = FrfOptions {
+        responses: ResponseInputs::Excited,
+        estimator: ResponseEstimator::SweepReference,
+        ..FrfOptions::default()
+    };
+    let err = options.validate().unwrap_err();
+    assert!(err.to_string().contains("sweep-reference"), "{err}");
+    let ratio = FrfOptions {
+        response_ratio: 0.0,
+        ..FrfOptions::default()
+    };
+    assert!(ratio.validate().is_err());
 }
