@@ -302,7 +302,11 @@ impl PairResponse {
         }
         if let Some([lo, hi]) = self.valid_range {
             let inside = match (self.omega.first(), self.omega.last()) {
-                (Some(&first), Some(&last)) => first <= lo && lo <= hi && hi <= last,
+                // A grid computed from the band's ends may miss them by rounding.
+                (Some(&first), Some(&last)) => {
+                    let slack = 1e-9 * last.abs().max(1.0);
+                    first - slack <= lo && lo <= hi && hi <= last + slack
+                }
                 _ => false,
             };
             if !inside {
