@@ -100,6 +100,15 @@ fn refused_command_lines_and_outputs_that_are_inputs() {
     let data = flown_data(&dir);
     std::fs::write(dir.join("not-a-folder"), "x").unwrap();
     std::fs::write(data.join("lag.json"), LAG_MODEL).unwrap();
+    // frf.json damaged two ways: another layout version, a magnitude no response has.
+    let frf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data.join("frf.json")).unwrap()).unwrap();
+    let mut version = frf.clone();
+    version["version"] = 99.into();
+    std::fs::write(data.join("frf-v99.json"), version.to_string()).unwrap();
+    let mut huge = frf;
+    huge["pairs"][0]["mag_db"][3] = 1e300.into();
+    std::fs::write(data.join("frf-huge.json"), huge.to_string()).unwrap();
     let before = snapshot(&data);
     let cases: &[(&[&str], i32, &str)] = &[
         // An output that is one of the inputs: refused before anything is written.
@@ -146,6 +155,23 @@ fn refused_command_lines_and_outputs_that_are_inputs() {
             ],
             1,
             "is one of the inputs",
+        ),
+        // Documents that are not what they claim, named with the field at fault.
+        (
+            &["fit", "--frf", "data/frf-v99.json", "--model", "bo105-6dof"],
+            1,
+            "version 99",
+        ),
+        (
+            &[
+                "fit",
+                "--frf",
+                "data/frf-huge.json",
+                "--model",
+                "bo105-6dof",
+            ],
+            1,
+            "mag_db",
         ),
         // Counts beyond their documented range.
         (
