@@ -110,9 +110,17 @@ impl AtomicFile {
         let name = destination
             .file_name()
             .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-        let file = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".tmp")
+        let prefix = format!(".{name}.");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        // The mode a plain `File::create` gives (0666 less the umask), not the private
+        // 0600 of a temporary file: the result is an ordinary output file.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(fs::Permissions::from_mode(0o666));
+        }
+        let file = builder
             .tempfile_in(folder)
             .with_context(|| format!("cannot create {}", destination.display()))?;
         Ok(AtomicFile {
@@ -376,6 +384,16 @@ mod tests {
         assert_eq!(fs::read(&path).unwrap(), b"earlier");
         write_atomic(&path, b"new").unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"new");
+        #[cfg(unix)]
+        {
+            // As File::create would make it: readable by others unless the umask says no.
+            use std::os::unix::fs::PermissionsExt;
+            let plain = dir.join("plain");
+            fs::File::create(&plain).unwrap();
+            let mode = |p: &Path| fs::metadata(p).unwrap().permissions().mode() & 0o777;
+            assert_eq!(mode(&path), mode(&plain));
+            fs::remove_file(&plain).unwrap();
+        }
         // No temporary file is left behind.
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
         assert!(write_atomic(&dir, b"x").is_err());
