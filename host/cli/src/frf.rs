@@ -3,11 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::output::{check_input_file, check_output_folder, refuse_inputs_as_outputs, write_json};
+use crate::output::{
+    check_input_file, check_output_folder, refuse_inputs_as_outputs, write_files_into, write_json,
+};
 use anyhow::bail;
 use clap::Args;
 use sysid::frf::{
-    analyse, group_by_primary, load_csv, load_dump, write_plots, CsvColumns, FrfAnalysis,
+    analyse, group_by_primary, load_csv, load_dump, render_plots, CsvColumns, FrfAnalysis,
     FrfOptions, Record, ResponseEstimator, ResponseInputs,
 };
 
@@ -295,7 +297,7 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
 
     // Plots first: the document is the result, written last and whole.
     let plots = match &args.plots {
-        Some(dir) => write_plots(&analysis, dir)?.len(),
+        Some(dir) => write_files_into(dir, &render_plots(&analysis)?)?,
         None => 0,
     };
     write_json(&args.out, &analysis.document)?;

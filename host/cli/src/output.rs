@@ -171,6 +171,17 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result
     write_atomic(path, text.as_bytes())
 }
 
+/// Write `files` (`(name, text)`, e.g. rendered plots) into the folder `dir`, creating it;
+/// each file atomically. Returns how many were written.
+pub fn write_files_into(dir: &Path, files: &[(String, String)]) -> anyhow::Result<usize> {
+    check_output_folder("--plots", dir)?;
+    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    for (name, text) in files {
+        write_atomic(&dir.join(name), text.as_bytes())?;
+    }
+    Ok(files.len())
+}
+
 /// Refuse a `--plots`-style output folder that exists as something else than a folder,
 /// before any work is done.
 pub fn check_output_folder(role: &str, dir: &Path) -> anyhow::Result<()> {

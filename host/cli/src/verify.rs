@@ -7,10 +7,10 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::PathBuf;
 
-use crate::output::{check_input_file, check_output_folder};
+use crate::output::{check_input_file, check_output_folder, write_files_into};
 use anyhow::{anyhow, Context};
 use clap::Args;
-use sysid::fit::verify::{verify_record_in_segments, write_verification_plots, Verification};
+use sysid::fit::verify::{render_verification_plots, verify_record_in_segments, Verification};
 use sysid::fit::ModelDocument;
 use sysid::frf::load_test_dump;
 
@@ -91,8 +91,8 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
         write_verification(&mut report, &verification);
         all_theil.extend(verification.outputs.iter().map(|o| o.theil));
         if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {
-            let files = write_verification_plots(&verification, dir)?;
-            let _ = writeln!(report, "wrote {} plots to {}", files.len(), dir.display());
+            let written = write_files_into(dir, &render_verification_plots(&verification)?)?;
+            let _ = writeln!(report, "wrote {written} plots to {}", dir.display());
         }
     }
     if args.dumps.len() > 1 && !all_theil.is_empty() {

@@ -119,7 +119,7 @@ impl fmt::Display for VerifyError {
                 "the simulated model diverged (non-finite at sample {sample})"
             ),
             VerifyError::Plot { path, message } => {
-                write!(f, "cannot write plot {}: {message}", path.display())
+                write!(f, "cannot draw plot {}: {message}", path.display())
             }
         }
     }
@@ -574,22 +574,21 @@ fn file_stem(name: &str) -> String {
         .collect()
 }
 
-/// Write one SVG per compared output into `dir`: measured (bias removed) and predicted
-/// against time, named `<record stem>-<output>.svg`. Returns the files written.
-pub fn write_verification_plots(
+/// One SVG per compared output, as `(file name, SVG text)`: measured (bias removed) and
+/// predicted against time, named `<record stem>-<output>.svg`. The caller writes them
+/// (the CLI writes each file whole, atomically).
+pub fn render_verification_plots(
     verification: &Verification,
-    dir: &Path,
-) -> Result<Vec<PathBuf>, VerifyError> {
+) -> Result<Vec<(String, String)>, VerifyError> {
     let plot_error = |path: &Path, e: &dyn fmt::Display| VerifyError::Plot {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    std::fs::create_dir_all(dir).map_err(|e| plot_error(dir, &e))?;
     let stem = Path::new(&verification.source).file_stem().map_or_else(
         || "record".to_string(),
         |s| s.to_string_lossy().into_owned(),
     );
-    let mut written = Vec::new();
+    let mut plots = Vec::new();
     let h = 1.0 / verification.sample_rate_hz;
     for ((score, measured), predicted) in verification
         .outputs
@@ -597,12 +596,10 @@ pub fn write_verification_plots(
         .zip(&verification.measured)
         .zip(&verification.predicted)
     {
-        let path = dir.join(format!(
-            "{}-{}.svg",
-            file_stem(&stem),
-            file_stem(&score.output)
-        ));
-        let root = SVGBackend::new(&path, (1000, 400)).into_drawing_area();
+        let name = format!("{}-{}.svg", file_stem(&stem), file_stem(&score.output));
+        let path = PathBuf::from(&name);
+        let mut svg = String::new();
+        let root = SVGBackend::with_string(&mut svg, (1000, 400)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_error(&path, &e))?;
         let (lo, hi) = measured
             .iter()
@@ -654,9 +651,11 @@ pub fn write_verification_plots(
             .draw()
             .map_err(|e| plot_error(&path, &e))?;
         root.present().map_err(|e| plot_error(&path, &e))?;
-        written.push(path.clone());
+        drop(chart);
+        drop(root);
+        plots.push((name, svg));
     }
-    Ok(written)
+    Ok(plots)
 }
 
 #[cfg(test)]

@@ -66,7 +66,7 @@ pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };
 pub use options::{FrfOptions, ResponseEstimator, ResponseInputs};
-pub use plots::write_plots;
+pub use plots::render_plots;
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
 
 use std::path::PathBuf;

@@ -4,7 +4,7 @@
 //! threshold in red), and one cross-control coherence plot per swept axis (like
 //! the paper's Fig. 3 and 7).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use plotters::prelude::*;
 
@@ -20,14 +20,11 @@ fn plot_error(path: &Path, e: impl std::fmt::Display) -> FrfError {
     FrfError::Plot(format!("{}: {e}", path.display()))
 }
 
-/// Write `DIR/frf_<input>_<output>.svg` per pair and `DIR/cross_coherence_<axis>.svg`
-/// per record group; creates `dir`. Returns the files written.
-pub fn write_plots(analysis: &FrfAnalysis, dir: &Path) -> Result<Vec<PathBuf>, FrfError> {
-    std::fs::create_dir_all(dir).map_err(|source| FrfError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let mut written = Vec::new();
+/// The plots of `analysis`, as `(file name, SVG text)`: `frf_<input>_<output>.svg` per
+/// pair and `cross_coherence_<axis>.svg` per record group. The caller writes them (the
+/// CLI writes each file whole, atomically).
+pub fn render_plots(analysis: &FrfAnalysis) -> Result<Vec<(String, String)>, FrfError> {
+    let mut plots = Vec::new();
     let document = &analysis.document;
     for pair in &document.pairs {
         let siso = document
@@ -38,9 +35,17 @@ pub fn write_plots(analysis: &FrfAnalysis, dir: &Path) -> Result<Vec<PathBuf>, F
             .multiple_coherence
             .iter()
             .find(|m| m.input == pair.input && m.output == pair.output);
-        let path = dir.join(format!("frf_{}_{}.svg", pair.input, pair.output));
-        bode_plot(&path, pair, siso, multiple, document.coherence_threshold)?;
-        written.push(path);
+        let name = format!("frf_{}_{}.svg", pair.input, pair.output);
+        let mut svg = String::new();
+        bode_plot(
+            &mut svg,
+            Path::new(&name),
+            pair,
+            siso,
+            multiple,
+            document.coherence_threshold,
+        )?;
+        plots.push((name, svg));
     }
     let mut axes: Vec<&str> = analysis
         .cross_coherence_curves
@@ -54,11 +59,12 @@ pub fn write_plots(analysis: &FrfAnalysis, dir: &Path) -> Result<Vec<PathBuf>, F
             .iter()
             .filter(|c| c.axis == axis)
             .collect();
-        let path = dir.join(format!("cross_coherence_{axis}.svg"));
-        coherence_plot(&path, axis, &curves)?;
-        written.push(path);
+        let name = format!("cross_coherence_{axis}.svg");
+        let mut svg = String::new();
+        coherence_plot(&mut svg, Path::new(&name), axis, &curves)?;
+        plots.push((name, svg));
     }
-    Ok(written)
+    Ok(plots)
 }
 
 /// Range of finite values with a margin; a flat or empty series gets a unit span.
@@ -76,13 +82,14 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 fn bode_plot(
+    svg: &mut String,
     path: &Path,
     pair: &PairResponse,
     siso: Option<&PairResponse>,
     multiple: Option<&MultipleCoherence>,
     threshold: f64,
 ) -> Result<(), FrfError> {
-    let root = SVGBackend::new(path, (WIDTH, HEIGHT)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (WIDTH, HEIGHT)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_error(path, e))?;
     let panels = root.split_evenly((3, 1));
     let all = || {
@@ -207,8 +214,13 @@ fn bode_plot(
     root.present().map_err(|e| plot_error(path, e))
 }
 
-fn coherence_plot(path: &Path, axis: &str, curves: &[&CoherenceCurve]) -> Result<(), FrfError> {
-    let root = SVGBackend::new(path, (WIDTH, 450)).into_drawing_area();
+fn coherence_plot(
+    svg: &mut String,
+    path: &Path,
+    axis: &str,
+    curves: &[&CoherenceCurve],
+) -> Result<(), FrfError> {
+    let root = SVGBackend::with_string(svg, (WIDTH, 450)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_error(path, e))?;
     let (w_lo, w_hi) = curves
         .iter()
