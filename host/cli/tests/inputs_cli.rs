@@ -405,7 +405,7 @@ fn a_fly_folder_is_replaced_whole() {
 #[test]
 fn decode_to_a_file_writes_it_whole_or_not_at_all() {
     let dir = scratch("decode-atomic");
-    let data = flown_data(&dir);
+    flown_data(&dir);
     std::fs::write(dir.join("rows.csv"), "earlier rows\n").unwrap();
     std::fs::write(dir.join("noise.bin"), [7u8; 300]).unwrap();
     // A dump without a frame fails; the earlier output stays as it was.
