@@ -253,6 +253,17 @@ fn parse_axis(text: &str) -> Result<Axis, String> {
 }
 
 impl FlyArgs {
+    /// The records these arguments fly, in flying order.
+    pub fn plans(&self) -> Vec<RecordPlan> {
+        plan_records(
+            &self.axes,
+            self.mode.mode(),
+            self.input.kind(),
+            self.t_rec_s,
+            self.seed,
+        )
+    }
+
     fn check(&self) -> anyhow::Result<()> {
         if self.axes.is_empty() {
             bail!("--axes names no axis");
@@ -294,16 +305,11 @@ impl FlyArgs {
             );
         }
         if let Some(at) = self.pilot_override_at_s {
-            let shortest = plan_records(
-                &self.axes,
-                self.mode.mode(),
-                self.input.kind(),
-                self.t_rec_s,
-                self.seed,
-            )
-            .iter()
-            .map(|plan| expected_duration_s(&record_config(self.vehicle, plan, self.rate_hz)))
-            .fold(f64::INFINITY, f64::min);
+            let shortest = self
+                .plans()
+                .iter()
+                .map(|plan| expected_duration_s(&record_config(self.vehicle, plan, self.rate_hz)))
+                .fold(f64::INFINITY, f64::min);
             if !(at >= 0.0 && at < shortest) {
                 bail!(
                     "--pilot-override {at}: expected a time from 0 to {shortest:.1} s after arming \
@@ -432,13 +438,7 @@ fn fly_on_link(args: &FlyArgs, image: Option<&std::path::Path>) -> anyhow::Resul
 /// anything is flown or written.
 pub fn validate(args: &FlyArgs) -> anyhow::Result<()> {
     args.check()?;
-    let plans = plan_records(
-        &args.axes,
-        args.mode.mode(),
-        args.input.kind(),
-        args.t_rec_s,
-        args.seed,
-    );
+    let plans = args.plans();
     for plan in &plans {
         let config = record_config(args.vehicle, plan, args.rate_hz);
         sweephold_firmware::FlightController::new(config).map_err(|e| {
@@ -472,13 +472,7 @@ pub fn fly_with_workers(
     let heli = args.vehicle.sim().helicopter();
     let trim = bo105::trim(&heli, 0.0)
         .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
-    let plans = plan_records(
-        &args.axes,
-        args.mode.mode(),
-        args.input.kind(),
-        args.t_rec_s,
-        args.seed,
-    );
+    let plans = args.plans();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
 
