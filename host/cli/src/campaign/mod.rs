@@ -509,6 +509,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
         let document = ScoredModelDocument {
             model: nine.to_document(),
             truth: Some(section),
+            modes: Vec::new(),
         };
         write_json(&run.dir().join(files::MODEL_9DOF), &document)?;
         Ok(((), line))
