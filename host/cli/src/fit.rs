@@ -239,7 +239,8 @@ enum ModesReport {
 fn write_modes(out: &mut String, modes: &Result<ModesReport, ModeError>) -> std::fmt::Result {
     writeln!(
         out,
-        "\nmodes (eigenvalues of M⁻¹F, named from their eigenvectors; hover: |λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s):"
+        "\nmodes (eigenvalues of M⁻¹F, named from their eigenvectors; hover: \
+|λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s):"
     )?;
     match modes {
         Err(error) => writeln!(out, "  not computed: {error}"),

@@ -240,7 +240,8 @@ fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
 /// when the truth was scored but the modes are missing; absent before the truth stage.
 fn hover_mode_bar(fit: &FitSummary) -> Option<Vec<Cell>> {
     let what = format!(
-        "hover modes (truth |λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s) within {HOVER_MODE_TOLERANCE_PERCENT:.0} % of the truth, poles at the origin"
+        "hover modes (truth |λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s) within \
+{HOVER_MODE_TOLERANCE_PERCENT:.0} % of the truth, poles at the origin"
     );
     let bar = "every hover mode within 25 %, no pole at the origin";
     match (fit.hover_modes_matched, fit.poles_at_origin) {
@@ -276,7 +277,10 @@ pub fn modes_section(inputs: &ReportInputs) -> String {
         return section(
             "modes",
             title,
-            &note("The modes of this fit were not computed (a summary written before they were, or a model without eigenvalues)."),
+            &note(
+                "The modes of this fit were not computed (a summary written before they \
+were, or a model without eigenvalues).",
+            ),
         );
     }
     let time = |double: Option<f64>, half: Option<f64>| match (double, half) {
@@ -339,7 +343,15 @@ pub fn modes_section(inputs: &ReportInputs) -> String {
         _ => String::new(),
     };
     let content = note(&format!(
-        "Eigenvalues λ of A = M⁻¹F of the identified model, one row per real pole or complex pair (its Im > 0 member), sorted by |λ|; ω_n = |λ|, ζ = −Re λ/|λ|, time to double (ln 2/Re λ) or to half (ln 2/−Re λ) the amplitude (of the envelope for a pair). Each mode is named from its eigenvector (shape: the largest shares, rates divided by |λ| and speeds multiplied by |λ|/g so that each reads as the attitude it amounts to; rules in sysid::fit::modes) and paired with a mode of the truth model (the same structure at the simulator's truth values): same name first, then the nearest eigenvalue. Error = 100·|λ − λ_truth|/|λ_truth|, green/red against 25 % for the truth's hover modes (|λ| < 3 rad/s); a pole at the origin (|λ| < 1e−6 rad/s) is red.{verdict}"
+        "Eigenvalues λ of A = M⁻¹F of the identified model, one row per real pole or \
+complex pair (its Im > 0 member), sorted by |λ|; ω_n = |λ|, ζ = −Re λ/|λ|, time to double \
+(ln 2/Re λ) or to half (ln 2/−Re λ) the amplitude (of the envelope for a pair). Each mode is \
+named from its eigenvector (shape: the largest shares, rates divided by ω_s = max(|λ|, 0.1 \
+rad/s) and speeds multiplied by ω_s/g so that each reads as the attitude it amounts to; rules \
+in sysid::fit::modes) and paired with a mode of the truth model (the same structure at the \
+simulator's truth values): same name first, then the nearest eigenvalue. Error = \
+100·|λ − λ_truth|/|λ_truth|, green/red against 25 % for the truth's hover modes (|λ| < 3 \
+rad/s); a pole at the origin (|λ| < 1e−6 rad/s) is red.{verdict}"
     )) + &table(
         &[
             "identified mode",

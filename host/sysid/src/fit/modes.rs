@@ -23,17 +23,21 @@
 //! The eigenvector `x` (of `(A − λI) x = 0`, the right singular vector of the smallest
 //! singular value of `A − λI`) has components in the states' own units: m/s, rad/s, rad.
 //! They are made comparable by expressing each as the attitude [rad] it amounts to in this
-//! mode, `|λ|` being the mode's rate of change:
+//! mode, `ω_s = max(|λ|, 0.1 rad/s)` being the mode's rate of change:
 //!
 //! ```text
 //! angle (φ, θ, ψ, flapping b1c, b1s)   a = |x_i|                 [rad]
-//! rate  (p, q, r)                       a = |x_i| / |λ|           (θ̇ = q  ⇒  |θ| = |q|/|λ|)
-//! speed (u, v, w)                       a = |x_i| · |λ| / g       (u̇ = −g θ  ⇒  |θ| = |u|·|λ|/g)
+//! rate  (p, q, r)                       a = |x_i| / ω_s           (θ̇ = q  ⇒  |θ| = |q|/|λ|)
+//! speed (u, v, w)                       a = |x_i| · ω_s / g       (u̇ = −g θ  ⇒  |θ| = |u|·|λ|/g)
 //! ```
 //!
 //! so that a rate and the attitude it integrates to, or a speed and the attitude whose
 //! gravity component drives it, weigh the same (g = 9.80665 m/s²). A state of another
-//! name keeps its own unit. The share of state i is `a_i² / Σ_j a_j²` (the shares sum to
+//! name keeps its own unit. The floor of 0.1 rad/s ([`SCALING_FLOOR_RAD_S`], a 63 s
+//! period) keeps a drift from being named by a trace of attitude: with `|λ|` itself a heave
+//! mode that has lost its damping (`Z_w` = 0, λ = −0.0007 rad/s, eigenvector w 1, θ 0.0018
+//! — seed 2 of the default campaign) would weigh its speed by 7·10⁻⁵ and read as a pitch
+//! mode. The share of state i is `a_i² / Σ_j a_j²` (the shares sum to
 //! 1), and the states fall into groups: lateral body `v p φ`, longitudinal body `u q θ`,
 //! heave `w`, yaw `r ψ`, rotor `b1s` (lateral) and `b1c` (longitudinal) (also
 //! `beta1s`/`beta1c`), other. The rules, first match wins:
@@ -91,6 +95,8 @@ pub const HOVER_MODE_LIMIT_RAD_S: f64 = 3.0;
 pub const HOVER_MODE_TOLERANCE_PERCENT: f64 = 25.0;
 /// Gravity [m/s²] of the speed-to-attitude scaling of the eigenvector.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
+/// The eigenvector's rates and speeds are scaled with `max(|λ|, this)` [rad/s].
+pub const SCALING_FLOOR_RAD_S: f64 = 0.1;
 /// A mode whose flap states take at least this share is a rotor (flap) mode.
 pub const ROTOR_SHARE_LIMIT: f64 = 0.10;
 /// A hover oscillation is lateral (longitudinal) when its lateral (longitudinal) share is
@@ -242,7 +248,7 @@ fn classify(state: &str) -> (Unit, Group) {
     }
 }
 
-/// Shares of a mode per group of states (they sum to 1; all 0 at the origin).
+/// Shares of a mode per group of states (they sum to 1).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GroupShares {
     /// `v p φ`.
@@ -316,8 +322,7 @@ pub struct Mode {
     /// Poles the mode stands for: 1 (real) or 2 (complex pair).
     pub poles: usize,
     /// Shares of the states (in the model's state order), scaled as the module
-    /// documentation says; they sum to 1. At the origin the components are taken in their
-    /// own units (no |λ| to scale with).
+    /// documentation says; they sum to 1.
     pub shares: Vec<f64>,
     /// The same shares by group.
     pub groups: GroupShares,
@@ -395,7 +400,9 @@ pub fn modes(model: &Model) -> Result<Vec<Mode>, ModeError> {
     let mut found = Vec::new();
     for lambda in eigenvalues.iter() {
         // Real when its imaginary part is at rounding level; a pair by its Im > 0 member.
-        let real = lambda.im.abs() <= 1e-12 * scale;
+        // At the origin every eigenvalue is a mode of its own: a double root at 0 may come
+        // out of the Schur form as ±10⁻¹⁰j, and it stands for two lost modes, not one.
+        let real = lambda.im.abs() <= 1e-12 * scale || lambda.norm() < ORIGIN_LIMIT_RAD_S;
         if !real && lambda.im < 0.0 {
             continue;
         }
@@ -456,15 +463,15 @@ fn eigenvector_magnitudes(a: &DMatrix<f64>, lambda: Complex64) -> Result<Vec<f64
 
 /// Shares `a_i² / Σ a_j²` of the attitude-equivalent components (module documentation).
 fn scaled_shares(states: &[String], magnitudes: &[f64], omega: f64) -> Vec<f64> {
-    let at_origin = omega < ORIGIN_LIMIT_RAD_S;
+    let omega = omega.max(SCALING_FLOOR_RAD_S);
     let scaled: Vec<f64> = states
         .iter()
         .zip(magnitudes)
         .map(|(state, magnitude)| {
-            let factor = match (classify(state).0, at_origin) {
-                (_, true) | (Unit::Angle | Unit::Own, false) => 1.0,
-                (Unit::Rate, false) => 1.0 / omega,
-                (Unit::Speed, false) => omega / STANDARD_GRAVITY,
+            let factor = match classify(state).0 {
+                Unit::Angle | Unit::Own => 1.0,
+                Unit::Rate => 1.0 / omega,
+                Unit::Speed => omega / STANDARD_GRAVITY,
             };
             (magnitude * factor).powi(2)
         })
@@ -973,7 +980,7 @@ mod tests {
         assert_eq!(found[0].natural_frequency(), None);
         assert_eq!(found[0].time_to_half_s(), None);
         assert_eq!(found[0].time_to_double_s(), None);
-        // At the origin the shares are the unscaled eigenvector: all w.
+        // The origin's eigenvector: all w.
         assert!(close(found[0].shares[1], 1.0, 1e-12));
         assert_eq!(found[1].name, ModeName::RollSubsidence);
         assert!(close(
@@ -1018,6 +1025,36 @@ mod tests {
         // The other one (−0.2) is φ alone: a roll subsidence.
         let roll = found.iter().find(|m| close(m.eigenvalue.re, -0.2, 1e-12));
         assert_eq!(roll.unwrap().name, ModeName::RollSubsidence);
+    }
+
+    #[test]
+    fn a_heave_mode_without_damping_is_still_heave() {
+        // Z_w = 0 with a trace of pitch attitude in the eigenvector (seed 2 of the default
+        // campaign: λ = −0.0007, θ/w = 0.0018): θ̇ = −2 θ + 0.0036 w, ẇ = −0.0007 w.
+        let states = ["theta", "w"];
+        let f = DMatrix::from_row_slice(2, 2, &[-2.0, 0.0036, 0.0, -0.0007]);
+        let found = modes(&model_of(&states, f)).unwrap();
+        let slow = &found[0];
+        assert!(close(slow.eigenvalue.re, -0.0007, 1e-15));
+        // Scaled with |λ| itself, w would weigh 0.0007/g = 7·10⁻⁵ against θ's 0.0018.
+        assert_eq!(slow.name, ModeName::Heave, "{:?}", slow.shares);
+        assert!(slow.shares[1] > 0.9, "{:?}", slow.shares);
+        assert_eq!(found[1].name, ModeName::PitchSubsidence);
+    }
+
+    #[test]
+    fn a_double_root_at_the_origin_is_two_modes() {
+        // ẇ = r, ṙ = −10⁻²⁰ w: eigenvalues ±10⁻¹⁰j, a conjugate pair at the origin (as a
+        // double root at 0 may come out of the Schur form; seed 7 of the default campaign,
+        // with heave and yaw damping both lost). It is two lost modes, each paired with a
+        // truth mode of its own.
+        let states = ["w", "r", "p"];
+        let f = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, -1e-20, 0.0, 0.0, 0.0, 0.0, -3.0]);
+        let records = mode_records(&model_of(&states, f)).unwrap();
+        let origins: Vec<&ModeRecord> = records.iter().filter(|r| r.name == "origin").collect();
+        assert_eq!(origins.len(), 2, "{records:?}");
+        assert!(origins.iter().all(|r| r.poles == 1), "{records:?}");
+        assert_eq!(poles_at_origin(&records), 2);
     }
 
     #[test]
