@@ -13,6 +13,10 @@ use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use anyhow::{bail, Context};
 use clap::Args;
 use sysid::document::FrfDocument;
+use sysid::fit::modes::{
+    eigenvalue_text, hover_summary, mode_records, mode_table, origin_text, poles_at_origin,
+    ModeComparison, ModeError, ModeRecord, HOVER_MODE_LIMIT_RAD_S,
+};
 use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
@@ -190,14 +194,25 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         let _ = writeln!(report);
     }
 
-    let truth = match args.truth {
-        Some(vehicle) => Some(crate::truth::score_fit(
+    let scored = match args.truth {
+        Some(vehicle) => Some(crate::truth::score_fit_with_modes(
             &result,
             &crate::truth::VehicleTruth::at_hover(vehicle)?,
         )?),
         None => None,
     };
+    // The modes, paired with the truth's when scored; an error (a model without
+    // eigenvalues) is printed, not fatal.
+    let modes = match &scored {
+        Some(scored) => scored
+            .modes
+            .clone()
+            .map(|compared| ModesReport::Compared(Box::new(compared))),
+        None => mode_records(&result.model).map(ModesReport::Alone),
+    };
+    let truth = scored.map(|scored| scored.section);
     write_report(&mut report, &result, truth.as_ref()).expect("writing to a String cannot fail");
+    write_modes(&mut report, &modes).expect("writing to a String cannot fail");
     if !result.average_cost.is_finite() {
         bail!(
             "the fit's cost is not finite (J_ave {}): the responses in {} are not a plausible \
@@ -210,6 +225,11 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         let document = ScoredModelDocument {
             model: result.to_document(),
             truth,
+            modes: match modes {
+                Ok(ModesReport::Compared(compared)) => compared.identified,
+                Ok(ModesReport::Alone(records)) => records,
+                Err(_) => Vec::new(),
+            },
         };
         write_json(path, &document)?;
         let _ = writeln!(report, "\nwrote {}", path.display());
@@ -226,6 +246,47 @@ fn emit(report: &str) -> anyhow::Result<()> {
     {
         Err(error) if error.kind() != io::ErrorKind::BrokenPipe => Err(error.into()),
         _ => Ok(()),
+    }
+}
+
+/// The modes of the fitted model, alone or against the truth's.
+enum ModesReport {
+    /// Without a truth.
+    Alone(Vec<ModeRecord>),
+    /// Paired with the truth model's modes (`--truth`).
+    Compared(Box<ModeComparison>),
+}
+
+/// The modes table, and against a truth its hover-mode line and the truth modes no
+/// identified mode was paired with.
+fn write_modes(out: &mut String, modes: &Result<ModesReport, ModeError>) -> std::fmt::Result {
+    writeln!(
+        out,
+        "\nmodes (eigenvalues of M⁻¹F, named from their eigenvectors; hover: \
+|λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s):"
+    )?;
+    match modes {
+        Err(error) => writeln!(out, "  not computed: {error}"),
+        Ok(ModesReport::Alone(records)) => {
+            write!(out, "{}", mode_table(records))?;
+            writeln!(out, "{}", origin_text(poles_at_origin(records)))
+        }
+        Ok(ModesReport::Compared(compared)) => {
+            write!(out, "{}", mode_table(&compared.identified))?;
+            for unpaired in compared.truth.iter().filter(|t| t.identified.is_none()) {
+                writeln!(
+                    out,
+                    "truth mode {} {} has no identified counterpart",
+                    unpaired.name,
+                    eigenvalue_text(unpaired.eigenvalue)
+                )?;
+            }
+            writeln!(
+                out,
+                "{}",
+                hover_summary(&compared.hover, compared.poles_at_origin)
+            )
+        }
     }
 }
 

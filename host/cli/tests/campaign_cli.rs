@@ -120,6 +120,44 @@ fn check_summary(dir: &Path) -> Value {
         "no truth values"
     );
 
+    // The identified modes, each paired with a truth mode (the same structure: as many
+    // modes on both sides unless a pair split), and the hover-mode score.
+    let modes = fit["modes"].as_array().expect("fit.modes");
+    assert!(!modes.is_empty());
+    for mode in modes {
+        string(&mode["name"], "mode name");
+        let eigenvalue = mode["eigenvalue"].as_array().expect("eigenvalue");
+        assert_eq!(eigenvalue.len(), 2);
+        assert!(number(&eigenvalue[1], "Im λ") >= 0.0);
+        for key in [
+            "omega_n",
+            "zeta",
+            "time_to_double_s",
+            "time_to_half_s",
+            "error_percent",
+        ] {
+            assert!(mode.get(key).is_some(), "mode {key} missing");
+            optional_number(&mode[key], key);
+        }
+        assert!(mode["truth"].is_null() || mode["truth"].as_array().map(Vec::len) == Some(2));
+    }
+    assert!(
+        modes.iter().any(|m| m["truth"].is_array()),
+        "no mode paired"
+    );
+    let truth_modes = fit["truth_modes"].as_array().expect("fit.truth_modes");
+    let hover = &fit["hover_modes_matched"];
+    // The Bo-105 truth at hover: two oscillations, heave and yaw below 3 rad/s.
+    assert_eq!(hover["of"].as_u64(), Some(4), "{hover}");
+    assert_eq!(truth_modes.iter().filter(|t| t["hover"] == true).count(), 4);
+    assert!(hover["matched"].as_u64().unwrap() <= 4);
+    optional_number(&hover["worst_error_percent"], "worst_error_percent");
+    assert!(
+        fit["poles_at_origin"].is_u64(),
+        "{}",
+        fit["poles_at_origin"]
+    );
+
     let tic = &summary["verify"]["tic"];
     for output in ["p", "q", "r"] {
         let value = number(&tic[output], output);
@@ -186,7 +224,16 @@ fn quick_campaign_report_and_errors() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
+    assert!(
+        String::from_utf8_lossy(&output.stdout).contains("modes (eigenvalues of M⁻¹F"),
+        "fit prints the modes table"
+    );
     let model: Value = serde_json::from_str(&std::fs::read_to_string(&refit).unwrap()).unwrap();
+    assert!(!model["modes"].as_array().expect("modes").is_empty());
+    let model9: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("model9.json")).unwrap()).unwrap();
+    assert_eq!(model9["modes"], summary["fit"]["modes"]);
+    assert!(model9["truth"]["modes"].is_array());
     let value = |name: &str| {
         let parameters = model["parameters"].as_array().expect("parameters");
         let parameter = parameters.iter().find(|p| p["name"] == name).expect(name);
@@ -214,6 +261,11 @@ fn quick_campaign_report_and_errors() {
             .unwrap_or_else(|| panic!("no section {id}"));
         assert!(svgs >= 1, "section {id} has no <svg>");
     }
+    assert!(
+        sections.iter().any(|(s, _)| s == "modes"),
+        "no modes section"
+    );
+    assert!(html.contains("no pole at the origin"), "no hover-mode bar");
     let bode = sections.iter().find(|(s, _)| s == "bode").unwrap().1;
     assert_eq!(bode, summary["fit"]["pairs"].as_array().unwrap().len());
 

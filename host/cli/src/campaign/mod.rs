@@ -19,6 +19,7 @@ use anyhow::anyhow;
 use clap::Args;
 use sweephold_protocol::Axis;
 use sysid::document::FrfDocument;
+use sysid::fit::modes::{hover_summary, mode_records, poles_at_origin, HOVER_MODE_LIMIT_RAD_S};
 use sysid::fit::report::ScoredModelDocument;
 use sysid::fit::{
     fit, fit_from_alternative_starts, start_from_quasi_steady, FitOptions, FitResult,
@@ -166,6 +167,14 @@ fn headline(summary: &CampaignSummary) -> String {
                 .map_or("-".to_string(), |c| format!("{c:.1}"))
         );
     }
+    if let Some(fit) = &summary.fit {
+        if let (Some(hover), Some(poles)) = (&fit.hover_modes_matched, fit.poles_at_origin) {
+            text += &format!(
+                "modes     {} (hover: |λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s)\n",
+                hover_summary(hover, poles)
+            );
+        }
+    }
     if let Some(verify) = &summary.verify {
         let tic: Vec<String> = ["p", "q", "r"]
             .iter()
@@ -276,6 +285,7 @@ fn fly_in_process(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
 
 /// The `fit` section of the summary from the final fit (truth filled in later).
 fn fit_summary(result: &FitResult, start_cost_ave: f64) -> FitSummary {
+    let identified_modes = mode_records(&result.model);
     FitSummary {
         structure: result.structure.name.clone(),
         cost_ave: result.average_cost,
@@ -311,6 +321,12 @@ fn fit_summary(result: &FitResult, start_cost_ave: f64) -> FitSummary {
             })
             .collect(),
         model_file: files::MODEL_9DOF.to_string(),
+        // Without the truth yet; the truth stage pairs them. An error (a model without
+        // eigenvalues) leaves them empty here and is reported by the truth stage.
+        modes: identified_modes.clone().unwrap_or_default(),
+        truth_modes: Vec::new(),
+        hover_modes_matched: None,
+        poles_at_origin: identified_modes.as_deref().ok().map(poles_at_origin),
     }
 }
 
@@ -483,14 +499,36 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
     run.stage(Stage::Truth, |run| {
         let vehicle = run.args.vehicle.sim();
         let truth = crate::truth::VehicleTruth::at_hover(vehicle)?;
-        let section = crate::truth::score_fit(&nine, &truth)?;
-        let mapped = crate::truth::structure_truth(&nine.structure, &truth)?;
+        let scored = crate::truth::score_fit_with_modes(&nine, &truth)?;
+        let (section, mapped) = (scored.section, scored.mapped);
         write_json(
             &run.dir().join(files::TRUTH_MODEL_9DOF),
             &TruthModelDocument::new(vehicle.name(), &nine.structure.name, &mapped.model),
         )?;
-        let line = format!("J_ave against the truth {:.1}", section.average_cost);
+        let modes_line = match &scored.modes {
+            Ok(compared) => hover_summary(&compared.hover, compared.poles_at_origin),
+            // Reported, not fatal: the model and its scoring are still worth the report.
+            Err(error) => format!("modes not computed: {error}"),
+        };
+        let line = format!(
+            "J_ave against the truth {:.1}; {modes_line}",
+            section.average_cost
+        );
         if let Some(fit) = run.summary.fit.as_mut() {
+            match &scored.modes {
+                Ok(compared) => {
+                    fit.modes = compared.identified.clone();
+                    fit.truth_modes = compared.truth.clone();
+                    fit.hover_modes_matched = Some(compared.hover);
+                    fit.poles_at_origin = Some(compared.poles_at_origin);
+                }
+                Err(_) => {
+                    fit.modes.clear();
+                    fit.truth_modes.clear();
+                    fit.hover_modes_matched = None;
+                    fit.poles_at_origin = None;
+                }
+            }
             fit.truth_cost_ave = Some(section.average_cost);
             for pair in &mut fit.pairs {
                 pair.truth_cost = section
@@ -509,6 +547,10 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
         let document = ScoredModelDocument {
             model: nine.to_document(),
             truth: Some(section),
+            modes: scored
+                .modes
+                .map(|compared| compared.identified)
+                .unwrap_or_default(),
         };
         write_json(&run.dir().join(files::MODEL_9DOF), &document)?;
         Ok(((), line))

@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
+use sysid::fit::modes::{HoverModeScore, ModeRecord, TruthModeRecord};
 
 use crate::fly::summary::FlySummary;
 
@@ -121,6 +122,23 @@ pub struct FitSummary {
     pub params: Vec<ParameterSummary>,
     /// Model file, relative to the campaign folder.
     pub model_file: String,
+    /// The identified model's modes (`sysid::fit::modes`), sorted by |λ|, each with its
+    /// truth mode and error once the truth stage has run. Empty in older files.
+    #[serde(default)]
+    pub modes: Vec<ModeRecord>,
+    /// The truth model's modes (the structure at the truth values), each with the
+    /// identified mode paired with it. Empty until the truth stage, and in older files.
+    #[serde(default)]
+    pub truth_modes: Vec<TruthModeRecord>,
+    /// Truth hover modes (10⁻⁶ ≤ |λ| < 3 rad/s) with an identified counterpart within
+    /// 25 %, of how many, and the worst error; null until the truth stage (or when the
+    /// modes could not be computed), and in older files.
+    #[serde(default)]
+    pub hover_modes_matched: Option<HoverModeScore>,
+    /// Poles of the identified model at the origin (|λ| < 10⁻⁶ rad/s; a pair counts 2);
+    /// null when its modes could not be computed, and in older files.
+    #[serde(default)]
+    pub poles_at_origin: Option<usize>,
 }
 
 /// Verification of one held-out record.

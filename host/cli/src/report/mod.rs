@@ -64,6 +64,7 @@ with the simulator's truth.",
     body += &sections::coherence_section(inputs);
     body += &sections::bode_section(inputs);
     body += &sections::parameter_section(inputs);
+    body += &sections::modes_section(inputs);
     body += &sections::cost_section(inputs);
     body += &sections::verification_section(inputs);
     html::page(&title, &body)

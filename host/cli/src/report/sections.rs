@@ -1,11 +1,16 @@
 //! The report's sections, top to bottom as a flight-test engineer reads them: campaign
 //! summary against the bars of the issues, the sweep input (paper Fig. 1/6), cross-control
 //! coherence (Fig. 3/7), Bode plots data vs model vs truth (Fig. 10), the parameter table
-//! (Table 3), the cost table, and the verification time histories.
+//! (Table 3), the modes of the identified model beside the truth's, the cost table, and
+//! the verification time histories.
 
 use std::path::Path;
 
 use sysid::document::PairResponse;
+use sysid::fit::modes::{
+    eigenvalue_text, hover_summary, origin_text, ModeName, HOVER_MODE_LIMIT_RAD_S,
+    HOVER_MODE_TOLERANCE_PERCENT, ORIGIN_LIMIT_RAD_S,
+};
 use sysid::fit::Model;
 
 use super::html::{figure, note, section, table, Cell, Mark};
@@ -198,6 +203,9 @@ fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
             ));
         }
     }
+    if let Some(row) = hover_mode_bar(fit) {
+        rows.push(row);
+    }
     let rate_pairs: Vec<_> = fit
         .pairs
         .iter()
@@ -225,6 +233,140 @@ fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
         ));
     }
     rows
+}
+
+/// The hover-mode bar: every truth hover mode (|λ| < 3 rad/s) matched by an identified
+/// mode within 25 %, and no pole of the identified model at the origin. Red, not absent,
+/// when the truth was scored but the modes are missing; absent before the truth stage.
+fn hover_mode_bar(fit: &FitSummary) -> Option<Vec<Cell>> {
+    let what = format!(
+        "hover modes (truth |λ| < {HOVER_MODE_LIMIT_RAD_S} rad/s) within \
+{HOVER_MODE_TOLERANCE_PERCENT:.0} % of the truth, poles at the origin"
+    );
+    let bar = "every hover mode within 25 %, no pole at the origin";
+    match (fit.hover_modes_matched, fit.poles_at_origin) {
+        (Some(hover), Some(poles)) => Some(bar_row(
+            &what,
+            format!(
+                "{}/{}{}, {}",
+                hover.matched,
+                hover.of,
+                hover
+                    .worst_error_percent
+                    .map_or(String::new(), |w| format!(" (worst {w:.0} %)")),
+                origin_text(poles)
+            ),
+            bar,
+            Some(hover.all_matched() && poles == 0),
+        )),
+        _ if fit.truth_cost_ave.is_some() => {
+            Some(bar_row(&what, "not computed".to_string(), bar, Some(false)))
+        }
+        _ => None,
+    }
+}
+
+/// The identified model's modes beside the truth's: one row per identified mode with the
+/// truth mode paired with it, then the truth modes left without a counterpart.
+pub fn modes_section(inputs: &ReportInputs) -> String {
+    let title = "Modes: identified vs truth";
+    let Some(fit) = &inputs.summary.fit else {
+        return section("modes", title, &note("No fit in this campaign."));
+    };
+    if fit.modes.is_empty() {
+        return section(
+            "modes",
+            title,
+            &note(
+                "The modes of this fit were not computed (a summary written before they \
+were, or a model without eigenvalues).",
+            ),
+        );
+    }
+    let time = |double: Option<f64>, half: Option<f64>| match (double, half) {
+        (Some(t), _) => format!("double {t:.2}"),
+        (None, Some(t)) => format!("half {t:.2}"),
+        (None, None) => "-".to_string(),
+    };
+    let is_hover = |eigenvalue: [f64; 2]| {
+        let magnitude = eigenvalue[0].hypot(eigenvalue[1]);
+        (ORIGIN_LIMIT_RAD_S..HOVER_MODE_LIMIT_RAD_S).contains(&magnitude)
+    };
+    let mut rows: Vec<Vec<Cell>> = fit
+        .modes
+        .iter()
+        .map(|mode| {
+            let origin = mode.name == ModeName::Origin.as_str();
+            let error = match (mode.error_percent, mode.truth) {
+                (Some(e), Some(truth)) if is_hover(truth) => {
+                    Cell::judged(format!("{e:.1}"), e <= HOVER_MODE_TOLERANCE_PERCENT)
+                }
+                (e, _) => Cell::plain(fmt(e, 1)),
+            };
+            vec![
+                if origin {
+                    Cell::judged(mode.name.clone(), false)
+                } else {
+                    Cell::name(mode.name.clone())
+                },
+                Cell::plain(eigenvalue_text(mode.eigenvalue)),
+                Cell::plain(fmt(mode.omega_n, 3)),
+                Cell::plain(fmt(mode.zeta, 3)),
+                Cell::plain(time(mode.time_to_double_s, mode.time_to_half_s)),
+                Cell::plain(mode.shape()),
+                Cell::plain(mode.truth_name.clone().unwrap_or_else(|| "-".into())),
+                Cell::plain(mode.truth.map_or("-".to_string(), eigenvalue_text)),
+                error,
+            ]
+        })
+        .collect();
+    for truth in fit.truth_modes.iter().filter(|t| t.identified.is_none()) {
+        rows.push(vec![
+            // A truth hover mode the identified model lacks is a miss.
+            if truth.hover {
+                Cell::judged("(none)", false)
+            } else {
+                Cell::name("(none)")
+            },
+            Cell::plain("-"),
+            Cell::plain("-"),
+            Cell::plain("-"),
+            Cell::plain("-"),
+            Cell::plain(""),
+            Cell::plain(truth.name.clone()),
+            Cell::plain(eigenvalue_text(truth.eigenvalue)),
+            Cell::plain("-"),
+        ]);
+    }
+    let verdict = match (fit.hover_modes_matched, fit.poles_at_origin) {
+        (Some(hover), Some(poles)) => format!(" Here: {}.", hover_summary(&hover, poles)),
+        _ => String::new(),
+    };
+    let content = note(&format!(
+        "Eigenvalues λ of A = M⁻¹F of the identified model, one row per real pole or \
+complex pair (its Im > 0 member), sorted by |λ|; ω_n = |λ|, ζ = −Re λ/|λ|, time to double \
+(ln 2/Re λ) or to half (ln 2/−Re λ) the amplitude (of the envelope for a pair). Each mode is \
+named from its eigenvector (shape: the largest shares, rates divided by ω_s = max(|λ|, 0.1 \
+rad/s) and speeds multiplied by ω_s/g so that each reads as the attitude it amounts to; rules \
+in sysid::fit::modes) and paired with a mode of the truth model (the same structure at the \
+simulator's truth values): same name first, then the nearest eigenvalue. Error = \
+100·|λ − λ_truth|/|λ_truth|, green/red against 25 % for the truth's hover modes (|λ| < 3 \
+rad/s); a pole at the origin (|λ| < 1e−6 rad/s) is red.{verdict}"
+    )) + &table(
+        &[
+            "identified mode",
+            "λ [rad/s]",
+            "ω_n [rad/s]",
+            "ζ",
+            "t2 / t½ [s]",
+            "shape",
+            "truth mode",
+            "truth λ [rad/s]",
+            "error %",
+        ],
+        &rows,
+    );
+    section("modes", title, &content)
 }
 
 /// The lateral `cah` sweep: the stick inputs and the attitudes (paper Fig. 1/6).
@@ -819,6 +961,7 @@ not used in the fit){}; a constant bias per output is removed. TIC = rms(y − b
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sysid::fit::modes::{HoverModeScore, ModeRecord, TruthModeRecord};
 
     #[test]
     fn unwrap_removes_turns() {
@@ -864,6 +1007,140 @@ mod tests {
             ..pair
         };
         assert!(model_response(&model, &other, None).is_none());
+    }
+
+    /// A report's inputs holding only a summary with `fit`.
+    fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
+        use crate::campaign::summary::{CampaignSummary, Modes};
+        ReportInputs {
+            dir: std::path::PathBuf::from("campaign"),
+            summary: CampaignSummary {
+                vehicle: "bo105".into(),
+                seed: 1,
+                verification_seed: 2,
+                t_rec_s: 90.0,
+                quick: false,
+                modes: Modes::default(),
+                fit: Some(fit),
+                verify: None,
+                timings_s: Default::default(),
+                error: None,
+            },
+            frf: None,
+            model: None,
+            truth_model: None,
+            verify: None,
+            sweep: None,
+            coherence: Vec::new(),
+        }
+    }
+
+    fn mode(name: &str, eigenvalue: [f64; 2], truth: Option<([f64; 2], f64)>) -> ModeRecord {
+        ModeRecord {
+            name: name.into(),
+            eigenvalue,
+            omega_n: Some(eigenvalue[0].hypot(eigenvalue[1])),
+            zeta: None,
+            time_to_double_s: None,
+            time_to_half_s: Some(1.0),
+            poles: if eigenvalue[1] == 0.0 { 1 } else { 2 },
+            shares: Default::default(),
+            truth: truth.map(|t| t.0),
+            truth_name: truth.map(|_| name.to_string()),
+            error_percent: truth.map(|t| t.1),
+        }
+    }
+
+    fn fit_with_modes(
+        modes: Vec<ModeRecord>,
+        truth_modes: Vec<TruthModeRecord>,
+        hover: HoverModeScore,
+        poles: usize,
+    ) -> FitSummary {
+        FitSummary {
+            structure: "bo105-9dof-hybrid".into(),
+            cost_ave: 16.0,
+            truth_cost_ave: Some(10.0),
+            start_cost_ave: 17.0,
+            pairs: Vec::new(),
+            params: Vec::new(),
+            model_file: "model9.json".into(),
+            modes,
+            truth_modes,
+            hover_modes_matched: Some(hover),
+            poles_at_origin: Some(poles),
+        }
+    }
+
+    #[test]
+    fn a_model_without_its_hover_modes_reads_red() {
+        // Heave lost to the origin, the lateral oscillation 40 % off, yaw missing.
+        let modes = vec![
+            mode("origin", [0.0, 0.0], Some(([-0.32, 0.0], 100.0))),
+            mode(
+                "hover oscillation (coupled)",
+                [0.2, 0.6],
+                Some(([0.31, 0.6], 40.0)),
+            ),
+            mode("roll–flap", [-7.0, 12.0], Some(([-7.2, 12.5], 3.0))),
+        ];
+        let unpaired_yaw = TruthModeRecord {
+            name: "yaw".into(),
+            eigenvalue: [-0.36, 0.0],
+            omega_n: Some(0.36),
+            zeta: None,
+            hover: true,
+            identified: None,
+            identified_name: None,
+            error_percent: None,
+        };
+        let hover = HoverModeScore {
+            matched: 0,
+            of: 3,
+            worst_error_percent: Some(100.0),
+        };
+        let fit = fit_with_modes(modes, vec![unpaired_yaw], hover, 1);
+        let bar = hover_mode_bar(&fit).unwrap();
+        assert_eq!(bar[1].mark, Mark::Bad);
+        assert_eq!(bar[1].text, "0/3 (worst 100 %), 1 pole at the origin");
+        let html = modes_section(&inputs_with_fit(fit.clone()));
+        assert!(html.contains(r#"<td class="bad">origin</td>"#), "{html}");
+        assert!(html.contains(r#"<td class="bad">40.0</td>"#), "{html}");
+        // The rotor mode is no hover mode: its error is not judged.
+        assert!(html.contains("<td>3.0</td>"), "{html}");
+        assert!(
+            html.contains(r#"<td class="bad">(none)</td><td>-</td>"#),
+            "{html}"
+        );
+        assert!(html.contains("Here: hover modes 0/3 within 25 %"), "{html}");
+
+        // Every hover mode within 25 % and no origin: green.
+        let passing = fit_with_modes(
+            vec![mode("heave", [-0.3, 0.0], Some(([-0.32, 0.0], 6.3)))],
+            Vec::new(),
+            HoverModeScore {
+                matched: 1,
+                of: 1,
+                worst_error_percent: Some(6.3),
+            },
+            0,
+        );
+        assert_eq!(hover_mode_bar(&passing).unwrap()[1].mark, Mark::Good);
+        // Scored against the truth but without modes: red, not a pass.
+        let missing = FitSummary {
+            hover_modes_matched: None,
+            poles_at_origin: None,
+            modes: Vec::new(),
+            ..passing.clone()
+        };
+        assert_eq!(hover_mode_bar(&missing).unwrap()[1].mark, Mark::Bad);
+        assert!(modes_section(&inputs_with_fit(missing.clone())).contains("not computed"));
+        // Before the truth stage: no bar.
+        let unscored = FitSummary {
+            truth_cost_ave: None,
+            ..missing
+        };
+        assert!(hover_mode_bar(&unscored).is_none());
     }
 
     #[test]

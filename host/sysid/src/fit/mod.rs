@@ -13,6 +13,7 @@ pub mod cost;
 pub mod error;
 pub mod expression;
 pub mod model;
+pub mod modes;
 pub mod optimizer;
 pub mod reduce;
 pub mod report;

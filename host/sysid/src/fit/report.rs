@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use super::model::{Model, RowMajor};
+use super::modes::{ModeRecord, TruthModeRecord};
 use super::reduce::ReductionStep;
 use super::{AccuracyFlag, FitResult, PairFit, ParameterReport, ParameterStatus, StartOutcome};
 
@@ -122,10 +123,11 @@ pub struct ModelDocument {
     pub skipped_pairs: Vec<super::SkippedPair>,
 }
 
-/// `model.json` with its optional `truth` section: the [`ModelDocument`] keys at the top
-/// level plus `"truth"` when the fit was scored against a simulator
-/// (`sweephold fit --truth`). A [`ModelDocument`] reads such a file too (it ignores the
-/// extra key); the section is kept apart so that existing code building a
+/// `model.json` with its optional `truth` section and the model's `modes`: the
+/// [`ModelDocument`] keys at the top level plus `"truth"` when the fit was scored against
+/// a simulator (`sweephold fit --truth`) and `"modes"` (absent from files written before
+/// it existed: read as empty). A [`ModelDocument`] reads such a file too (it ignores the
+/// extra keys); the sections are kept apart so that existing code building a
 /// `ModelDocument` is unaffected.
 ///
 /// Deserialization goes through a `serde_json::Value` rather than `#[serde(flatten)]`:
@@ -140,6 +142,10 @@ pub struct ScoredModelDocument {
     /// Scoring against a simulator's truth; absent without `--truth`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth: Option<TruthSection>,
+    /// The modes of the model (eigenvalues of M⁻¹F, named: [`super::modes`]), each with
+    /// its truth mode and error when scored against a truth.
+    #[serde(default)]
+    pub modes: Vec<ModeRecord>,
 }
 
 impl<'de> Deserialize<'de> for ScoredModelDocument {
@@ -150,8 +156,16 @@ impl<'de> Deserialize<'de> for ScoredModelDocument {
             None | Some(serde_json::Value::Null) => None,
             Some(section) => Some(serde_json::from_value(section).map_err(D::Error::custom)?),
         };
+        let modes = match value.as_object_mut().and_then(|map| map.remove("modes")) {
+            None | Some(serde_json::Value::Null) => Vec::new(),
+            Some(list) => serde_json::from_value(list).map_err(D::Error::custom)?,
+        };
         let model = serde_json::from_value(value).map_err(D::Error::custom)?;
-        Ok(ScoredModelDocument { model, truth })
+        Ok(ScoredModelDocument {
+            model,
+            truth,
+            modes,
+        })
     }
 }
 
@@ -182,6 +196,10 @@ pub struct TruthSection {
     /// Structure parameters the truth mapping does not know (held at 0 in the truth model).
     #[serde(default)]
     pub unmapped: Vec<String>,
+    /// The truth model's modes, each with the identified mode paired with it
+    /// ([`super::modes::compare_modes`]); empty in files written before it existed.
+    #[serde(default)]
+    pub modes: Vec<TruthModeRecord>,
 }
 
 impl TruthSection {
@@ -442,11 +460,24 @@ mod tests {
             pairs: Vec::new(),
             average_cost: 0.5,
             unmapped: Vec::new(),
+            modes: vec![TruthModeRecord {
+                name: "heave".into(),
+                eigenvalue: [-0.5, 0.0],
+                omega_n: Some(0.5),
+                zeta: None,
+                hover: true,
+                identified: Some([-0.25, 0.0]),
+                identified_name: Some("heave".into()),
+                error_percent: Some(50.0),
+            }],
         };
+        let modes = crate::fit::modes::mode_records(&result.model).unwrap();
+        assert_eq!(modes.len(), 1);
         for truth in [Some(truth), None] {
             let document = ScoredModelDocument {
                 model: model.clone(),
                 truth,
+                modes: modes.clone(),
             };
             let json = serde_json::to_string_pretty(&document).unwrap();
             assert!(json.contains(r#""flag": "correlated""#), "{json}");
@@ -466,8 +497,20 @@ mod tests {
             let back: ScoredModelDocument = serde_json::from_str(&json).unwrap();
             assert!(close(&back.model, &model));
             assert_eq!(back.truth, document.truth);
+            assert_eq!(back.modes.len(), 1);
+            assert_eq!(back.modes[0].name, modes[0].name);
             let plain: ModelDocument = serde_json::from_str(&json).unwrap();
             assert!(close(&plain, &model));
+            // A file written before `modes` and the truth's modes existed still reads.
+            let mut older: serde_json::Value = serde_json::from_str(&json).unwrap();
+            let map = older.as_object_mut().unwrap();
+            map.remove("modes");
+            if let Some(section) = map.get_mut("truth") {
+                section.as_object_mut().unwrap().remove("modes");
+            }
+            let back: ScoredModelDocument = serde_json::from_value(older).unwrap();
+            assert!(back.modes.is_empty());
+            assert!(back.truth.is_none_or(|t| t.modes.is_empty()));
         }
         let unknown = r#"{"flag": "bogus"}"#;
         assert!(serde_json::from_str::<AccuracyFlag>(unknown).is_err());
