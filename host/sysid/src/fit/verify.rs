@@ -786,6 +786,7 @@ mod tests {
             outputs,
             references: Vec::new(),
             notes: Vec::new(),
+            trim_samples: 0,
         }
     }
 
