@@ -10,7 +10,9 @@ use std::path::PathBuf;
 use crate::output::{check_input_file, check_output_folder, write_files_into};
 use anyhow::{anyhow, Context};
 use clap::Args;
-use sysid::fit::verify::{render_verification_plots, verify_record_in_segments, Verification};
+use sysid::fit::verify::{
+    render_verification_plots, verify_record_in_segments, BiasMode, Verification,
+};
 use sysid::fit::ModelDocument;
 use sysid::frf::load_test_dump;
 
@@ -79,15 +81,17 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
     for dump in &args.dumps {
         let record = load_test_dump(dump).map_err(|e| anyhow!("{e}"))?;
         let verification =
-            verify_record_in_segments(&model, &record, args.segment).map_err(|e| {
-                // Record errors name the dump already; model errors get it in front.
-                let message = e.to_string();
-                if message.contains(&record.source) {
-                    anyhow!(message)
-                } else {
-                    anyhow!("{}: {message}", dump.display())
-                }
-            })?;
+            verify_record_in_segments(&model, &record, args.segment, BiasMode::Fitted).map_err(
+                |e| {
+                    // Record errors name the dump already; model errors get it in front.
+                    let message = e.to_string();
+                    if message.contains(&record.source) {
+                        anyhow!(message)
+                    } else {
+                        anyhow!("{}: {message}", dump.display())
+                    }
+                },
+            )?;
         write_verification(&mut report, &verification);
         all_theil.extend(verification.outputs.iter().map(|o| o.theil));
         if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {

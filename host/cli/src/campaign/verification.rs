@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::anyhow;
 use serde::{Deserialize, Serialize};
-use sysid::fit::verify::{verify_record_in_segments, Verification};
+use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification};
 use sysid::fit::Model;
 use sysid::frf::load_test_dump;
 
@@ -108,8 +108,8 @@ pub fn verify_dump(
     segment_s: Option<f64>,
 ) -> anyhow::Result<VerifiedRecord> {
     let record = load_test_dump(dir.join(file)).map_err(|e| anyhow!("{e}"))?;
-    let verification =
-        verify_record_in_segments(model, &record, segment_s).map_err(|e| anyhow!("{e}"))?;
+    let verification = verify_record_in_segments(model, &record, segment_s, BiasMode::Fitted)
+        .map_err(|e| anyhow!("{e}"))?;
     Ok(verified_record(file, &verification))
 }
 
