@@ -10,17 +10,22 @@ use std::path::PathBuf;
 use crate::output::{check_input_file, check_output_folder, write_files_into};
 use anyhow::{anyhow, Context};
 use clap::Args;
-use sysid::fit::verify::{render_verification_plots, verify_record_in_segments, Verification};
+use sysid::fit::verify::{
+    render_verification_plots, verify_record_in_segments, BiasMode, Verification, VerifyError,
+};
 use sysid::fit::ModelDocument;
 use sysid::frf::load_test_dump;
 
 /// Arguments of `sweephold verify`.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Inputs are the applied commands lat lon ped col, taken as perturbations \
-from their first sample; a constant bias per output is fitted by least squares. \
-TIC = rms(y - b - ŷ) / (rms(y - b) + rms(ŷ)): 0 perfect, 1 worst; <= 0.25-0.3 is the usual \
-acceptance guideline."
+    after_help = "Inputs are the applied commands lat lon ped col, outputs every model output \
+the dump records, both as perturbations from trim. With --bias trim (the default) the trim \
+of each input and the bias b of each output is its mean over the dump's trim-capture samples \
+before the excitation; a dump without them is refused. With --bias fitted b is fitted by \
+least squares, b = mean(y - ŷ), and the inputs are taken from their first sample (this also \
+removes any constant error of the prediction). TIC = rms(y - b - ŷ) / (rms(y - b) + rms(ŷ)): \
+0 perfect, 1 worst; <= 0.25-0.3 is the usual acceptance guideline."
 )]
 pub struct VerifyArgs {
     /// The identified model (`model.json` as `sweephold fit --out` writes it).
@@ -38,10 +43,54 @@ pub struct VerifyArgs {
     /// record, which an unstable hover model cannot survive.
     #[arg(long, value_name = "SECONDS", value_parser = crate::arg_values::positive_seconds, allow_hyphen_values = true)]
     pub segment: Option<f64>,
+    /// Where each output's bias comes from: its mean over the trim samples before the
+    /// excitation (`trim`), or least squares over the record (`fitted`).
+    #[arg(long, value_enum, default_value_t = BiasArg::Trim)]
+    pub bias: BiasArg,
 }
 
-/// Run `sweephold verify`.
+/// `--bias`: the values of [`BiasMode`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BiasArg {
+    /// Each output's mean over the dump's trim-capture samples before the excitation.
+    Trim,
+    /// Least squares over the record, b = mean(y − ŷ).
+    Fitted,
+}
+
+impl BiasArg {
+    /// The mode `sysid` takes.
+    pub fn mode(self) -> BiasMode {
+        match self {
+            BiasArg::Trim => BiasMode::Trim,
+            BiasArg::Fitted => BiasMode::Fitted,
+        }
+    }
+}
+
+/// The report's line saying where the biases come from.
+fn bias_line(bias: BiasMode) -> &'static str {
+    match bias {
+        BiasMode::Trim => {
+            "bias: trim (each output's and input's mean over the trim samples before the \
+             excitation)"
+        }
+        BiasMode::Fitted => {
+            "bias: fitted (least squares, b = mean(y - ŷ) per output; inputs from their first \
+             sample)"
+        }
+    }
+}
+
+/// Run `sweephold verify`: the report on stdout.
 pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
+    let report = report(args)?;
+    print!("{report}");
+    Ok(())
+}
+
+/// Verify and write the plots; the report's text.
+fn report(args: &VerifyArgs) -> anyhow::Result<String> {
     check_input_file("--model", &args.model)?;
     let text = fs::read_to_string(&args.model)
         .with_context(|| format!("cannot read {}", args.model.display()))?;
@@ -75,14 +124,21 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
             .collect::<Vec<_>>()
             .join(" ")
     );
+    let bias = args.bias.mode();
+    let _ = writeln!(report, "{}", bias_line(bias));
     let mut all_theil = Vec::new();
     for dump in &args.dumps {
         let record = load_test_dump(dump).map_err(|e| anyhow!("{e}"))?;
         let verification =
-            verify_record_in_segments(&model, &record, args.segment).map_err(|e| {
+            verify_record_in_segments(&model, &record, args.segment, bias).map_err(|e| {
                 // Record errors name the dump already; model errors get it in front.
                 let message = e.to_string();
-                if message.contains(&record.source) {
+                if let VerifyError::NoTrim { source } = &e {
+                    anyhow!(
+                        "{source}: no trim samples before the excitation to take the output \
+                         bias from; --bias fitted fits it instead"
+                    )
+                } else if message.contains(&record.source) {
                     anyhow!(message)
                 } else {
                     anyhow!("{}: {message}", dump.display())
@@ -103,8 +159,7 @@ pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
             all_theil.iter().sum::<f64>() / all_theil.len() as f64
         );
     }
-    print!("{report}");
-    Ok(())
+    Ok(report)
 }
 
 /// The table of one record: per output TIC, RMS of error, measurement, prediction, bias.
@@ -117,6 +172,14 @@ fn write_verification(out: &mut String, verification: &Verification) {
         verification.sample_rate_hz,
         verification.samples as f64 / verification.sample_rate_hz
     );
+    if verification.bias == BiasMode::Trim {
+        let _ = writeln!(
+            out,
+            "trim: the first {} samples ({:.2} s), before the excitation",
+            verification.trim_samples,
+            verification.trim_samples as f64 / verification.sample_rate_hz
+        );
+    }
     if let Some(at) = verification.diverged_at_s {
         let _ = writeln!(
             out,
@@ -170,6 +233,7 @@ mod tests {
             dumps,
             plots: None,
             segment: None,
+            bias: BiasArg::Trim,
         }
     }
 
@@ -231,12 +295,24 @@ mod tests {
             );
         }
         fs::write(&dump, bytes).unwrap();
-        run(&args(good.clone(), vec![dump.clone()])).unwrap();
+        // Every Sample of it is in the Sweep phase: no trim to take the bias from.
+        let error = run(&args(good.clone(), vec![dump.clone()])).unwrap_err();
+        let message = format!("{error:#}");
+        assert!(
+            message.contains("lat-1.bin: no trim samples") && message.contains("--bias fitted"),
+            "{message}"
+        );
+        assert!(!message.contains('\n'), "{message}");
+        let fitted = |model: &PathBuf| VerifyArgs {
+            bias: BiasArg::Fitted,
+            ..args(model.clone(), vec![dump.clone()])
+        };
+        run(&fitted(&good)).unwrap();
         let plots = directory.join("plots");
         let with_plots = VerifyArgs {
             plots: Some(plots.clone()),
             segment: Some(2.0),
-            ..args(good.clone(), vec![dump.clone()])
+            ..fitted(&good)
         };
         run(&with_plots).unwrap();
         assert!(plots.join("lat-1-p.svg").is_file());
@@ -265,6 +341,123 @@ mod tests {
         let message = format!("{error:#}");
         assert!(message.contains("garbage.bin"), "{message}");
         assert!(!message.contains('\n'), "{message}");
+        fs::remove_dir_all(&directory).ok();
+    }
+
+    /// A model (a lag from `lat` to `p`, seen in `p` and `q`) and a dump of synthetic
+    /// telemetry whose first 200 Samples (1 s) are trim capture and the next 1200 the
+    /// excitation, in `directory`.
+    fn trimmed_files(directory: &std::path::Path) -> (PathBuf, PathBuf) {
+        use sweephold_protocol::{codec, synthetic, Frame, Phase};
+        fs::create_dir_all(directory).unwrap();
+        let model = directory.join("model.json");
+        let document = serde_json::json!({
+            "version": 1, "structure": "lag", "description": "",
+            "states": ["p"], "controls": ["lat"], "outputs": ["p", "q"],
+            "matrices": {
+                "M": {"rows": 1, "cols": 1, "data": [1.0]},
+                "F": {"rows": 1, "cols": 1, "data": [-2.0]},
+                "G": {"rows": 1, "cols": 1, "data": [3.0]},
+                "H0": {"rows": 2, "cols": 1, "data": [1.0, 0.5]},
+                "H1": {"rows": 2, "cols": 1, "data": [0.0, 0.0]}
+            },
+            "delays": [0.013], "parameters": [], "pairs": [], "average_cost": 0.0,
+            "correlation": null, "starts": [], "minimum_confirmed": true, "reduction": []
+        });
+        fs::write(&model, document.to_string()).unwrap();
+        let dump = directory.join("lat-1.bin");
+        let mut bytes = codec::encode_to_vec(&Frame::Header(synthetic::header()))
+            .unwrap()
+            .to_vec();
+        for tick in 0..1400 {
+            let mut sample = synthetic::sample(tick);
+            if tick < 200 {
+                sample.phase = Phase::TrimCapture;
+            }
+            bytes.extend(
+                codec::encode_to_vec(&Frame::Sample(sample))
+                    .unwrap()
+                    .to_vec(),
+            );
+        }
+        fs::write(&dump, bytes).unwrap();
+        (model, dump)
+    }
+
+    /// `sweephold verify --model DIR/model.json DIR/lat-1.bin` on [`trimmed_files`] as the
+    /// code printed it before `--bias` existed (the fitted bias), `DIR` for the folder.
+    const FITTED_BEFORE: &str = "\
+model lag (DIR/model.json), 1 states, controls lat, delays 0.0130 s
+
+DIR/lat-1.bin: 1400 samples at 200 Hz (7.0 s)
+output        TIC    rms error    rms meas.    rms pred.         bias
+p          0.7191      0.08355      0.07061      0.04556      0.00761
+q          0.7189      0.04168      0.03519      0.02278      0.00145
+mean       0.7190
+";
+
+    /// The same with `--segment 0.5` and the dump given twice.
+    const FITTED_SEGMENTED_BEFORE: &str = "\
+model lag (DIR/model.json), 1 states, controls lat, delays 0.0130 s
+
+DIR/lat-1.bin: 1400 samples at 200 Hz (7.0 s)
+output        TIC    rms error    rms meas.    rms pred.         bias
+p          0.3836      0.05505      0.07939      0.06413      0.04532
+q          0.3440      0.02465      0.03959      0.03207      0.02030
+mean       0.3638
+
+DIR/lat-1.bin: 1400 samples at 200 Hz (7.0 s)
+output        TIC    rms error    rms meas.    rms pred.         bias
+p          0.3836      0.05505      0.07939      0.06413      0.04532
+q          0.3440      0.02465      0.03959      0.03207      0.02030
+mean       0.3638
+
+mean TIC over 2 dumps: 0.3638
+";
+
+    #[test]
+    fn the_fitted_bias_prints_what_verify_printed_before_and_trim_is_the_default() {
+        let directory =
+            std::env::temp_dir().join(format!("sweephold-verify-bias-{}", std::process::id()));
+        let (model, dump) = trimmed_files(&directory);
+        let text = |bias: BiasArg, segment: Option<f64>, copies: usize| {
+            report(&VerifyArgs {
+                bias,
+                segment,
+                ..args(model.clone(), vec![dump.clone(); copies])
+            })
+            .unwrap()
+            .replace(directory.to_str().unwrap(), "DIR")
+        };
+        // The fitted bias: the report of before, with the bias named in its second line.
+        for (segment, copies, before) in [
+            (None, 1, FITTED_BEFORE),
+            (Some(0.5), 2, FITTED_SEGMENTED_BEFORE),
+        ] {
+            let fitted = text(BiasArg::Fitted, segment, copies);
+            let mut lines: Vec<&str> = fitted.lines().collect();
+            assert_eq!(lines.remove(1), bias_line(BiasMode::Fitted));
+            assert_eq!(lines.join("\n") + "\n", before);
+        }
+        // The default: the trim bias, named, with the trim samples it averaged.
+        #[derive(clap::Parser)]
+        struct Command {
+            #[command(flatten)]
+            verify: VerifyArgs,
+        }
+        let parsed = <Command as clap::Parser>::try_parse_from(["verify", "--model", "m", "d"]);
+        assert_eq!(parsed.unwrap().verify.bias, BiasArg::Trim);
+        let parsed = <Command as clap::Parser>::try_parse_from([
+            "verify", "--bias", "fitted", "--model", "m", "d",
+        ]);
+        assert_eq!(parsed.unwrap().verify.bias, BiasArg::Fitted);
+        let trim = text(BiasArg::Trim, None, 1);
+        assert_eq!(trim.lines().nth(1), Some(bias_line(BiasMode::Trim)));
+        assert!(
+            trim.contains("trim: the first 200 samples (1.00 s), before the excitation"),
+            "{trim}"
+        );
+        assert!(!trim.contains("p          0.7191"), "{trim}");
         fs::remove_dir_all(&directory).ok();
     }
 }

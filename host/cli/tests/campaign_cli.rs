@@ -158,10 +158,31 @@ fn check_summary(dir: &Path) -> Value {
         fit["poles_at_origin"]
     );
 
-    let tic = &summary["verify"]["tic"];
-    for output in ["p", "q", "r"] {
+    let verify = &summary["verify"];
+    assert_eq!(string(&verify["bias"], "bias"), "trim");
+    let tic = &verify["tic"];
+    // Every output the 9-DOF model predicts is recorded in the dumps and compared.
+    let outputs = ["u", "v", "w", "p", "q", "r", "ax", "ay", "az"];
+    assert_eq!(tic.as_object().expect("tic").len(), outputs.len(), "{tic}");
+    for output in outputs {
         let value = number(&tic[output], output);
         assert!((0.0..=1.0).contains(&value), "TIC {output}: {value}");
+    }
+    let mean = |names: &[&str]| {
+        names.iter().map(|o| number(&tic[*o], o)).sum::<f64>() / names.len() as f64
+    };
+    let pqr = number(&verify["tic_mean_pqr"], "tic_mean_pqr");
+    assert!((pqr - mean(&["p", "q", "r"])).abs() < 1e-12, "{pqr}");
+    let all = number(&verify["tic_mean_all"], "tic_mean_all");
+    assert!((all - mean(&outputs)).abs() < 1e-12, "{all}");
+    assert_eq!(number(&verify["tic_mean"], "tic_mean"), all);
+    let verify_json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("verify.json")).unwrap()).unwrap();
+    assert_eq!(string(&verify_json["bias"], "verify.json bias"), "trim");
+    for record in verify_json["records"].as_array().expect("records") {
+        for output in record["outputs"].as_array().expect("outputs") {
+            number(&output["bias"], "bias");
+        }
     }
     let timings = summary["timings_s"].as_object().expect("timings_s");
     for stage in Stage::ALL

@@ -172,21 +172,37 @@ fn ticks_that_step_back_are_reported_by_decode_and_refused_by_frf_and_verify() {
         &["reversed.bin: ticks step back at sample 1 (tick 1000 → 999)"],
     );
 
-    let verify = |dump: &Path| {
+    let verify = |dump: &Path, bias: &str| {
         sweephold_in(
             &dir.0,
-            &["verify", "--model", &path(&model), &path(dump)],
+            &[
+                "verify",
+                "--model",
+                &path(&model),
+                &path(dump),
+                "--bias",
+                bias,
+            ],
             &[],
         )
     };
-    let out = verify(&back);
+    let out = verify(&back, "fitted");
     assert_one_line_error(
         &out,
         &["back.bin: ticks step back at sample 3 (tick 102 → 50)"],
     );
-    // The same model on a dump whose ticks move forward verifies.
-    let out = verify(&good);
+    // The same model on a dump whose ticks move forward verifies (with the fitted bias:
+    // these dumps have no trim-capture samples to take the trim bias from).
+    let out = verify(&good, "fitted");
     assert!(out.status.success(), "{}", stderr(&out));
+    let out = verify(&good, "trim");
+    assert_one_line_error(
+        &out,
+        &[
+            "good.bin: no trim samples before the excitation",
+            "--bias fitted",
+        ],
+    );
 
     assert_unchanged(&inputs, &before);
 }

@@ -87,6 +87,7 @@ fn record(primary: usize, seed: u64) -> Record {
         outputs,
         references: Vec::new(),
         notes: Vec::new(),
+        trim_samples: 0,
     }
 }
 

@@ -21,6 +21,7 @@ use sweephold_protocol::Axis;
 use sysid::document::FrfDocument;
 use sysid::fit::modes::{hover_summary, mode_records, poles_at_origin, HOVER_MODE_LIMIT_RAD_S};
 use sysid::fit::report::ScoredModelDocument;
+use sysid::fit::verify::BiasMode;
 use sysid::fit::{
     fit, fit_from_alternative_starts, start_from_quasi_steady, FitOptions, FitResult,
 };
@@ -45,6 +46,10 @@ pub const QUICK_T_REC_S: f64 = 20.0;
 /// The held-out doublets are simulated open loop over their whole record (a few seconds:
 /// the hover instabilities do not run away in that time), as VERIFID does.
 pub const VERIFY_SEGMENT_S: Option<f64> = None;
+
+/// Each output's bias is its mean over the trim capture before the doublet (and each
+/// input's trim likewise), not fitted to the prediction.
+pub const VERIFY_BIAS: BiasMode = BiasMode::Trim;
 
 /// Files of the campaign folder.
 pub mod files {
@@ -176,11 +181,7 @@ fn headline(summary: &CampaignSummary) -> String {
         }
     }
     if let Some(verify) = &summary.verify {
-        let tic: Vec<String> = ["p", "q", "r"]
-            .iter()
-            .filter_map(|o| verify.tic.get(*o).map(|t| format!("{o} {t:.3}")))
-            .collect();
-        text += &format!("verify    TIC {}\n", tic.join(", "));
+        text += &format!("verify    TIC {}\n", verify.headline());
     }
     if let Some(total) = summary.timings_s.get("total") {
         text += &format!("total     {total:.1} s\n");
@@ -559,19 +560,25 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
     run.stage(Stage::Verify, |run| {
         let records = doublets
             .iter()
-            .map(|file| verify_dump(&nine.model, run.dir(), file, VERIFY_SEGMENT_S))
+            .map(|file| verify_dump(&nine.model, run.dir(), file, VERIFY_SEGMENT_S, VERIFY_BIAS))
             .collect::<anyhow::Result<Vec<_>>>()?;
         let document = VerifyDocument {
             model_file: files::MODEL_9DOF.to_string(),
             segment_s: VERIFY_SEGMENT_S,
+            bias: VERIFY_BIAS,
             records,
         };
         write_json(&run.dir().join(files::VERIFY), &document)?;
         let summary = document.summary();
         let line = format!(
-            "{} records, mean TIC {:.3}",
+            "{} records, mean TIC p q r {}, all {} outputs {:.3} ({} bias)",
             document.records.len(),
-            summary.tic_mean
+            summary
+                .mean_pqr()
+                .map_or("-".to_string(), |m| format!("{m:.3}")),
+            summary.tic.len(),
+            summary.mean_all(),
+            summary.bias
         );
         run.summary.verify = Some(summary);
         Ok(((), line))

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 use sysid::fit::modes::{HoverModeScore, ModeRecord, TruthModeRecord};
+use sysid::fit::verify::BiasMode;
 
 use crate::fly::summary::FlySummary;
 
@@ -154,15 +155,77 @@ pub struct VerifyRecordSummary {
     pub diverged_at_s: Option<f64>,
 }
 
+/// The outputs whose verification TIC the bar (≤ 0.25) is read on.
+pub const ANGULAR_RATES: [&str; 3] = ["p", "q", "r"];
+
+/// Where the output biases of a verification written before `bias` was recorded came
+/// from: they were fitted by least squares.
+pub fn bias_of_older_files() -> BiasMode {
+    BiasMode::Fitted
+}
+
+/// Mean of the values of `tic` named in `outputs` (all of them when `None`); `None` when
+/// there are none.
+pub fn mean_tic(tic: &BTreeMap<String, f64>, outputs: Option<&[&str]>) -> Option<f64> {
+    let values: Vec<f64> = tic
+        .iter()
+        .filter(|(name, _)| outputs.is_none_or(|names| names.contains(&name.as_str())))
+        .map(|(_, value)| *value)
+        .collect();
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+}
+
 /// Verification of the final model on the held-out doublets.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct VerifySummary {
+    /// Where each output's bias came from: `trim` (its mean over the trim capture before
+    /// the doublet) or `fitted` (least squares). Summaries written before it: `fitted`.
+    #[serde(default = "bias_of_older_files")]
+    pub bias: BiasMode,
     /// Per output: the mean TIC over the held-out records.
     pub tic: BTreeMap<String, f64>,
-    /// Mean over outputs and records.
+    /// Mean of `tic` over p, q, r; null when none of them was compared (and in
+    /// summaries written before it).
+    #[serde(default)]
+    pub tic_mean_pqr: Option<f64>,
+    /// Mean of `tic` over every compared output (u v w p q r ax ay az for the 9-DOF
+    /// model); null in summaries written before it.
+    #[serde(default)]
+    pub tic_mean_all: Option<f64>,
+    /// Mean over outputs and records: the same number as `tic_mean_all` (kept).
     pub tic_mean: f64,
     /// Per record.
     pub records: Vec<VerifyRecordSummary>,
+}
+
+impl VerifySummary {
+    /// Mean TIC over p, q, r: `tic_mean_pqr`, or from `tic` for summaries without it.
+    pub fn mean_pqr(&self) -> Option<f64> {
+        self.tic_mean_pqr
+            .or_else(|| mean_tic(&self.tic, Some(&ANGULAR_RATES)))
+    }
+
+    /// Mean TIC over every compared output: `tic_mean_all`, or `tic_mean`.
+    pub fn mean_all(&self) -> f64 {
+        self.tic_mean_all.unwrap_or(self.tic_mean)
+    }
+
+    /// `p 0.108, q 0.111, r 0.176; mean p q r 0.132, all 9 outputs 0.302 (trim bias)`.
+    pub fn headline(&self) -> String {
+        let rates: Vec<String> = ANGULAR_RATES
+            .iter()
+            .filter_map(|o| self.tic.get(*o).map(|t| format!("{o} {t:.3}")))
+            .collect();
+        format!(
+            "{}; mean p q r {}, all {} outputs {:.3} ({} bias)",
+            rates.join(", "),
+            self.mean_pqr()
+                .map_or("-".to_string(), |m| format!("{m:.3}")),
+            self.tic.len(),
+            self.mean_all(),
+            self.bias
+        )
+    }
 }
 
 /// Where and why a campaign stopped.

@@ -7,11 +7,13 @@ use std::path::Path;
 
 use anyhow::anyhow;
 use serde::{Deserialize, Serialize};
-use sysid::fit::verify::{verify_record_in_segments, Verification};
+use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification};
 use sysid::fit::Model;
 use sysid::frf::load_test_dump;
 
-use super::summary::{VerifyRecordSummary, VerifySummary};
+use super::summary::{
+    bias_of_older_files, mean_tic, VerifyRecordSummary, VerifySummary, ANGULAR_RATES,
+};
 
 /// Every `DECIMATION`-th sample is kept in `verify.json` (200 Hz → 50 Hz): the doublets'
 /// content is below 10 rad/s, and the file stays small.
@@ -24,7 +26,9 @@ pub struct VerifiedOutput {
     pub name: String,
     /// Theil's inequality coefficient.
     pub tic: f64,
-    /// Fitted bias (trim plus sensor bias), removed from `measured`.
+    /// Bias b (trim value plus sensor bias) removed from `measured`: the output's mean over
+    /// the trim samples before the doublet, or the least-squares mean(y − ŷ), as the
+    /// document's `bias` says.
     pub bias: f64,
     /// Measured perturbation y − b, decimated.
     pub measured: Vec<f64>,
@@ -55,6 +59,10 @@ pub struct VerifyDocument {
     /// Simulation restarted from the measured state every this many seconds (null: open
     /// loop over the whole record).
     pub segment_s: Option<f64>,
+    /// Where the output biases came from: `trim` or `fitted` (files written before it:
+    /// `fitted`).
+    #[serde(default = "bias_of_older_files")]
+    pub bias: BiasMode,
     /// One entry per held-out record.
     pub records: Vec<VerifiedRecord>,
 }
@@ -74,14 +82,13 @@ impl VerifyDocument {
             .into_iter()
             .map(|(name, (sum, n))| (name, sum / n as f64))
             .collect();
-        let tic_mean = if tic.is_empty() {
-            1.0
-        } else {
-            tic.values().sum::<f64>() / tic.len() as f64
-        };
+        let tic_mean_all = mean_tic(&tic, None);
         VerifySummary {
+            bias: self.bias,
+            tic_mean_pqr: mean_tic(&tic, Some(&ANGULAR_RATES)),
+            tic_mean_all,
+            tic_mean: tic_mean_all.unwrap_or(1.0),
             tic,
-            tic_mean,
             records: self
                 .records
                 .iter()
@@ -106,10 +113,11 @@ pub fn verify_dump(
     dir: &Path,
     file: &str,
     segment_s: Option<f64>,
+    bias: BiasMode,
 ) -> anyhow::Result<VerifiedRecord> {
     let record = load_test_dump(dir.join(file)).map_err(|e| anyhow!("{e}"))?;
     let verification =
-        verify_record_in_segments(model, &record, segment_s).map_err(|e| anyhow!("{e}"))?;
+        verify_record_in_segments(model, &record, segment_s, bias).map_err(|e| anyhow!("{e}"))?;
     Ok(verified_record(file, &verification))
 }
 
@@ -177,6 +185,7 @@ mod tests {
         let document = VerifyDocument {
             model_file: "model9.json".into(),
             segment_s: None,
+            bias: BiasMode::Trim,
             records: vec![
                 VerifiedRecord {
                     file: "a.bin".into(),
@@ -188,16 +197,44 @@ mod tests {
                 VerifiedRecord {
                     file: "b.bin".into(),
                     step_s: 0.02,
-                    tic_mean: 0.3,
+                    tic_mean: 0.5,
                     diverged_at_s: None,
-                    outputs: vec![output("p", 0.3)],
+                    outputs: vec![output("p", 0.3), output("w", 0.7)],
                 },
             ],
         };
         let summary = document.summary();
         assert!((summary.tic["p"] - 0.2).abs() < 1e-12);
         assert!((summary.tic["q"] - 0.3).abs() < 1e-12);
-        assert!((summary.tic_mean - 0.25).abs() < 1e-12);
+        assert!((summary.tic["w"] - 0.7).abs() < 1e-12);
+        assert!((summary.tic_mean - 0.4).abs() < 1e-12);
+        assert_eq!(summary.tic_mean_all, Some(summary.tic_mean));
+        assert!((summary.tic_mean_pqr.unwrap() - 0.25).abs() < 1e-12);
+        assert_eq!(summary.bias, BiasMode::Trim);
         assert_eq!(summary.records.len(), 2);
+        let json = serde_json::to_value(&summary).unwrap();
+        assert_eq!(json["bias"], "trim");
+        assert_eq!(serde_json::to_value(&document).unwrap()["bias"], "trim");
+        assert!(
+            summary
+                .headline()
+                .ends_with("; mean p q r 0.250, all 3 outputs 0.400 (trim bias)"),
+            "{}",
+            summary.headline()
+        );
+    }
+
+    #[test]
+    fn files_written_before_the_bias_was_recorded_read_as_fitted() {
+        let old_document = r#"{"model_file": "model9.json", "segment_s": null, "records": []}"#;
+        let document: VerifyDocument = serde_json::from_str(old_document).unwrap();
+        assert_eq!(document.bias, BiasMode::Fitted);
+        let old_summary = r#"{"tic": {"p": 0.1, "q": 0.2, "r": 0.3, "w": 0.8},
+            "tic_mean": 0.35, "records": []}"#;
+        let summary: VerifySummary = serde_json::from_str(old_summary).unwrap();
+        assert_eq!(summary.bias, BiasMode::Fitted);
+        assert_eq!(summary.tic_mean_pqr, None);
+        assert!((summary.mean_pqr().unwrap() - 0.2).abs() < 1e-12);
+        assert_eq!(summary.mean_all(), 0.35);
     }
 }

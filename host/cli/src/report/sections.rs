@@ -11,6 +11,7 @@ use sysid::fit::modes::{
     eigenvalue_text, hover_summary, origin_text, ModeName, HOVER_MODE_LIMIT_RAD_S,
     HOVER_MODE_TOLERANCE_PERCENT, ORIGIN_LIMIT_RAD_S,
 };
+use sysid::fit::verify::BiasMode;
 use sysid::fit::Model;
 
 use super::html::{figure, note, section, table, Cell, Mark};
@@ -126,13 +127,34 @@ folder (`sweephold report DIR` redraws it).",
         for output in ANGULAR_RATES {
             if let Some(tic) = verify.tic.get(output) {
                 rows.push(bar_row(
-                    &format!("verification TIC, {output} (mean over the doublets)"),
+                    &format!(
+                        "verification TIC, {output} (mean over the doublets, {} bias)",
+                        verify.bias
+                    ),
                     format!("{tic:.3}"),
                     "≤ 0.25",
                     Some(*tic <= 0.25),
                 ));
             }
         }
+        if let Some(mean) = verify.mean_pqr() {
+            rows.push(bar_row(
+                "verification TIC, mean over p, q, r",
+                format!("{mean:.3}"),
+                "reported",
+                None,
+            ));
+        }
+        rows.push(bar_row(
+            &format!(
+                "verification TIC, mean over all {} outputs ({})",
+                verify.tic.len(),
+                verify.tic.keys().cloned().collect::<Vec<_>>().join(" ")
+            ),
+            format!("{:.3}", verify.mean_all()),
+            "reported",
+            None,
+        ));
     }
     if let Some(total) = s.timings_s.get("total") {
         rows.push(bar_row(
@@ -872,7 +894,8 @@ pub fn verification_section(inputs: &ReportInputs) -> String {
     }
     let mut headers = vec!["record".to_string()];
     headers.extend(outputs.iter().cloned());
-    headers.push("mean".into());
+    headers.push("mean p q r".into());
+    headers.push("mean all".into());
     let rows: Vec<Vec<Cell>> = verify
         .records
         .iter()
@@ -887,6 +910,17 @@ pub fn verification_section(inputs: &ReportInputs) -> String {
                     None => Cell::plain("-"),
                 });
             }
+            let rates: Vec<f64> = record
+                .outputs
+                .iter()
+                .filter(|o| ANGULAR_RATES.contains(&o.name.as_str()))
+                .map(|o| o.tic)
+                .collect();
+            row.push(Cell::plain(if rates.is_empty() {
+                "-".to_string()
+            } else {
+                format!("{:.3}", rates.iter().sum::<f64>() / rates.len() as f64)
+            }));
             row.push(Cell::plain(format!("{:.3}", record.tic_mean)));
             row
         })
@@ -894,12 +928,20 @@ pub fn verification_section(inputs: &ReportInputs) -> String {
     let header_refs: Vec<&str> = headers.iter().map(String::as_str).collect();
     let mut content = note(&format!(
         "The identified model simulated on the commands of held-out doublet records (seed {}, \
-not used in the fit){}; a constant bias per output is removed. TIC = rms(y − b − ŷ) / \
-(rms(y − b) + rms(ŷ)): 0 perfect, ≤ 0.25 the bar for p, q, r.",
+not used in the fit){}; {}. TIC = rms(y − b − ŷ) / (rms(y − b) + rms(ŷ)): 0 perfect, \
+≤ 0.25 the bar for p, q, r.",
         inputs.summary.verification_seed,
         match verify.segment_s {
             Some(s) => format!(", restarted from the measured state every {s} s"),
             None => ", open loop over each record".to_string(),
+        },
+        match verify.bias {
+            BiasMode::Trim =>
+                "the bias b of each output (and the trim of each command) is its \
+mean over the trim capture before the doublet (trim bias)",
+            BiasMode::Fitted =>
+                "a constant bias b per output is fitted by least squares, \
+b = mean(y − ŷ) (fitted bias)",
         }
     )) + &table(&header_refs, &rows);
     for record in &verify.records {

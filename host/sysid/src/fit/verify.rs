@@ -8,8 +8,9 @@
 //! y = C x + D u_d,   C = H0 + H1·A, D = H1·B
 //! ```
 //!
-//! **Inputs** are perturbations: each recorded control minus its first sample (the trim
-//! the firmware captured before the excitation). **Delays** shift each control by τ_j·f_s
+//! **Inputs** are perturbations: each recorded control minus its trim, taken as the output
+//! biases are (below): its mean over the record's trim samples, or (fitted bias) its
+//! first sample. **Delays** shift each control by τ_j·f_s
 //! samples, the fractional part by linear interpolation; before the record starts the
 //! control is at trim (0). **Integration** is exact for inputs that are linear between
 //! samples (first-order hold, consistent with the interpolation of the delay): with
@@ -24,9 +25,23 @@
 //! (the zero-order-hold discretisation `exp(h·[[A, B], [0, 0]])` is the top-left part; the
 //! third block row adds the ramp). The state starts at 0 (trim).
 //!
-//! **Bias.** Per output a constant b is fitted by least squares, `b = mean(y − ŷ)`; it
-//! stands for the output's trim value (and any sensor bias). **Theil's inequality
-//! coefficient** is then computed on perturbations, measured `y − b` against predicted ŷ:
+//! **Bias.** The model predicts perturbations from trim; the recorded outputs are absolute.
+//! Per output a constant b, its trim value (and any sensor bias), is removed, chosen by
+//! [`BiasMode`]:
+//!
+//! * [`BiasMode::Trim`] (the default): `b = mean(y[0..n₀])`, the output's mean over the
+//!   record's `n₀ = `[`Record::trim_samples`] samples taken at trim before the excitation
+//!   starts (a dump's trim-capture phase), and each input's trim likewise
+//!   `u₀ = mean(u[0..n₀])`. Nothing is taken from the prediction, so a model whose
+//!   response is offset or drifts during the excitation pays for it in the TIC. A record
+//!   without trim samples is refused ([`VerifyError::NoTrim`]), not scored another way.
+//! * [`BiasMode::Fitted`]: `b = mean(y − ŷ)` over the whole record (least squares; inputs
+//!   from their first sample). It removes any constant error of the prediction as well,
+//!   and so flatters the model; kept for comparison with earlier results.
+//!
+//! Either way the score runs over the whole record, trim samples included. **Theil's
+//! inequality coefficient** is then computed on perturbations, measured `y − b` against
+//! predicted ŷ:
 //!
 //! ```text
 //! TIC = √(Σ(y − b − ŷ)²/N) / (√(Σ(y − b)²/N) + √(Σŷ²/N))
@@ -83,6 +98,12 @@ pub enum VerifyError {
         /// Sample index where the first non-finite value appeared.
         sample: usize,
     },
+    /// The trim bias was asked for, but the record has no trim samples before its
+    /// excitation.
+    NoTrim {
+        /// The record.
+        source: String,
+    },
     /// A plot could not be written.
     Plot {
         /// The file.
@@ -117,6 +138,11 @@ impl fmt::Display for VerifyError {
             VerifyError::Diverged { sample } => write!(
                 f,
                 "the simulated model diverged (non-finite at sample {sample})"
+            ),
+            VerifyError::NoTrim { source } => write!(
+                f,
+                "{source}: no trim samples before the excitation to take the output bias from \
+                 (the fitted bias needs none)"
             ),
             VerifyError::Plot { path, message } => {
                 write!(f, "cannot draw plot {}: {message}", path.display())
@@ -340,12 +366,43 @@ pub fn simulate_with_resets(
     Ok(outputs)
 }
 
+/// Where the constant b removed from each measured output (its trim value plus any sensor
+/// bias) comes from; see the module documentation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BiasMode {
+    /// b = the output's mean over the record's trim samples before the excitation; the
+    /// inputs are taken from their mean over the same samples.
+    #[default]
+    Trim,
+    /// b = mean(y − ŷ) over the record (least squares); the inputs from their first
+    /// sample.
+    Fitted,
+}
+
+impl BiasMode {
+    /// `trim` or `fitted` (as in JSON).
+    pub fn name(self) -> &'static str {
+        match self {
+            BiasMode::Trim => "trim",
+            BiasMode::Fitted => "fitted",
+        }
+    }
+}
+
+impl fmt::Display for BiasMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The fit of one output.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct OutputScore {
     /// Output name.
     pub output: String,
-    /// Least-squares constant bias b = mean(y − ŷ) (trim value plus sensor bias).
+    /// The constant b removed from the measurement: the output's trim mean
+    /// ([`BiasMode::Trim`]) or the least-squares mean(y − ŷ) ([`BiasMode::Fitted`]).
     pub bias: f64,
     /// RMS of the residual y − b − ŷ.
     pub rms_error: f64,
@@ -366,6 +423,11 @@ pub struct Verification {
     pub sample_rate_hz: f64,
     /// Samples compared.
     pub samples: usize,
+    /// Where the output biases came from.
+    pub bias: BiasMode,
+    /// Samples averaged for the trim biases (the record's trim samples); 0 with
+    /// [`BiasMode::Fitted`].
+    pub trim_samples: usize,
     /// Per compared output (model outputs recorded in the record), model order.
     pub outputs: Vec<OutputScore>,
     /// Model outputs the record does not have.
@@ -385,7 +447,8 @@ fn rms(values: impl Iterator<Item = f64>, n: usize) -> f64 {
     (values.map(|v| v * v).sum::<f64>() / n as f64).sqrt()
 }
 
-/// Score a prediction against a measurement of one output (bias fitted, TIC).
+/// Score a prediction against a measurement of one output with the bias fitted by least
+/// squares, `b = mean(y − ŷ)` ([`BiasMode::Fitted`]), then the TIC.
 pub fn score_output(name: &str, measured: &[f64], predicted: &[f64]) -> OutputScore {
     let n = measured.len().min(predicted.len()).max(1);
     let bias = measured
@@ -394,6 +457,18 @@ pub fn score_output(name: &str, measured: &[f64], predicted: &[f64]) -> OutputSc
         .map(|(y, p)| y - p)
         .sum::<f64>()
         / n as f64;
+    score_output_with_bias(name, measured, predicted, bias)
+}
+
+/// Score a prediction against a measurement of one output with a given bias b (e.g. the
+/// output's trim): the RMS of `y − b − ŷ`, `y − b` and ŷ, and the TIC.
+pub fn score_output_with_bias(
+    name: &str,
+    measured: &[f64],
+    predicted: &[f64],
+    bias: f64,
+) -> OutputScore {
+    let n = measured.len().min(predicted.len()).max(1);
     let rms_error = rms(measured.iter().zip(predicted).map(|(y, p)| y - bias - p), n);
     let rms_measured = rms(measured.iter().map(|y| y - bias), n);
     let rms_predicted = rms(predicted.iter().copied(), n);
@@ -417,26 +492,35 @@ pub fn score_output(name: &str, measured: &[f64], predicted: &[f64]) -> OutputSc
 }
 
 /// Verify `model` on `record` over the whole record from trim: simulate it on the
-/// record's inputs (perturbations from the first sample) and score every model output
-/// the record has.
+/// record's inputs (perturbations from their trim) and score every model output the
+/// record has, with the bias from the trim ([`BiasMode::Trim`]).
 pub fn verify_record(model: &Model, record: &Record) -> Result<Verification, VerifyError> {
-    verify_record_in_segments(model, record, None)
+    verify_record_in_segments(model, record, None, BiasMode::default())
 }
 
-/// Seconds of the record's start averaged for the trim values of the measured states.
+/// With the fitted bias, seconds of the record's start averaged for the trim values of
+/// the measured states the segments restart from.
 const TRIM_AVERAGE_S: f64 = 1.0;
+
+/// Mean of the first `n` (≥ 1) values.
+fn mean_of_first(values: &[f64], n: usize) -> f64 {
+    values[..n].iter().sum::<f64>() / n as f64
+}
 
 /// [`verify_record`], optionally restarting the simulation every `segment_s` seconds from
 /// the measured state. A hover helicopter is unstable (the Bo-105's phugoid-like pair
 /// doubles in ≈ 2 s), so an open-loop prediction over a 90 s record runs away whatever
 /// the model; VERIFID-style checks use records of a few seconds. Each model state named
 /// like a recorded output (u v w p q r phi theta) restarts at its measured value minus
-/// its trim (the mean over the record's first second, where the firmware captured trim);
-/// other states (flapping) restart at 0. One bias per output over the whole record.
+/// its trim (the mean over the record's trim samples with [`BiasMode::Trim`]; over its
+/// first second, where the firmware captured trim, with [`BiasMode::Fitted`]); other
+/// states (flapping) restart at 0. One bias per output over the whole record, as `bias`
+/// says.
 pub fn verify_record_in_segments(
     model: &Model,
     record: &Record,
     segment_s: Option<f64>,
+    bias: BiasMode,
 ) -> Result<Verification, VerifyError> {
     if let Some(segment) = segment_s {
         if !(segment.is_finite() && segment * record.sample_rate_hz >= 2.0) {
@@ -458,7 +542,7 @@ pub fn verify_record_in_segments(
             reason: format!("{} samples, need at least 2", record.len()),
         });
     }
-    let mut inputs = Vec::with_capacity(model.controls.len());
+    let mut recorded_inputs = Vec::with_capacity(model.controls.len());
     for control in &model.controls {
         let series = record
             .input(control)
@@ -467,8 +551,7 @@ pub fn verify_record_in_segments(
                 source: record.source.clone(),
                 available: record.inputs.iter().map(|c| c.name.clone()).collect(),
             })?;
-        let trim = series[0];
-        inputs.push(series.iter().map(|v| v - trim).collect::<Vec<f64>>());
+        recorded_inputs.push(series);
     }
     let compared: Vec<(usize, &[f64])> = model
         .outputs
@@ -488,19 +571,46 @@ pub fn verify_record_in_segments(
         .filter(|name| record.output(name).is_none())
         .cloned()
         .collect();
+    // Samples whose means are the trims (biases), with the trim bias.
+    let trim_samples = match bias {
+        BiasMode::Fitted => None,
+        BiasMode::Trim if record.trim_samples == 0 => {
+            return Err(VerifyError::NoTrim {
+                source: record.source.clone(),
+            })
+        }
+        BiasMode::Trim if record.trim_samples > record.len() => {
+            return Err(VerifyError::BadRecord {
+                source: record.source.clone(),
+                reason: format!(
+                    "{} trim samples in a record of {}",
+                    record.trim_samples,
+                    record.len()
+                ),
+            })
+        }
+        BiasMode::Trim => Some(record.trim_samples),
+    };
+    let inputs: Vec<Vec<f64>> = recorded_inputs
+        .iter()
+        .map(|series| {
+            let trim = trim_samples.map_or(series[0], |n| mean_of_first(series, n));
+            series.iter().map(|v| v - trim).collect()
+        })
+        .collect();
     let mut resets = Vec::new();
     if let Some(segment) = segment_s {
         let length = (segment * record.sample_rate_hz).round() as usize;
-        let trim_samples =
-            ((TRIM_AVERAGE_S * record.sample_rate_hz) as usize).clamp(1, record.len());
+        let averaged = trim_samples.unwrap_or_else(|| {
+            ((TRIM_AVERAGE_S * record.sample_rate_hz) as usize).clamp(1, record.len())
+        });
         let measured_states: Vec<Option<(&[f64], f64)>> = model
             .states
             .iter()
             .map(|name| {
-                record.output(name).map(|series| {
-                    let trim = series[..trim_samples].iter().sum::<f64>() / trim_samples as f64;
-                    (series, trim)
-                })
+                record
+                    .output(name)
+                    .map(|series| (series, mean_of_first(series, averaged)))
             })
             .collect();
         for start in (0..record.len()).step_by(length.max(2)) {
@@ -515,9 +625,9 @@ pub fn verify_record_in_segments(
         Err(VerifyError::Diverged { sample }) => {
             let outputs = compared
                 .iter()
-                .map(|(index, _)| OutputScore {
+                .map(|(index, series)| OutputScore {
                     output: model.outputs[*index].clone(),
-                    bias: f64::NAN,
+                    bias: trim_samples.map_or(f64::NAN, |n| mean_of_first(series, n)),
                     rms_error: f64::INFINITY,
                     rms_measured: f64::NAN,
                     rms_predicted: f64::INFINITY,
@@ -528,6 +638,8 @@ pub fn verify_record_in_segments(
                 source: record.source.clone(),
                 sample_rate_hz: record.sample_rate_hz,
                 samples: record.len(),
+                bias,
+                trim_samples: trim_samples.unwrap_or(0),
                 outputs,
                 not_recorded,
                 theil_mean: 1.0,
@@ -542,7 +654,13 @@ pub fn verify_record_in_segments(
     let mut measured = Vec::with_capacity(compared.len());
     let mut predicted = Vec::with_capacity(compared.len());
     for (index, series) in &compared {
-        let score = score_output(&model.outputs[*index], series, &simulated[*index]);
+        let name = &model.outputs[*index];
+        let score = match trim_samples {
+            Some(n) => {
+                score_output_with_bias(name, series, &simulated[*index], mean_of_first(series, n))
+            }
+            None => score_output(name, series, &simulated[*index]),
+        };
         measured.push(series.iter().map(|y| y - score.bias).collect());
         predicted.push(simulated[*index].clone());
         outputs.push(score);
@@ -552,6 +670,8 @@ pub fn verify_record_in_segments(
         source: record.source.clone(),
         sample_rate_hz: record.sample_rate_hz,
         samples: record.len(),
+        bias,
+        trim_samples: trim_samples.unwrap_or(0),
         not_recorded,
         outputs,
         theil_mean,
@@ -786,14 +906,20 @@ mod tests {
             outputs,
             references: Vec::new(),
             notes: Vec::new(),
+            trim_samples: 0,
         }
+    }
+
+    /// The verification with the fitted bias, as it was before the trim bias existed.
+    fn verify_fitted(model: &Model, record: &Record) -> Result<Verification, VerifyError> {
+        verify_record_in_segments(model, record, None, BiasMode::Fitted)
     }
 
     #[test]
     fn self_generated_data_scores_zero_and_noise_raises_the_tic() {
         let model = two_axis_model();
         let clean_record = record_of(&model, 0.0);
-        let exact = verify_record(&model, &clean_record).unwrap();
+        let exact = verify_fitted(&model, &clean_record).unwrap();
         assert_eq!(exact.outputs.len(), 4);
         for score in &exact.outputs {
             assert!(score.theil < 1e-9, "{}: {}", score.output, score.theil);
@@ -802,7 +928,7 @@ mod tests {
         }
         let mut previous = exact.theil_mean;
         for noise in [0.05, 0.2, 0.5] {
-            let noisy = verify_record(&model, &record_of(&model, noise)).unwrap();
+            let noisy = verify_fitted(&model, &record_of(&model, noise)).unwrap();
             assert!(
                 noisy.theil_mean > previous,
                 "noise {noise}: {} after {previous}",
@@ -814,7 +940,7 @@ mod tests {
         // A wrong model scores clearly worse than the right one on clean data.
         let mut wrong = model.clone();
         wrong.g.scale_mut(-1.0);
-        let bad = verify_record(&wrong, &clean_record).unwrap();
+        let bad = verify_fitted(&wrong, &clean_record).unwrap();
         // (A pure sign flip would give 1; the fitted bias takes out the means.)
         assert!(bad.theil_mean > 0.7, "{}", bad.theil_mean);
     }
@@ -829,8 +955,9 @@ mod tests {
         let record = record_of(&truth, 0.0);
         let mut wrong = truth.clone();
         wrong.f[(2, 2)] = 0.4;
-        let whole = verify_record(&wrong, &record).unwrap();
-        let segmented = verify_record_in_segments(&wrong, &record, Some(3.0)).unwrap();
+        let whole = verify_fitted(&wrong, &record).unwrap();
+        let segmented =
+            verify_record_in_segments(&wrong, &record, Some(3.0), BiasMode::Fitted).unwrap();
         let q_whole = whole
             .outputs
             .iter()
@@ -847,9 +974,11 @@ mod tests {
         assert!(q_segmented < 0.5 * q_whole, "{q_segmented} vs {q_whole}");
         // The right model restarted from measured states still predicts well (the
         // restarts use trim estimated from the first second, so not exactly).
-        let right = verify_record_in_segments(&truth, &record, Some(3.0)).unwrap();
+        let right =
+            verify_record_in_segments(&truth, &record, Some(3.0), BiasMode::Fitted).unwrap();
         assert!(right.theil_mean < 0.1, "{}", right.theil_mean);
-        let error = verify_record_in_segments(&truth, &record, Some(0.001)).unwrap_err();
+        let error =
+            verify_record_in_segments(&truth, &record, Some(0.001), BiasMode::Fitted).unwrap_err();
         assert!(error.to_string().contains("segment"), "{error}");
     }
 
@@ -858,7 +987,7 @@ mod tests {
         let model = two_axis_model();
         let mut record = record_of(&model, 0.0);
         record.inputs.retain(|c| c.name != "lon");
-        let error = verify_record(&model, &record).unwrap_err();
+        let error = verify_fitted(&model, &record).unwrap_err();
         assert!(matches!(error, VerifyError::MissingInput { ref control, .. } if control == "lon"));
         assert!(error.to_string().contains("`lon`"), "{error}");
 
@@ -866,7 +995,7 @@ mod tests {
         for channel in &mut record.outputs {
             channel.name = format!("other_{}", channel.name);
         }
-        let error = verify_record(&model, &record).unwrap_err();
+        let error = verify_fitted(&model, &record).unwrap_err();
         assert!(
             matches!(error, VerifyError::NoCommonOutput { .. }),
             "{error}"
@@ -874,20 +1003,20 @@ mod tests {
 
         let mut singular = model.clone();
         singular.m[(2, 2)] = 0.0;
-        let error = verify_record(&singular, &record_of(&model, 0.0)).unwrap_err();
+        let error = verify_fitted(&singular, &record_of(&model, 0.0)).unwrap_err();
         assert!(error.to_string().contains("singular"), "{error}");
 
         let mut short = record_of(&model, 0.0);
         for channel in short.inputs.iter_mut().chain(short.outputs.iter_mut()) {
             channel.values.truncate(1);
         }
-        let error = verify_record(&model, &short).unwrap_err();
+        let error = verify_fitted(&model, &short).unwrap_err();
         assert!(matches!(error, VerifyError::BadRecord { .. }), "{error}");
 
         // A model that runs away is a result (TIC 1 everywhere), not an error.
         let mut unstable = model.clone();
         unstable.f[(2, 2)] = 50.0;
-        let result = verify_record(&unstable, &record_of(&model, 0.0)).unwrap();
+        let result = verify_fitted(&unstable, &record_of(&model, 0.0)).unwrap();
         let at = result.diverged_at_s.expect("diverged");
         assert!(at > 0.0 && at < 30.0, "{at}");
         assert!(result.outputs.iter().all(|o| o.theil == 1.0));
@@ -896,8 +1025,182 @@ mod tests {
         // An output missing from the record is listed, not an error.
         let mut partial = record_of(&model, 0.0);
         partial.outputs.retain(|c| c.name != "ay");
-        let result = verify_record(&model, &partial).unwrap();
+        let result = verify_fitted(&model, &partial).unwrap();
         assert_eq!(result.not_recorded, vec!["ay".to_string()]);
         assert_eq!(result.outputs.len(), 3);
+    }
+
+    /// Trim samples at 100 Hz in front of the excitation of [`record_with_trim`].
+    const TRIM: usize = 150;
+
+    /// `model` flown from trim: `TRIM` samples with the sticks at `stick_trim` (plus
+    /// `stick_trim_wobble`, one value per trim sample and control, which the caller keeps at
+    /// zero mean), then 28.5 s of excitation; each output is the model's response to the
+    /// sticks minus their trim mean, plus the offset 0.7·i − 1 (its trim value). Returns
+    /// the record and the perturbation inputs the outputs were simulated with.
+    fn record_with_trim(
+        model: &Model,
+        stick_trim_wobble: &dyn Fn(usize, usize) -> f64,
+    ) -> (Record, Vec<Vec<f64>>) {
+        let rate = 100.0;
+        let n = 3000;
+        let stick_trim = [0.1, -0.2];
+        let perturbations: Vec<Vec<f64>> = (0..2)
+            .map(|j| {
+                (0..n)
+                    .map(|k| {
+                        if k < TRIM {
+                            return stick_trim_wobble(k, j);
+                        }
+                        // Starts at 0 when the excitation starts.
+                        let t = (k - TRIM) as f64 / rate;
+                        0.05 * (t * (0.5 + 0.1 * t) + j as f64).sin() - 0.05 * (j as f64).sin()
+                            + 0.02 * (7.0 * t).sin()
+                    })
+                    .collect()
+            })
+            .collect();
+        let clean = simulate(model, &perturbations, rate).unwrap();
+        let outputs = model
+            .outputs
+            .iter()
+            .zip(&clean)
+            .enumerate()
+            .map(|(i, (name, series))| {
+                let offset = 0.7 * i as f64 - 1.0;
+                Channel::new(name.clone(), series.iter().map(|v| v + offset).collect())
+            })
+            .collect();
+        let record = Record {
+            source: "trimmed".into(),
+            sample_rate_hz: rate,
+            primary: "lat".into(),
+            primary_guessed: false,
+            sweep_band: None,
+            inputs: perturbations
+                .iter()
+                .zip(["lat", "lon"])
+                .zip(stick_trim)
+                .map(|((series, name), t)| {
+                    Channel::new(name, series.iter().map(|v| v + t).collect())
+                })
+                .collect(),
+            outputs,
+            references: Vec::new(),
+            notes: Vec::new(),
+            trim_samples: TRIM,
+        };
+        (record, perturbations)
+    }
+
+    #[test]
+    fn the_trim_bias_is_the_mean_before_the_excitation() {
+        let model = two_axis_model();
+        let (record, _) = record_with_trim(&model, &|_, _| 0.0);
+        let exact = verify_record(&model, &record).unwrap();
+        assert_eq!(exact.bias, BiasMode::Trim);
+        assert_eq!(exact.trim_samples, TRIM);
+        assert_eq!(exact.outputs.len(), 4);
+        for score in &exact.outputs {
+            let offset = 0.7 * model.output_index(&score.output).unwrap() as f64 - 1.0;
+            assert!((score.bias - offset).abs() < 1e-12, "{score:?}");
+            assert!(score.theil < 1e-9, "{}: {}", score.output, score.theil);
+        }
+        // The fitted bias finds the same offsets on exact data.
+        let fitted = verify_fitted(&model, &record).unwrap();
+        assert_eq!(fitted.bias, BiasMode::Fitted);
+        assert_eq!(fitted.trim_samples, 0);
+        assert!(fitted.theil_mean < 1e-9, "{}", fitted.theil_mean);
+
+        // An error the model makes as a constant during the excitation (here: the
+        // measured q settles 0.02 rad/s higher than predicted once the excitation starts).
+        // The trim bias counts it; the fitted bias takes most of it out.
+        let mut offset_q = record.clone();
+        let q = offset_q.outputs.iter_mut().find(|c| c.name == "q").unwrap();
+        for value in &mut q.values[TRIM..] {
+            *value += 0.02;
+        }
+        let tic_q = |v: &Verification| v.outputs.iter().find(|o| o.output == "q").unwrap().theil;
+        let trim = verify_record(&model, &offset_q).unwrap();
+        let fitted = verify_fitted(&model, &offset_q).unwrap();
+        assert!(tic_q(&trim) > 0.05, "{}", tic_q(&trim));
+        assert!(
+            tic_q(&fitted) < 0.5 * tic_q(&trim),
+            "{} vs {}",
+            tic_q(&fitted),
+            tic_q(&trim)
+        );
+        // The other outputs are untouched either way.
+        for v in [&trim, &fitted] {
+            for o in v.outputs.iter().filter(|o| o.output != "q") {
+                assert!(o.theil < 1e-9, "{o:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn inputs_are_taken_from_the_same_trim_as_the_outputs() {
+        // The sticks wobble during the trim capture (zero mean): the first sample is
+        // 0.01 off the trim. The outputs were simulated on the sticks minus their trim
+        // mean, so that is what the model must be driven with.
+        let wobble = |k: usize, _: usize| {
+            if k == 0 {
+                0.01
+            } else {
+                -0.01 / (TRIM - 1) as f64
+            }
+        };
+        let model = two_axis_model();
+        let (record, perturbations) = record_with_trim(&model, &wobble);
+        let verification = verify_record(&model, &record).unwrap();
+        let expected = simulate(&model, &perturbations, record.sample_rate_hz).unwrap();
+        for (score, predicted) in verification.outputs.iter().zip(&verification.predicted) {
+            let index = model.output_index(&score.output).unwrap();
+            for (a, b) in predicted.iter().zip(&expected[index]) {
+                assert!((a - b).abs() < 1e-12, "{}: {a} vs {b}", score.output);
+            }
+            // The bias is the measured trim mean: the offset plus the (small) response
+            // to the wobble over the trim samples; what is left is that constant.
+            let offset = 0.7 * index as f64 - 1.0;
+            let response = expected[index][..TRIM].iter().sum::<f64>() / TRIM as f64;
+            assert!(
+                (score.bias - offset - response).abs() < 1e-12,
+                "{}: {} vs {}",
+                score.output,
+                score.bias,
+                offset + response
+            );
+        }
+        // Driven from the first sample instead, the model sees a 0.01 step held over the
+        // whole record, and misses: the fitted bias (which takes its inputs from there)
+        // scores worse although it fits the constant.
+        let fitted = verify_fitted(&model, &record).unwrap();
+        assert!(
+            fitted.theil_mean > 10.0 * verification.theil_mean,
+            "{} vs {}",
+            fitted.theil_mean,
+            verification.theil_mean
+        );
+    }
+
+    #[test]
+    fn the_trim_bias_needs_trim_samples() {
+        let model = two_axis_model();
+        let record = record_of(&model, 0.0);
+        let error = verify_record(&model, &record).unwrap_err();
+        assert_eq!(
+            error,
+            VerifyError::NoTrim {
+                source: "synthetic".into()
+            }
+        );
+        assert!(
+            error.to_string().starts_with("synthetic: no trim samples"),
+            "{error}"
+        );
+        let mut overlong = record;
+        overlong.trim_samples = overlong.len() + 1;
+        let error = verify_record(&model, &overlong).unwrap_err();
+        assert!(matches!(error, VerifyError::BadRecord { .. }), "{error}");
     }
 }

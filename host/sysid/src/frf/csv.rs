@@ -326,6 +326,7 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
             .collect(),
         references: Vec::new(),
         notes,
+        trim_samples: 0,
     };
     record.validate()?;
     Ok(record)

@@ -287,6 +287,9 @@ fn record_from_samples_at(
         previous = Some((sample.tick, row, output));
     }
     let references = inputs.split_off(4);
+    // The trim-capture samples in front of the excitation, counted on the tick grid (lost
+    // ticks among them are filled like any others).
+    let trim_samples = samples[before].tick.wrapping_sub(samples[0].tick) as usize;
 
     let mut notes = Vec::new();
     if missing > 0 {
@@ -319,6 +322,7 @@ fn record_from_samples_at(
             .map(|(name, values)| Channel::new(*name, values))
             .collect(),
         notes,
+        trim_samples,
     };
     record.validate()?;
     Ok(record)
@@ -337,6 +341,8 @@ mod tests {
         assert_eq!(record.primary, "lat");
         assert_eq!(record.sample_rate_hz, 100.0);
         assert_eq!(record.len(), spec.sweep_samples);
+        // No trim capture in front of this one's excitation.
+        assert_eq!(record.trim_samples, 0);
         assert_eq!(record.inputs.len(), 4);
         assert_eq!(record.outputs.len(), 11);
         // References: sweep + noise of each control (the synthetic dump injects 1.5 ×
@@ -370,8 +376,10 @@ mod tests {
         };
         let record = load_dump_bytes(&dump_bytes(&spec), "settle.dump").unwrap();
         assert_eq!(record.len(), spec.sweep_samples + 2 * 200);
+        assert_eq!(record.trim_samples, 200);
         let p = record.output("p").unwrap();
         assert_eq!(p[0], f64::from(spec.first_sweep_tick() - 200));
+        assert_eq!(p[200], f64::from(spec.first_sweep_tick()));
         assert!(p.windows(2).all(|w| w[1] - w[0] == 1.0));
     }
 

@@ -60,6 +60,12 @@ pub struct Record {
     pub references: Vec<Channel>,
     /// Remarks made while loading (gaps filled, …); copied into the document's notes.
     pub notes: Vec<String>,
+    /// Leading samples taken at trim, before the excitation starts: a telemetry dump's
+    /// trim-capture samples kept in front of the fade-in (up to
+    /// [`SETTLE_S`](super::dump::SETTLE_S), on the tick grid). 0 when there are none or
+    /// the source does not say (CSV records). Time-domain verification takes each
+    /// channel's trim (the bias of its perturbations) as its mean over these samples.
+    pub trim_samples: usize,
 }
 
 impl Record {
@@ -416,6 +422,7 @@ mod tests {
             outputs: vec![Channel::new("p", p)],
             references: Vec::new(),
             notes: vec![],
+            trim_samples: 0,
         }
     }
 

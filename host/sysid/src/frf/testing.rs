@@ -214,6 +214,7 @@ pub fn record(
             .collect(),
         references: Vec::new(),
         notes: vec![],
+        trim_samples: 0,
     }
 }
 
