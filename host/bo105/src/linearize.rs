@@ -277,7 +277,7 @@ mod tests {
     use super::*;
     use crate::trim::trim;
 
-    /// Padfield's Helisim Bo-105 hover derivatives (DESIGN.md §5).
+    /// Padfield's Helisim Bo-105 hover derivatives.
     const PADFIELD: [(&str, f64); 10] = [
         ("Xu", -0.0211),
         ("Yv", -0.0405),

@@ -245,7 +245,7 @@ pub struct Helicopter {
 }
 
 impl Helicopter {
-    /// The MBB Bo-105 from Padfield's Helisim data (DESIGN.md §5).
+    /// The MBB Bo-105 from Padfield's Helisim data.
     ///
     /// Gearing (positive stick produces a positive moment: lat → roll right, lon → nose up,
     /// ped → nose right, col → up):
@@ -330,10 +330,10 @@ impl Helicopter {
     ///
     /// The flybarless head is modelled as a stiff hub with an equivalent centre-spring
     /// stiffness of 350 N·m/rad per blade (head dampers), chosen so the roll flap-moment
-    /// derivative L_β1s = (N_b K_β/2 + T h)/I_xx ≈ 3 000 s⁻², of the order of the 700-size
-    /// approximation in DESIGN.md (3 588.6). The flap time constant follows from the blade
+    /// derivative L_β1s = (N_b K_β/2 + T h)/I_xx ≈ 3 000 s⁻², of the order of a first
+    /// 700-size estimate (3 588.6). The flap time constant follows from the blade
     /// data (γ ≈ 3.4, Ω = 199 rad/s): τ_f ≈ 0.023 s. A hub spring can only shorten τ_f, so
-    /// DESIGN.md's 0.068 s (at 1500 rpm) cannot be reached with 1900 rpm and real blades.
+    /// that estimate's 0.068 s (at 1500 rpm) cannot be reached with 1900 rpm and real blades.
     /// CCPM-120 mixing is a firmware concern: here the controls are the same four stick
     /// fractions as for the Bo-105. Gearing: θ1c = −8°·lat, θ1s = +8°·lon,
     /// θ0_TR = 5° − 25°·ped, θ0 = 2° + 12°·col.

@@ -467,7 +467,7 @@ pub fn structure_truth(
             .a(simulator, rate)
             .context("the linearization has no flapping states")?;
         // Padfield's convention as a fallback when the structure writes no rate coupling:
-        // DESIGN's states are the negatives of the simulator's (bo105 README).
+        // The paper's flap states are the negatives of the simulator's (bo105 README).
         // The flapping states are not measured, so their scale is the structure's choice:
         // it fixes the rate coupling (−1 per rad/s in the shipped file, where the
         // simulator's disc has 1.05). b = s·β with s = (structure coupling)/(simulator's)

@@ -10,7 +10,7 @@ use sweephold_protocol::{
 use super::records::{Channel, Record};
 use crate::random::SplitMix64;
 
-/// Tischler's exponential sweep, closed form (DESIGN.md §1):
+/// Tischler's exponential sweep, closed form:
 /// θ(t) = ω_min t + (ω_max − ω_min)·C2·[(T/C1)(e^{C1 t/T} − 1) − t], C1 = 4,
 /// C2 = 1/(e⁴ − 1); the signal is A·sin θ(t) on [0, T] and 0 outside.
 #[derive(Clone, Copy, Debug)]
