@@ -396,3 +396,65 @@ fn decode_to_a_file_writes_it_whole_or_not_at_all() {
     assert!(names.is_empty(), "temporary files left: {names:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn frf_reads_the_swept_axis_from_its_own_decoded_csv() {
+    let dir = scratch("decoded-csv");
+    flown_data(&dir);
+    let decode = |dumps: &[&str], csv: &str| {
+        let mut args = vec!["decode"];
+        args.extend_from_slice(dumps);
+        args.extend(["-o", csv, "-q"]);
+        let output = sweephold(&dir, &args);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    };
+    // Two dumps decoded into one file: their times restart, which frf names.
+    decode(&["data/fly/lat-1.bin", "data/fly/lat-2.bin"], "both.csv");
+    let output = sweephold(
+        &dir,
+        &["frf", "both.csv", "--band", "0.2,31.4", "--out", "x.json"],
+    );
+    assert_one_line_error(
+        &output,
+        1,
+        "decode each dump to its own file",
+        "frf both.csv",
+    );
+    // One file per dump.
+    decode(&["data/fly/lat-1.bin"], "lat-1.csv");
+    decode(&["data/fly/lat-2.bin"], "lat-2.csv");
+    let csv = std::fs::read(dir.join("lat-1.csv")).unwrap();
+    let args = [
+        "frf",
+        "lat-1.csv",
+        "lat-2.csv",
+        "--band",
+        "0.2,31.4",
+        "--out",
+        "csv-frf.json",
+    ];
+    let output = sweephold(&dir, &args);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let document: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("csv-frf.json")).unwrap()).unwrap();
+    let pairs = document["pairs"].as_array().expect("pairs");
+    assert!(!pairs.is_empty());
+    // Every response is to the lateral stick the `primary` column names.
+    for pair in pairs {
+        assert_eq!(pair["input"], "lat", "{}", pair["output"]);
+    }
+    assert_eq!(
+        std::fs::read(dir.join("lat-1.csv")).unwrap(),
+        csv,
+        "the CSV is unchanged"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -245,6 +245,21 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
             format!("time column `{}` does not increase", columns.time),
         ));
     }
+    // Several records in one file (e.g. `decode a.bin b.bin -o x.csv`: its time restarts
+    // with each dump) are one record per file here.
+    if let Some(i) = time.windows(2).position(|t| t[1] <= t[0]) {
+        return Err(error(
+            0,
+            format!(
+                "time column `{}` steps back at kept row {} ({} s → {} s): a CSV file holds \
+                 one record here; decode each dump to its own file",
+                columns.time,
+                i + 1,
+                time[i],
+                time[i + 1]
+            ),
+        ));
+    }
     if let Some(i) = time
         .windows(2)
         .position(|t| ((t[1] - t[0]) - step).abs() > 0.25 * step)
