@@ -63,7 +63,7 @@ pub struct FrfArgs {
     /// coherence does not see how few independent windows an estimate rests on: at the
     /// bottom of the band only the longest window resolves a frequency, and γ² = 0.65 there
     /// scatters three times as much as from the shorter windows. What it does to a fit is
-    /// measured in the README ("`sweephold frf`").
+    /// measured in docs/decisions/2026-11-21-random-error-bound.md.
     #[arg(long, value_name = "E|none", default_value = "0.15", value_parser = parse_max_random_error, allow_hyphen_values = true)]
     pub max_random_error: MaxRandomError,
     /// Number of window lengths (from 20π/ω_max to half the record), 1–20.
@@ -138,7 +138,7 @@ pub enum EstimatorArg {
     Cross,
     /// The recorded sweep as instrument of the swept control: free of the bias an engaged
     /// hold puts into the cross-spectral estimate by feeding sensor noise into the stick,
-    /// but more scattered (see the README); dumps only
+    /// but more scattered (see docs/cli.md, frf); dumps only
     SweepReference,
 }
 

@@ -1,6 +1,6 @@
 //! The frequency-response document (`frf.json`): what `sweephold frf` writes and
-//! `sweephold fit` reads. Its layout is part of the user interface (README, section
-//! `frf.json`); change it only compatibly.
+//! `sweephold fit` reads. Its layout is part of the user interface (docs/formats.md,
+//! section `frf.json`); change it only compatibly.
 //!
 //! **Every reading is checked.** [`FrfDocument`] deserialises through
 //! [`FrfDocument::validate`], so whichever reader parses a document (`fit`, `report`, a

@@ -1,6 +1,6 @@
-//! `summary.json` of `sweephold campaign` (layout documented in the README's campaign
-//! section; later checks read these names). Every section is null until its stage has
-//! completed, so a campaign stopped by an error still writes what it has.
+//! `summary.json` of `sweephold campaign` (layout documented in docs/formats.md,
+//! "Campaign summary.json"; later checks read these names). Every section is null until
+//! its stage has completed, so a campaign stopped by an error still writes what it has.
 
 use std::collections::BTreeMap;
 

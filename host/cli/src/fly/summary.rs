@@ -1,4 +1,4 @@
-//! `summary.json` of `sweephold fly` (layout documented in the README; later checks read
+//! `summary.json` of `sweephold fly` (layout documented in docs/formats.md; later checks read
 //! these names).
 
 use std::collections::BTreeMap;

@@ -24,7 +24,7 @@ pub struct FrfOptions {
     /// longest window resolves the frequency, with two or three independent averages, and
     /// a γ² = 0.65 estimate there scatters by ε_r ≈ 0.3 where the same γ² from the shorter
     /// windows scatters by 0.1. The value and its trade are measured over 20 simulated
-    /// Bo-105 campaigns in the README ("`sweephold frf`").
+    /// Bo-105 campaigns in docs/decisions/2026-11-21-random-error-bound.md.
     pub max_random_error: Option<f64>,
     /// A control whose RMS is below this fraction of the swept control's RMS counts as
     /// not excited and is left out of the conditioning (default 0.01).
@@ -90,8 +90,8 @@ pub enum ResponseEstimator {
     /// instrument and the other controls as their own ([`reference`](super::reference)).
     /// Needs records with reference channels (telemetry dumps). Coherences and valid
     /// ranges stay those of the cross-spectral estimate; the random error grows by the
-    /// estimator's variance ratio. Less biased, more scattered: README, "Frequency
-    /// responses", has the measured trade.
+    /// estimator's variance ratio. Less biased, more scattered: the measured trade is
+    /// in docs/decisions/2026-11-21-sweep-reference-estimator.md.
     SweepReference,
 }
 

@@ -18,7 +18,8 @@
 //! (y = Σ_j H_j u_j + v, multiplied by conj(z_i) and averaged; for the swept control's
 //! row the v term averages out). The other controls are their own instruments because
 //! their recorded excitation, the off-axis noise, is weak next to their holds' output:
-//! as instruments they multiply the scatter (measured over 20 seeded campaigns, README).
+//! as instruments they multiply the scatter (measured over 20 seeded campaigns,
+//! docs/decisions/2026-11-21-sweep-reference-estimator.md).
 //! G_zu is not Hermitian, so it is solved by LU with partial pivoting, on the normalised
 //! matrix `Â = D_z^{-1/2} G_zu D_u^{-1/2}` whose entries satisfy |Â_ij|² = coherence of z_i
 //! with u_j ≤ 1. A pivot with |p|² below `min_pivot` means the instruments do not drive
