@@ -26,7 +26,7 @@ pub enum Format {
 /// Arguments of `sweephold decode`.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Columns are listed in the README (section `decode`). A summary goes to \
+    after_help = "Columns are listed in docs/formats.md. A summary goes to \
 stderr: good frames, corrupt frames skipped, tick gaps, tick steps back (a Sample whose tick \
 is not after the previous one's), duration, vehicle, protocol version; with CSV output the \
 events are listed there too.\n\nExit status: 0 when at least one good \

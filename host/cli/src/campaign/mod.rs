@@ -81,8 +81,8 @@ pub mod files {
 #[command(
     after_help = "Writes into DIR: fly-cah/, fly-standard/, fly-noise/ (the sweep \
 dumps and fly's summary.json per mode), verify-doublet/ (held-out doublets), frf.json, \
-model6.json, model9.json, truth-model9.json, verify.json, summary.json (layout in the \
-README) and report.html. The campaign is built in DIR.partial and replaces DIR only \
+model6.json, model9.json, truth-model9.json, verify.json, summary.json (layout in \
+docs/formats.md) and report.html. The campaign is built in DIR.partial and replaces DIR only \
 when it completes. A failing stage, or Ctrl-C (the campaign stops after the current \
 stage), stops it with the stage's name: DIR keeps the previous complete campaign, and \
 the stopped one's files, with the error in its summary.json, are kept in DIR.failed. \

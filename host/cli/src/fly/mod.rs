@@ -120,7 +120,7 @@ impl VehicleArg {
 #[command(
     after_help = "Each record is written as DIR/<axis>-<n>.bin (the telemetry exactly as the \
 flight controller streamed it: read it with `sweephold decode` or `sweephold frf`), plus \
-DIR/summary.json (layout in the README). The same seed gives byte-identical dumps. With \
+DIR/summary.json (layout in docs/formats.md). The same seed gives byte-identical dumps. With \
 `--fc qemu` each record also gets DIR/<axis>-<n>.log: the image's defmt log decoded against \
 its ELF, one line per message (loop tick, level, text)."
 )]
