@@ -91,23 +91,86 @@ impl FileId {
 /// A file written atomically: bytes go to a temporary file in the destination's folder
 /// (same file system, so the final rename is atomic) and replace the destination only on
 /// [`AtomicFile::commit`]. Dropped without a commit, the temporary file is removed and
-/// the destination is untouched.
+/// the destination is untouched. A destination that is a symbolic link has its target
+/// replaced (the link stays); one that is a device, pipe or socket (`/dev/null`,
+/// `/dev/stdout`, a FIFO) is written in place, since a rename would put a plain file
+/// where the device was.
 pub struct AtomicFile {
     destination: PathBuf,
-    file: BufWriter<tempfile::NamedTempFile>,
+    file: BufWriter<Output>,
+}
+
+/// Where an [`AtomicFile`]'s bytes go until the commit.
+enum Output {
+    /// A temporary file renamed over the destination on commit.
+    Temporary(tempfile::NamedTempFile),
+    /// The destination itself (not a regular file: written in place).
+    InPlace(fs::File),
+}
+
+impl Write for Output {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        match self {
+            Output::Temporary(file) => file.write(buf),
+            Output::InPlace(file) => file.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match self {
+            Output::Temporary(file) => file.flush(),
+            Output::InPlace(file) => file.flush(),
+        }
+    }
+}
+
+/// How a destination path is written.
+#[derive(Debug, PartialEq, Eq)]
+enum Destination {
+    /// A regular file, or nothing yet, at this path (links resolved): replaced by rename.
+    Replace(PathBuf),
+    /// A device, pipe or socket: written in place.
+    InPlace,
+}
+
+impl Destination {
+    /// Classify `path` without touching it.
+    fn of(path: &Path) -> anyhow::Result<Destination> {
+        match fs::metadata(path) {
+            Ok(meta) if meta.is_dir() => bail!("cannot write {}: it is a folder", path.display()),
+            Ok(meta) if meta.is_file() => Ok(Destination::Replace(
+                fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+            )),
+            Ok(_) => Ok(Destination::InPlace),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+                Ok(Destination::Replace(path.to_path_buf()))
+            }
+            Err(e) => Err(e).with_context(|| format!("cannot write {}", path.display())),
+        }
+    }
 }
 
 impl AtomicFile {
     /// Start writing `destination` (its folder must exist).
     pub fn create(destination: &Path) -> anyhow::Result<AtomicFile> {
-        let folder = match destination.parent() {
+        let target = match Destination::of(destination)? {
+            Destination::InPlace => {
+                let file = fs::OpenOptions::new()
+                    .write(true)
+                    .open(destination)
+                    .with_context(|| format!("cannot write {}", destination.display()))?;
+                return Ok(AtomicFile {
+                    destination: destination.to_path_buf(),
+                    file: BufWriter::with_capacity(256 * 1024, Output::InPlace(file)),
+                });
+            }
+            Destination::Replace(target) => target,
+        };
+        let folder = match target.parent() {
             Some(parent) if !parent.as_os_str().is_empty() => parent,
             _ => Path::new("."),
         };
-        if destination.is_dir() {
-            bail!("cannot write {}: it is a folder", destination.display());
-        }
-        let name = destination
+        let name = target
             .file_name()
             .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
         let prefix = format!(".{name}.");
@@ -124,24 +187,29 @@ impl AtomicFile {
             .tempfile_in(folder)
             .with_context(|| format!("cannot create {}", destination.display()))?;
         Ok(AtomicFile {
-            destination: destination.to_path_buf(),
-            file: BufWriter::with_capacity(256 * 1024, file),
+            destination: target,
+            file: BufWriter::with_capacity(256 * 1024, Output::Temporary(file)),
         })
     }
 
-    /// Flush, sync and rename over the destination.
+    /// Flush, sync and rename over the destination (or, in place, flush).
     pub fn commit(self) -> anyhow::Result<()> {
         let destination = self.destination;
         let context = || format!("cannot write {}", destination.display());
-        let file = self
+        let output = self
             .file
             .into_inner()
             .map_err(|e| e.into_error())
             .with_context(context)?;
-        file.as_file().sync_all().with_context(context)?;
-        file.persist(&destination)
-            .map_err(|e| e.error)
-            .with_context(context)?;
+        match output {
+            Output::Temporary(file) => {
+                file.as_file().sync_all().with_context(context)?;
+                file.persist(&destination)
+                    .map_err(|e| e.error)
+                    .with_context(context)?;
+            }
+            Output::InPlace(mut file) => file.flush().with_context(context)?,
+        }
         Ok(())
     }
 }
@@ -408,6 +476,30 @@ mod tests {
         // No temporary file is left behind.
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
         assert!(write_atomic(&dir, b"x").is_err());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_device_is_written_in_place_and_a_link_keeps_pointing_at_its_target() {
+        // Classified only: a rename over /dev/null would replace the device with a file.
+        assert_eq!(
+            Destination::of(Path::new("/dev/null")).unwrap(),
+            Destination::InPlace
+        );
+        let dir = scratch("link");
+        let target = dir.join("target.json");
+        fs::write(&target, b"old").unwrap();
+        #[cfg(unix)]
+        {
+            let link = dir.join("link.json");
+            std::os::unix::fs::symlink(&target, &link).unwrap();
+            write_atomic(&link, b"new").unwrap();
+            assert!(fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink());
+            assert_eq!(fs::read(&target).unwrap(), b"new");
+        }
         fs::remove_dir_all(&dir).unwrap();
     }
 
