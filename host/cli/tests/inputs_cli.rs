@@ -458,3 +458,49 @@ fn frf_reads_the_swept_axis_from_its_own_decoded_csv() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A named pipe (like `/dev/null` or `/dev/stdout`) as output is written in place: a
+/// rename over it would leave a plain file where the pipe or device was.
+#[cfg(unix)]
+#[test]
+fn a_pipe_as_output_is_written_in_place() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = scratch("pipe");
+    flown_data(&dir);
+    let pipe = dir.join("rows.pipe");
+    let made = Command::new("mkfifo")
+        .arg(&pipe)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    // A second name for the pipe, to release the reader should the output replace it.
+    let keep = dir.join("keep.pipe");
+    std::fs::hard_link(&pipe, &keep).unwrap();
+    let reader = {
+        let pipe = pipe.clone();
+        std::thread::spawn(move || std::fs::read(pipe).expect("the pipe reads"))
+    };
+    let output = sweephold(
+        &dir,
+        &["decode", "data/fly/lat-1.bin", "-o", "rows.pipe", "-q"],
+    );
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let still_a_pipe = std::fs::symlink_metadata(&pipe)
+        .unwrap()
+        .file_type()
+        .is_fifo();
+    if !still_a_pipe {
+        drop(std::fs::OpenOptions::new().write(true).open(&keep));
+    }
+    let rows = reader.join().unwrap();
+    assert!(still_a_pipe, "the pipe was replaced by a file");
+    assert!(
+        rows.starts_with(b"tick,time_s,"),
+        "the rows came through the pipe"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
