@@ -29,9 +29,11 @@ pub enum Format {
     after_help = "Columns are listed in docs/formats.md. A summary goes to \
 stderr: good frames, corrupt frames skipped, tick gaps, tick steps back (a Sample whose tick \
 is not after the previous one's), duration, vehicle, protocol version; with CSV output the \
-events are listed there too.\n\nExit status: 0 when at least one good \
-frame was read; 1 on a missing or unreadable file, a dump of another protocol major version, \
-or no valid frame at all."
+events are listed there too. With -o FILE the file appears only when decoding \
+succeeded (an earlier FILE stays as it was otherwise); a FILE that is one of the dumps is \
+refused.\n\nExit status: 0 when at least one good frame was read; 1 on a missing or \
+unreadable file or a folder, an output that is an input, a dump of another protocol major \
+version, or no valid frame at all."
 )]
 pub struct DecodeArgs {
     /// Telemetry dumps (raw frame streams as the flight controller sends them).

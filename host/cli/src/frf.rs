@@ -297,7 +297,7 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
 
     // Plots first: the document is the result, written last and whole.
     let plots = match &args.plots {
-        Some(dir) => write_files_into(dir, &render_plots(&analysis)?)?,
+        Some(dir) => write_files_into("--plots", dir, &render_plots(&analysis)?)?,
         None => 0,
     };
     write_json(&args.out, &analysis.document)?;

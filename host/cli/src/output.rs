@@ -241,8 +241,12 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result
 
 /// Write `files` (`(name, text)`, e.g. rendered plots) into the folder `dir`, creating it;
 /// each file atomically. Returns how many were written.
-pub fn write_files_into(dir: &Path, files: &[(String, String)]) -> anyhow::Result<usize> {
-    check_output_folder("--plots", dir)?;
+pub fn write_files_into(
+    role: &str,
+    dir: &Path,
+    files: &[(String, String)],
+) -> anyhow::Result<usize> {
+    check_output_folder(role, dir)?;
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     for (name, text) in files {
         write_atomic(&dir.join(name), text.as_bytes())?;

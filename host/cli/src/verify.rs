@@ -147,7 +147,8 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
         write_verification(&mut report, &verification);
         all_theil.extend(verification.outputs.iter().map(|o| o.theil));
         if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {
-            let written = write_files_into(dir, &render_verification_plots(&verification)?)?;
+            let written =
+                write_files_into("--plots", dir, &render_verification_plots(&verification)?)?;
             let _ = writeln!(report, "wrote {written} plots to {}", dir.display());
         }
     }

@@ -122,7 +122,9 @@ impl VehicleArg {
 flight controller streamed it: read it with `sweephold decode` or `sweephold frf`), plus \
 DIR/summary.json (layout in docs/formats.md). The same seed gives byte-identical dumps. With \
 `--fc qemu` each record also gets DIR/<axis>-<n>.log: the image's defmt log decoded against \
-its ELF, one line per message (loop tick, level, text)."
+its ELF, one line per message (loop tick, level, text). The records are flown into \
+DIR.partial, which replaces DIR whole when every record was written; a failed run leaves DIR \
+as it was and its own files in DIR.failed. DIR must be new, empty or an earlier run's folder."
 )]
 pub struct FlyArgs {
     /// Aircraft simulated.
