@@ -22,5 +22,5 @@ pub mod vehicle;
 pub use linearize::{linearize, linearize_with, Linearization};
 pub use model::State;
 pub use sim::{ActuatorModel, SensorNoise, SensorReading, Sim, SimOptions};
-pub use trim::{trim, Trim, TrimError, KNOT};
+pub use trim::{trim, trim_steady, SteadyFlight, Trim, TrimError, KNOT};
 pub use vehicle::{BladePitch, Gearing, Helicopter, Rotor, Surface, UnknownVehicle, Vehicle};

@@ -71,6 +71,12 @@ pub struct FitArgs {
     /// file does not declare is an error.
     #[arg(long = "constant", value_name = "NAME=VALUE", value_parser = parse_constant)]
     pub constants: Vec<(String, f64)>,
+    /// Trim points (CSV: label, u v w p q r phi theta, lat lon ped col per steady flight;
+    /// `sweephold sim trim-points` writes the simulator's): the structure's `trim_derived`
+    /// parameters (the shipped files: Lv Mu Nv Zw Nr) are derived from the steady-state
+    /// balance at the points and held, status `trim`, instead of fitted.
+    #[arg(long, value_name = "FILE")]
+    pub trim_points: Option<PathBuf>,
 }
 
 /// `NAME=VALUE` of `--constant`.
@@ -116,6 +122,7 @@ fn model_structure(
 pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let mut inputs = vec![args.frf.as_path()];
     inputs.extend(args.start_from.as_deref());
+    inputs.extend(args.trim_points.as_deref());
     if args.model.is_file() {
         inputs.push(args.model.as_path());
     }
@@ -126,6 +133,18 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.start_from {
         check_input_file("--start-from", path)?;
     }
+    let trim_points = match &args.trim_points {
+        None => None,
+        Some(path) => {
+            check_input_file("--trim-points", path)?;
+            let text = fs::read_to_string(path)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            Some(
+                sysid::fit::trim::TrimPoints::parse_csv(&text)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+            )
+        }
+    };
     let frf_text = fs::read_to_string(&args.frf)
         .with_context(|| format!("cannot read {}", args.frf.display()))?;
     let data: FrfDocument = serde_json::from_str(&frf_text).with_context(|| {
@@ -175,6 +194,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         max_starts: args.max_starts.max(1),
         seed: args.seed,
         reduce: args.reduce,
+        trim_points,
         ..FitOptions::default()
     };
     // With --start-from, the file's own starts are the fallback: the lower J_ave wins.
@@ -419,6 +439,7 @@ lat = "b"
             points: 20,
             truth: None,
             constants: Vec::new(),
+            trim_points: None,
         };
         run(&args).unwrap();
         let document: ModelDocument =

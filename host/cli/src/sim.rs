@@ -3,6 +3,7 @@
 //! ```text
 //! sweephold sim trim      --vehicle bo105 [--speed KT] [--json]
 //! sweephold sim linearize --vehicle bo105 [--speed KT] [--dynamic-inflow] [--json]
+//! sweephold sim trim-points --vehicle bo105 [--out FILE]
 //! ```
 //!
 //! Arguments are parsed here (not by clap's value parsers) so that a bad vehicle or speed
@@ -10,10 +11,15 @@
 
 use std::fmt::Write as _;
 
+use std::path::PathBuf;
+
 use anyhow::{anyhow, Context};
-use bo105::{linearize_with, trim, Helicopter, Linearization, Trim, Vehicle};
+use bo105::{
+    linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim, Vehicle,
+};
 use clap::{Args, Subcommand};
 use serde_json::{json, Map, Value};
+use sysid::fit::trim::{TrimPoint, TrimPoints};
 
 /// Arguments of `sweephold sim`.
 #[derive(Args, Debug)]
@@ -30,6 +36,64 @@ pub enum SimCommand {
     Trim(CaseArgs),
     /// Linearize about a trim: A, B, C, D, eigenvalues, τ_f and quasi-static derivatives.
     Linearize(LinearizeArgs),
+    /// Trim points for `fit --trim-points`: the nonlinear model trimmed in hover, 1 m/s
+    /// forward, aft, right and left, climbing and descending at 0.5 m/s and turning on the
+    /// spot at ±0.1 rad/s (CSV: body velocities, rates, attitude and sticks per point).
+    TrimPoints(TrimPointsArgs),
+}
+
+/// Arguments of `sim trim-points`.
+#[derive(Args, Debug)]
+pub struct TrimPointsArgs {
+    /// Vehicle: bo105 or trex700l.
+    #[arg(long, default_value = "bo105", value_name = "NAME")]
+    pub vehicle: String,
+    /// Write the CSV here (atomically) instead of to standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
+/// The steady flights of [`simulator_trim_points`]: label, velocity over the ground
+/// (north, east, down) [m/s], turn rate [rad/s]. Small, so that the hover linearization
+/// holds (the fuselage drag's u·|u| is the largest departure: 4 % of the u row's terms at
+/// 0.05 m/s, linear in the speed), and symmetric, so that the even part of that
+/// departure cancels in the least-squares gradient.
+pub const TRIM_FLIGHTS: [(&str, [f64; 3], f64); 9] = [
+    ("hover", [0.0, 0.0, 0.0], 0.0),
+    ("forward", [1.0, 0.0, 0.0], 0.0),
+    ("aft", [-1.0, 0.0, 0.0], 0.0),
+    ("right", [0.0, 1.0, 0.0], 0.0),
+    ("left", [0.0, -1.0, 0.0], 0.0),
+    ("descent", [0.0, 0.0, 0.5], 0.0),
+    ("climb", [0.0, 0.0, -0.5], 0.0),
+    ("turn right", [0.0, 0.0, 0.0], 0.1),
+    ("turn left", [0.0, 0.0, 0.0], -0.1),
+];
+
+/// The trim points of `vehicle` at [`TRIM_FLIGHTS`]: what a pilot would record flying
+/// them, taken from the nonlinear model's trims (exact: no measurement noise).
+pub fn simulator_trim_points(vehicle: Vehicle) -> anyhow::Result<TrimPoints> {
+    let heli = vehicle.helicopter();
+    let points = TRIM_FLIGHTS
+        .iter()
+        .map(|&(label, velocity_ned, turn_rate)| {
+            let flight = SteadyFlight {
+                velocity_ned,
+                turn_rate,
+            };
+            let t = trim_steady(&heli, &flight)
+                .with_context(|| format!("{} trim point `{label}`", vehicle.name()))?;
+            let x = &t.state.0;
+            let mut states = [0.0; 8];
+            states.copy_from_slice(&x[..8]);
+            Ok(TrimPoint {
+                label: label.to_string(),
+                states,
+                controls: t.controls,
+            })
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(TrimPoints { points })
 }
 
 /// Which aircraft and flight condition.
@@ -82,6 +146,17 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
                 serde_json::to_string_pretty(&linearization_json(vehicle, &trimmed, &model))? + "\n"
             } else {
                 linearization_table(&heli, &trimmed, &model)
+            }
+        }
+        SimCommand::TrimPoints(points) => {
+            let vehicle: Vehicle = points.vehicle.parse().map_err(|e| anyhow!("{e}"))?;
+            let csv = simulator_trim_points(vehicle)?.to_csv();
+            match &points.out {
+                Some(path) => {
+                    crate::output::write_atomic(path, csv.as_bytes())?;
+                    return Ok(());
+                }
+                None => csv,
             }
         }
     };

@@ -21,6 +21,8 @@ pub enum Stage {
     FlyVerification,
     /// Frequency responses of the `cah` records.
     Frf,
+    /// Trim points (the simulator's steady flights), `trim-points.csv`.
+    TrimPoints,
     /// Quasi-steady 6-DOF fit (start values of the hybrid).
     Fit6Dof,
     /// 9-DOF hybrid fit with reduction.
@@ -35,13 +37,14 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in the order a campaign runs them.
-    pub const ALL: [Stage; 11] = [
+    pub const ALL: [Stage; 12] = [
         Stage::Setup,
         Stage::FlyCah,
         Stage::FlyStandard,
         Stage::FlyNoise,
         Stage::FlyVerification,
         Stage::Frf,
+        Stage::TrimPoints,
         Stage::Fit6Dof,
         Stage::Fit9Dof,
         Stage::Truth,
@@ -58,6 +61,7 @@ impl Stage {
             Stage::FlyNoise => "fly_noise",
             Stage::FlyVerification => "fly_verification",
             Stage::Frf => "frf",
+            Stage::TrimPoints => "trim_points",
             Stage::Fit6Dof => "fit_6dof",
             Stage::Fit9Dof => "fit_9dof",
             Stage::Truth => "truth",
@@ -75,6 +79,7 @@ impl Stage {
             Stage::FlyNoise => "flying the sweeps, hold plus off-axis noise",
             Stage::FlyVerification => "flying the held-out doublets",
             Stage::Frf => "frequency responses of the cah records",
+            Stage::TrimPoints => "trim points (steady flights)",
             Stage::Fit6Dof => "6-DOF quasi-steady fit (start values)",
             Stage::Fit9Dof => "9-DOF hybrid fit with reduction",
             Stage::Truth => "scoring against the simulator's truth",

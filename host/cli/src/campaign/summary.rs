@@ -140,6 +140,27 @@ pub struct FitSummary {
     /// null when its modes could not be computed, and in older files.
     #[serde(default)]
     pub poles_at_origin: Option<usize>,
+    /// The quasi-static speed derivatives M_u, L_v, N_v of the identified model (flapping
+    /// at its steady value: what the trim points fix, whichever parameters carry it),
+    /// with the truth model's once the truth stage has run. Empty in older files.
+    #[serde(default)]
+    pub speed_derivatives: Vec<SpeedDerivativeSummary>,
+    /// What the trim points gave (`trim-points.csv`): null without them.
+    #[serde(default)]
+    pub trim: Option<sysid::fit::trim::TrimOutcome>,
+}
+
+/// One quasi-static speed derivative of [`FitSummary::speed_derivatives`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedDerivativeSummary {
+    /// `Mu`, `Lv` or `Nv`.
+    pub name: String,
+    /// The identified model's value [1/(m·s)].
+    pub value: Option<f64>,
+    /// The truth model's.
+    pub truth: Option<f64>,
+    /// 100·(value − truth)/|truth|.
+    pub error_percent: Option<f64>,
 }
 
 /// Verification of one held-out record.

@@ -1111,6 +1111,8 @@ mod tests {
             truth_modes,
             hover_modes_matched: Some(hover),
             poles_at_origin: Some(poles),
+            speed_derivatives: Vec::new(),
+            trim: None,
         }
     }
 

@@ -181,6 +181,8 @@ pub enum FitError {
     },
     /// A start-value source (a previous model) does not provide what is needed.
     StartValues(String),
+    /// The trim points cannot give the structure's `trim_derived` parameters.
+    TrimPoints(String),
 }
 
 impl fmt::Display for FitError {
@@ -225,6 +227,7 @@ impl fmt::Display for FitError {
                 write!(f, "pair {output}/{input} is not in both models")
             }
             Self::StartValues(message) => write!(f, "start values: {message}"),
+            Self::TrimPoints(message) => write!(f, "trim points: {message}"),
         }
     }
 }

@@ -20,6 +20,7 @@ pub mod report;
 pub mod start;
 pub mod structure;
 pub mod synthetic;
+pub mod trim;
 pub mod verify;
 
 #[cfg(test)]
@@ -65,6 +66,11 @@ pub struct FitOptions {
     /// move it near a minimum with the guideline limits): the model then slid into another
     /// minimum rather than losing a term the data do not determine ([`reduce`]).
     pub reduce_max_shift_cramer_rao: f64,
+    /// A reduction step is also undone when its refit moves a hover mode (|λ| < 3 rad/s)
+    /// of the model before it by more than this percentage of |λ|, or adds a pole at the
+    /// origin (default 10 %: well inside the 25 % a hover mode may be off the truth)
+    /// ([`reduce`]).
+    pub reduce_max_hover_mode_shift_percent: f64,
     /// Flag a Cramér–Rao bound above this percentage of the value.
     pub cramer_rao_limit_percent: f64,
     /// Flag an insensitivity above this percentage of the value.
@@ -75,6 +81,10 @@ pub struct FitOptions {
     /// `auto_range_limit`) spans at least this ratio ω_hi/ω_lo; narrower ones — usually a
     /// sliver where noise crossed the coherence threshold — are skipped and reported.
     pub min_auto_range_ratio: f64,
+    /// Trim points: with them the structure's `trim_derived` parameters are derived from
+    /// the steady-state balance at the points and held (status `trim`), re-derived as the
+    /// fit moves the others ([`trim`]). Without them those parameters are fitted.
+    pub trim_points: Option<trim::TrimPoints>,
 }
 
 impl Default for FitOptions {
@@ -89,10 +99,12 @@ impl Default for FitOptions {
             reduce: false,
             reduce_max_cost_rise: 2.0,
             reduce_max_shift_cramer_rao: 10.0,
+            reduce_max_hover_mode_shift_percent: 10.0,
             cramer_rao_limit_percent: 20.0,
             insensitivity_limit_percent: 10.0,
             correlation_limit: 0.9,
             min_auto_range_ratio: 3.0,
+            trim_points: None,
         }
     }
 }
@@ -105,13 +117,16 @@ pub enum ParameterStatus {
     Free,
     /// Held at its value (by the file, or dropped by the reduction at zero).
     Fixed,
+    /// Derived from trim points and held ([`trim`]).
+    Trim,
     /// A linear expression of other parameters.
     Constrained,
 }
 
 /// A warning on an identified parameter (guidelines of the paper and Tischler & Remple).
 /// In JSON: `{"flag": "cramer_rao"}`, `{"flag": "insensitive"}`,
-/// `{"flag": "correlated", "with": "Lp", "correlation": 0.93}` — read and written through
+/// `{"flag": "correlated", "with": "Lp", "correlation": 0.93}`,
+/// `{"flag": "needed", "reason": "…"}` — read and written through
 /// [`FlagRecord`], not serde's internal tagging, whose buffering cannot hold serde_json's
 /// arbitrary-precision numbers (switched on by another crate of the build).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -128,6 +143,22 @@ pub enum AccuracyFlag {
         /// The correlation coefficient.
         correlation: f64,
     },
+    /// Kept above the Cramér–Rao or insensitivity guideline because the reduction found
+    /// the fit needs it: dropping it raised J_ave too much, moved a hover mode, slid into
+    /// another minimum or left no usable model. Shown beside the guideline flags it
+    /// excuses (the paper keeps L_f(β1c) that way).
+    Needed {
+        /// Why, from the reduction step that restored it, e.g. `moves the heave mode
+        /// −0.309 → −0.0012`.
+        reason: String,
+    },
+}
+
+impl AccuracyFlag {
+    /// Whether this flag is a guideline violation (Cramér–Rao or insensitivity).
+    pub fn is_guideline_violation(&self) -> bool {
+        matches!(self, AccuracyFlag::CramerRao | AccuracyFlag::Insensitive)
+    }
 }
 
 /// The JSON form of an [`AccuracyFlag`].
@@ -141,21 +172,26 @@ pub struct FlagRecord {
     /// The correlation coefficient (`correlated` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub correlation: Option<f64>,
+    /// Why the fit needs the parameter (`needed` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 impl From<AccuracyFlag> for FlagRecord {
     fn from(flag: AccuracyFlag) -> FlagRecord {
-        let (name, with, correlation) = match flag {
-            AccuracyFlag::CramerRao => ("cramer_rao", None, None),
-            AccuracyFlag::Insensitive => ("insensitive", None, None),
+        let (name, with, correlation, reason) = match flag {
+            AccuracyFlag::CramerRao => ("cramer_rao", None, None, None),
+            AccuracyFlag::Insensitive => ("insensitive", None, None, None),
             AccuracyFlag::Correlated { with, correlation } => {
-                ("correlated", Some(with), Some(correlation))
+                ("correlated", Some(with), Some(correlation), None)
             }
+            AccuracyFlag::Needed { reason } => ("needed", None, None, Some(reason)),
         };
         FlagRecord {
             flag: name.to_string(),
             with,
             correlation,
+            reason,
         }
     }
 }
@@ -173,6 +209,9 @@ impl TryFrom<FlagRecord> for AccuracyFlag {
             ("correlated", _, _) => {
                 Err("a `correlated` flag needs `with` and `correlation`".into())
             }
+            ("needed", _, _) => Ok(AccuracyFlag::Needed {
+                reason: record.reason.unwrap_or_default(),
+            }),
             (other, _, _) => Err(format!("unknown accuracy flag `{other}`")),
         }
     }
@@ -251,6 +290,8 @@ pub struct FitResult {
     pub reduction: Vec<ReductionStep>,
     /// `auto` pairs left out because their data support no usable range.
     pub skipped_pairs: Vec<SkippedPair>,
+    /// What the trim points gave (None without trim points or `trim_derived`).
+    pub trim: Option<trim::TrimOutcome>,
 }
 
 impl FitResult {
@@ -299,8 +340,10 @@ pub fn fit(
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
     let mut result = fit_on_grids(&usable, &grids, options)?;
+    result = settle_trim(result, &grids, options)?;
     if options.reduce {
         result = reduce::reduce(result, &grids, options)?;
+        result = settle_trim(result, &grids, options)?;
     }
     result.skipped_pairs = skipped;
     Ok(result)
@@ -394,11 +437,78 @@ pub fn fit_from_alternative_starts(
             outcome.average_cost = Ok(result.average_cost);
         }
     }
+    result = settle_trim(result, &grids, options)?;
     if options.reduce {
         result = reduce::reduce(result, &grids, options)?;
+        result = settle_trim(result, &grids, options)?;
     }
     result.skipped_pairs = skipped;
     Ok((result, outcomes))
+}
+
+/// Derive the structure's `trim_derived` parameters from the trim points, hold them
+/// (status `trim`) and refit from the current values; repeat until they settle
+/// ([`trim`]). Without trim points, or without `trim_derived`, `result` is returned as it
+/// is. Each refit is one start from the current minimum and one perturbed restart, as in
+/// the reduction.
+fn settle_trim(
+    mut current: FitResult,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let Some(points) = &options.trim_points else {
+        return Ok(current);
+    };
+    let names = current.structure.trim_derived.clone();
+    if names.is_empty() {
+        return Ok(current);
+    }
+    let refit_options = FitOptions {
+        max_starts: options.max_starts.min(2),
+        ..options.clone()
+    };
+    let mut rounds = 0;
+    let mut settled = false;
+    let mut derived = Vec::new();
+    while rounds < trim::MAX_ROUNDS {
+        derived = trim::derive(&current.structure, &current.values, points, &names)
+            .map_err(|e| FitError::TrimPoints(e.to_string()))?;
+        let mut structure = current.structure.clone();
+        let mut change: f64 = 0.0;
+        let mut newly_held = false;
+        for d in &derived {
+            let Some(index) = structure.parameter_index(&d.name) else {
+                continue;
+            };
+            let parameter = &mut structure.parameters[index];
+            newly_held |= parameter.kind != ParameterKind::Trim;
+            change = change.max((d.value - parameter.value).abs() / d.value.abs().max(1e-12));
+            parameter.value = d.value;
+            parameter.kind = ParameterKind::Trim;
+            parameter.lower = None;
+            parameter.upper = None;
+        }
+        if !newly_held && change <= trim::SETTLED_RELATIVE_CHANGE {
+            settled = true;
+            break;
+        }
+        rounds += 1;
+        // Holding the derived parameters for the first time changes the cost surface
+        // (they were free): that refit gets the whole restart budget; later rounds only
+        // nudge them and restart from the minimum.
+        let round_options = if newly_held { options } else { &refit_options };
+        let reduction = std::mem::take(&mut current.reduction);
+        current = fit_on_grids(&structure, grids, round_options)?;
+        current.reduction = reduction;
+        reduce::flag_needed(&mut current);
+    }
+    current.trim = Some(trim::TrimOutcome {
+        points: points.points.len(),
+        rounds,
+        settled,
+        parameters: derived,
+    });
+    Ok(current)
 }
 
 /// A pair of the structure left out of the fit, and why.
@@ -676,6 +786,7 @@ fn finish_fit(
         minimum_confirmed,
         reduction: Vec::new(),
         skipped_pairs: Vec::new(),
+        trim: None,
     })
 }
 
@@ -726,7 +837,11 @@ fn parameter_reports(
                 None => ParameterReport {
                     name: parameter.name.clone(),
                     value,
-                    status: ParameterStatus::Fixed,
+                    status: if parameter.kind == ParameterKind::Trim {
+                        ParameterStatus::Trim
+                    } else {
+                        ParameterStatus::Fixed
+                    },
                     cramer_rao_percent: None,
                     insensitivity_percent: None,
                     flags: Vec::new(),

@@ -12,13 +12,25 @@
 //! cost nothing to remove). A parameter whose zero would make the mass matrix M singular
 //! (the flapping time constant τ_f) is never dropped: the result would not be a
 //! state-space model.
+//!
+//! **The physics guard.** J_ave weighs the fitted band, where the hover modes (below
+//! 3 rad/s) leave little trace, so a drop can pass the cost test and still change the
+//! aircraft: a heave damping at zero turns the heave mode into a pole at the origin, and
+//! a flap-back term at zero takes the hover oscillations with it. A step is therefore also
+//! undone when the refit moves any hover mode of the model before it by more than
+//! [`FitOptions::reduce_max_hover_mode_shift_percent`] (`|λ_after − λ_before| / |λ_before|`,
+//! modes paired one to one as in [`super::modes::pair_modes`]) or adds a pole at the
+//! origin. A parameter kept by any of these rules while it breaks the Cramér–Rao or
+//! insensitivity guideline is flagged [`AccuracyFlag::Needed`] with the reason.
 
 use serde::{Deserialize, Serialize};
 
 use super::cost::PairGrid;
 use super::error::FitError;
+use super::model::Model;
+use super::modes::{eigenvalue_text, modes, pair_modes, relative_error_percent, ModeName};
 use super::structure::ParameterKind;
-use super::{fit_on_grids, FitOptions, FitResult, ParameterReport, ParameterStatus};
+use super::{fit_on_grids, AccuracyFlag, FitOptions, FitResult, ParameterReport, ParameterStatus};
 
 /// One reduction step.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -40,6 +52,113 @@ pub struct ReductionStep {
     /// was undone whatever its cost; the reason names the parameter).
     #[serde(default)]
     pub left_the_minimum: bool,
+    /// The refit moved a hover mode beyond
+    /// [`FitOptions::reduce_max_hover_mode_shift_percent`] or added a pole at the origin
+    /// (so the step was undone whatever its cost): which mode, from where to where.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moved_hover_mode: Option<String>,
+}
+
+impl ReductionStep {
+    /// Why an undone step's parameter is needed, in words (None for an accepted step).
+    pub fn needed_because(&self) -> Option<String> {
+        if self.accepted {
+            return None;
+        }
+        Some(if let Some(mode) = &self.moved_hover_mode {
+            format!("without it the refit {mode}")
+        } else if self.left_the_minimum {
+            "without it the refit leaves the minimum".to_string()
+        } else if self.average_cost_after.is_finite() {
+            format!(
+                "without it J_ave rises {:.2} -> {:.2}",
+                self.average_cost_before, self.average_cost_after
+            )
+        } else {
+            "without it the model is unusable".to_string()
+        })
+    }
+}
+
+/// How the refit `after` changed the hover modes of `before` (module documentation), in
+/// words, when it moved one by more than `limit_percent` or added a pole at the origin;
+/// None when they stayed. A model whose modes cannot be computed counts as a change; a
+/// `before` without computable modes gives nothing to guard.
+pub fn hover_mode_change(before: &Model, after: &Model, limit_percent: f64) -> Option<String> {
+    let before_modes = modes(before).ok()?;
+    let Ok(after_modes) = modes(after) else {
+        return Some("has no computable modes".to_string());
+    };
+    let origin = |list: &[super::modes::Mode]| {
+        list.iter()
+            .filter(|m| m.name == ModeName::Origin)
+            .map(|m| m.poles)
+            .sum::<usize>()
+    };
+    let (origin_before, origin_after) = (origin(&before_modes), origin(&after_modes));
+    if origin_after > origin_before {
+        return Some(format!(
+            "puts {} pole(s) at the origin",
+            origin_after - origin_before
+        ));
+    }
+    let pairing = pair_modes(&before_modes, &after_modes);
+    let mut worst: Option<(f64, String)> = None;
+    for (mode, paired) in before_modes.iter().zip(&pairing) {
+        if !mode.is_hover_mode() {
+            continue;
+        }
+        let (moved_to, percent) = match paired.and_then(|k| after_modes.get(k)) {
+            Some(after_mode) => (
+                eigenvalue_text([after_mode.eigenvalue.re, after_mode.eigenvalue.im]),
+                relative_error_percent(after_mode.eigenvalue, mode.eigenvalue)
+                    .unwrap_or(f64::INFINITY),
+            ),
+            None => ("nothing".to_string(), f64::INFINITY),
+        };
+        if percent > limit_percent && worst.as_ref().is_none_or(|(w, _)| percent > *w) {
+            let text = format!(
+                "moves the {} mode {} -> {} ({:.0} %)",
+                mode.name.as_str(),
+                eigenvalue_text([mode.eigenvalue.re, mode.eigenvalue.im]),
+                moved_to,
+                percent
+            );
+            worst = Some((percent, text));
+        }
+    }
+    worst.map(|(_, text)| text)
+}
+
+/// Flag every free parameter that breaks a guideline and was kept by an undone step of
+/// `result.reduction` [`AccuracyFlag::Needed`], with the reason of the last such step.
+pub(crate) fn flag_needed(result: &mut FitResult) {
+    let steps = &result.reduction;
+    for report in result
+        .parameters
+        .iter_mut()
+        .filter(|p| p.status == ParameterStatus::Free)
+    {
+        if !report
+            .flags
+            .iter()
+            .any(AccuracyFlag::is_guideline_violation)
+            || report
+                .flags
+                .iter()
+                .any(|f| matches!(f, AccuracyFlag::Needed { .. }))
+        {
+            continue;
+        }
+        let reason = steps
+            .iter()
+            .rev()
+            .filter(|step| step.dropped == report.name)
+            .find_map(ReductionStep::needed_because);
+        if let Some(reason) = reason {
+            report.flags.push(AccuracyFlag::Needed { reason });
+        }
+    }
 }
 
 /// JSON has no infinity: a non-finite J is written as `null` and read back as +∞
@@ -178,6 +297,7 @@ pub fn reduce(
                 average_cost_after: f64::INFINITY,
                 accepted: false,
                 left_the_minimum: false,
+                moved_hover_mode: None,
             });
             needed.push((name, accepted_drops));
             continue;
@@ -197,7 +317,15 @@ pub fn reduce(
         let slid = shift
             .as_ref()
             .is_some_and(|(_, s)| *s > options.reduce_max_shift_cramer_rao);
-        let accepted = after - before < options.reduce_max_cost_rise && !slid;
+        let moved_hover_mode = refit.as_ref().and_then(|r| {
+            hover_mode_change(
+                &current.model,
+                &r.model,
+                options.reduce_max_hover_mode_shift_percent,
+            )
+        });
+        let accepted =
+            after - before < options.reduce_max_cost_rise && !slid && moved_hover_mode.is_none();
         let reason = match shift {
             Some((moved, s)) if slid => {
                 format!("{reason}; the refit moved {moved} by {s:.0} Cramér–Rao bounds")
@@ -211,6 +339,7 @@ pub fn reduce(
             average_cost_after: after,
             accepted,
             left_the_minimum: slid,
+            moved_hover_mode,
         });
         match refit {
             Some(refit) if accepted => {
@@ -221,6 +350,7 @@ pub fn reduce(
         }
     }
     current.reduction = steps;
+    flag_needed(&mut current);
     Ok(current)
 }
 
@@ -343,6 +473,67 @@ u = "b"
         assert_eq!(largest_shift(&unbounded, &after, "Nv"), None);
     }
 
+    /// A heave-only model ẇ = Zw·w + Zcol·col at `zw`.
+    fn heave_model(zw: f64) -> crate::fit::Model {
+        let text = format!(
+            "name = \"heave\"\nstates = [\"w\"]\ncontrols = [\"col\"]\noutputs = [\"w\"]\n\
+             pairs = [{{ output = \"w\", input = \"col\", range = [0.1, 10.0] }}]\n\
+             [parameters]\nZw = {zw:?}\nZcol = -14.0\n[F.w]\nw = \"Zw\"\n[G.w]\ncol = \"Zcol\"\n"
+        );
+        let structure = ModelStructure::parse(&text, "heave.toml").unwrap();
+        structure.model(&structure.values()).unwrap()
+    }
+
+    #[test]
+    fn the_guard_names_a_hover_mode_that_moves_or_goes_to_the_origin() {
+        let before = heave_model(-0.32);
+        // 3 % is within the 10 % limit.
+        assert_eq!(
+            super::hover_mode_change(&before, &heave_model(-0.31), 10.0),
+            None
+        );
+        // To −0.001: the heave mode is gone in all but name.
+        let moved = super::hover_mode_change(&before, &heave_model(-0.001), 10.0).unwrap();
+        assert!(moved.starts_with("moves the heave mode -0.32"), "{moved}");
+        assert!(moved.ends_with("(100 %)"), "{moved}");
+        // Exactly zero: a pole at the origin.
+        let origin = super::hover_mode_change(&before, &heave_model(0.0), 10.0).unwrap();
+        assert_eq!(origin, "puts 1 pole(s) at the origin");
+        // A mode above 3 rad/s is not guarded.
+        assert_eq!(
+            super::hover_mode_change(&heave_model(-5.0), &heave_model(-9.0), 10.0),
+            None
+        );
+    }
+
+    #[test]
+    fn needed_parameters_carry_the_reason_of_their_step() {
+        let step = |dropped: &str, accepted: bool, mode: Option<&str>| ReductionStep {
+            dropped: dropped.into(),
+            reason: "insensitivity 12.0 %".into(),
+            average_cost_before: 10.0,
+            average_cost_after: 14.5,
+            accepted,
+            left_the_minimum: false,
+            moved_hover_mode: mode.map(str::to_string),
+        };
+        assert_eq!(step("Xr", true, None).needed_because(), None);
+        assert_eq!(
+            step(
+                "Zw",
+                false,
+                Some("moves the heave mode -0.32 -> -0.001 (100 %)")
+            )
+            .needed_because()
+            .unwrap(),
+            "without it the refit moves the heave mode -0.32 -> -0.001 (100 %)"
+        );
+        assert_eq!(
+            step("Lfu", false, None).needed_because().unwrap(),
+            "without it J_ave rises 10.00 -> 14.50"
+        );
+    }
+
     #[test]
     fn a_step_that_could_not_be_evaluated_survives_a_json_round_trip() {
         let step = ReductionStep {
@@ -352,6 +543,7 @@ u = "b"
             average_cost_after: f64::INFINITY,
             accepted: false,
             left_the_minimum: false,
+            moved_hover_mode: None,
         };
         let json = serde_json::to_string(&step).unwrap();
         assert!(json.contains("\"average_cost_after\":null"), "{json}");

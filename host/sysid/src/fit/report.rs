@@ -121,6 +121,9 @@ pub struct ModelDocument {
     /// `auto` pairs left out of the fit, and why.
     #[serde(default)]
     pub skipped_pairs: Vec<super::SkippedPair>,
+    /// Parameters derived from trim points (absent without them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trim: Option<super::trim::TrimOutcome>,
 }
 
 /// `model.json` with its optional `truth` section and the model's `modes`: the
@@ -252,6 +255,7 @@ impl ModelDocument {
             minimum_confirmed: result.minimum_confirmed,
             reduction: result.reduction.clone(),
             skipped_pairs: result.skipped_pairs.clone(),
+            trim: result.trim.clone(),
         }
     }
 
@@ -306,6 +310,7 @@ fn parameter_rows(result: &FitResult, truth: Option<&TruthSection>) -> String {
         let status = match p.status {
             ParameterStatus::Free => "free",
             ParameterStatus::Fixed => "fixed",
+            ParameterStatus::Trim => "trim",
             ParameterStatus::Constrained => "constrained",
         };
         let flags: Vec<String> = p
@@ -317,6 +322,7 @@ fn parameter_rows(result: &FitResult, truth: Option<&TruthSection>) -> String {
                 AccuracyFlag::Correlated { with, correlation } => {
                     format!("r={correlation:+.2} with {with}")
                 }
+                AccuracyFlag::Needed { .. } => "needed".to_string(),
             })
             .collect();
         let truth_cells = match truth {
@@ -386,14 +392,9 @@ pub fn reduction_table(steps: &[ReductionStep]) -> String {
             step.reason,
             step.average_cost_before,
             step.average_cost_after,
-            if step.accepted {
-                "kept out"
-            } else if step.left_the_minimum {
-                "restored: needed (the refit left the minimum)"
-            } else if step.average_cost_after.is_finite() {
-                "restored: needed (cost rose too much)"
-            } else {
-                "restored: needed (the model without it is unusable)"
+            match step.needed_because() {
+                None => "kept out".to_string(),
+                Some(reason) => format!("restored: needed ({reason})"),
             }
         );
     }

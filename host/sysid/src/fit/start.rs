@@ -247,6 +247,7 @@ mod tests {
             minimum_confirmed: true,
             reduction: Vec::new(),
             skipped_pairs: Vec::new(),
+            trim: None,
         }
     }
 

@@ -22,8 +22,12 @@ use super::model::Model;
 pub enum ParameterKind {
     /// Identified by the fit, starting from `value`.
     Free,
-    /// Held at `value` (from trim data, or dropped by `--reduce` at zero).
+    /// Held at `value` (by the file, or dropped by `--reduce` at zero).
     Fixed,
+    /// Held at the value the trim points give ([`super::trim`]); the fit re-derives it as
+    /// the other parameters move. Only parameters the file lists in `trim_derived` become
+    /// `trim`, and only when trim points are given.
+    Trim,
 }
 
 /// A base parameter: free or fixed. Constrained parameters are [`DerivedParameter`]s.
@@ -180,6 +184,10 @@ pub struct ModelStructure {
     /// Named numbers of the file's `[constants]` (e.g. `hub_height`), with any override
     /// the caller gave ([`Self::parse_with_constants`]); expressions were built with these.
     pub constants: BTreeMap<String, f64>,
+    /// Base parameters the file's `trim_derived` names: with trim points
+    /// ([`super::trim`]) they are derived from the steady-state balance at the points
+    /// instead of fitted; without, they are fitted like the others.
+    pub trim_derived: Vec<String>,
 }
 
 // ---------------------------------------------------------------------------------------
@@ -256,6 +264,8 @@ struct RawStructure {
     delays: BTreeMap<Spanned<String>, Spanned<RawValue>>,
     #[serde(default)]
     pairs: Vec<Spanned<RawPair>>,
+    #[serde(default)]
+    trim_derived: Vec<Spanned<String>>,
 }
 
 // ---------------------------------------------------------------------------------------
@@ -720,6 +730,29 @@ impl ModelStructure {
             });
         }
 
+        let mut trim_derived: Vec<String> = Vec::new();
+        for name in &raw.trim_derived {
+            let problem = if trim_derived.contains(name.get_ref()) {
+                Some("listed twice in `trim_derived`")
+            } else if base_index.contains_key(name.get_ref()) {
+                None
+            } else if derived_forms.contains_key(name.get_ref()) {
+                Some("constrained (`expr`): only a free or fixed parameter can be derived from trim points")
+            } else {
+                Some("not a parameter of `[parameters]`")
+            };
+            if let Some(reason) = problem {
+                return Err(context.error(
+                    name.span(),
+                    StructureProblem::BadParameter {
+                        name: name.get_ref().clone(),
+                        reason: reason.to_string(),
+                    },
+                ));
+            }
+            trim_derived.push(name.get_ref().clone());
+        }
+
         Ok(Self {
             name: raw.name.into_inner(),
             description: raw.description,
@@ -735,6 +768,7 @@ impl ModelStructure {
             default_output_states,
             source_name: context.source_name.to_string(),
             constants,
+            trim_derived,
         })
     }
 

@@ -1,0 +1,476 @@
+//! Parameters from trim points: the steady-state balance of the identified model.
+//!
+//! A **trim point** is steady flight — hover, a little forward, aft, left, right, a slow
+//! climb or descent, a turn on the spot — with the body velocities, rates and attitude it
+//! was flown at and the four stick positions that held it. A pilot flies them; for the
+//! simulator `sweephold sim trim-points` trims the nonlinear model at the same
+//! conditions. In steady flight every acceleration is zero, so the linear model
+//! `M ẋ = F x + G u` must satisfy, at each point i (Δ relative to the mean of the points,
+//! which leaves out the unknown linearization point),
+//!
+//! ```text
+//! 0 = F Δx_i + G Δu_i.
+//! ```
+//!
+//! The paper (Jung, Shim & Kim, Eq. 28–30) uses this to fix the speed derivatives the
+//! frequency responses barely inform, from the stick gradients and the identified control
+//! derivatives: for a speed change Δu at constant collective the pitching-moment row reads
+//! `0 = M_u Δu + M_w Δw + M_lon Δδ_lon` with `Δw = −Z_u/Z_w Δu` from the heave row, so
+//! `M_u = −M_lon ∂δ_lon/∂u + M_w Z_u/Z_w`; likewise `L_v = −L_lat ∂δ_lat/∂v −
+//! L_ped ∂δ_ped/∂v` and `N_v = −N_ped ∂δ_ped/∂v`. This module does the same for any
+//! structure and any set of parameters (`trim_derived` in the structure file), using
+//! every measured state of the points instead of the paper's approximations:
+//!
+//! 1. The states the points give (u v w p q r φ θ) are *measured*; the others (the
+//!    flapping b1c, b1s) are *hidden* and take their steady value from their own rows,
+//!    `x_h = −F_hh⁻¹ (F_hm x_m + G_h u)` — the quasi-static (residualized) flapping, so the
+//!    control derivatives used are the model's quasi-static ones.
+//! 2. Each measured row's residual `r_i = F_m· x_i + G_m· u_i` is affine in the derived
+//!    parameters θ_T: they enter F and G linearly, and not M or F_hh, so x_h is affine in
+//!    them too (a flap-back term such as M_f,u, in a flapping row, is allowed):
+//!    `r_i = r_i(0) + Σ_k c_ik θ_k`, with c_ik read off by setting one θ_k to 1.
+//! 3. θ_T minimises Σ_i Σ_rows r_i² (linear least squares) over the moment rows p, q, r
+//!    — the paper's equations — and any other measured row a derived parameter enters
+//!    directly (w for Z_w): exact when the points come from a linear model whose other
+//!    parameters are the model's.
+//!
+//! A derived parameter multiplies a state that must vary over the points (no climb, no
+//! Z_w): a column of c that is (numerically) zero is refused with the state named. The
+//! fit iterates: fit with θ_T free, derive θ_T, hold it (status `trim`) and refit from
+//! there, re-derive, until θ_T moves less than [`SETTLED_RELATIVE_CHANGE`].
+
+use std::fmt;
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::structure::ModelStructure;
+
+/// The state columns of a trim-point file, in their order in [`TrimPoint::states`]:
+/// body velocities [m/s], body rates [rad/s], attitude [rad].
+pub const STATE_COLUMNS: [&str; 8] = ["u", "v", "w", "p", "q", "r", "phi", "theta"];
+/// The stick columns, in their order in [`TrimPoint::controls`] (fractions of travel).
+pub const CONTROL_COLUMNS: [&str; 4] = ["lat", "lon", "ped", "col"];
+
+/// The iteration stops when no derived parameter moved by more than this fraction of its
+/// value between two derivations.
+pub const SETTLED_RELATIVE_CHANGE: f64 = 0.01;
+/// Most derive-and-refit rounds.
+pub const MAX_ROUNDS: usize = 6;
+
+/// One steady flight condition.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrimPoint {
+    /// Free text (`hover`, `forward`, …); may be empty.
+    pub label: String,
+    /// u v w [m/s], p q r [rad/s], φ θ [rad] ([`STATE_COLUMNS`]).
+    pub states: [f64; 8],
+    /// lat lon ped col stick fractions ([`CONTROL_COLUMNS`]).
+    pub controls: [f64; 4],
+}
+
+/// A set of trim points (one CSV file).
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct TrimPoints {
+    /// The points, in file order.
+    pub points: Vec<TrimPoint>,
+}
+
+/// What is wrong with a trim-point file or a derivation.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TrimError {
+    /// The CSV text is malformed (line number, 1-based, and what is wrong).
+    Csv {
+        /// Line of the problem.
+        line: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Fewer than two points: no gradient.
+    TooFewPoints(usize),
+    /// A derived parameter appears in M or among the hidden states' own couplings (F_hh),
+    /// so the balance is not linear in it.
+    NotLinear(String),
+    /// The hidden states' rows cannot be solved (F_hh singular).
+    HiddenStatesSingular,
+    /// The points do not vary the state a derived parameter multiplies.
+    NotInformed {
+        /// The parameter.
+        parameter: String,
+    },
+    /// The model could not be built from the values.
+    Model(String),
+}
+
+impl fmt::Display for TrimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            TrimError::Csv { line, reason } => write!(f, "line {line}: {reason}"),
+            TrimError::TooFewPoints(n) => {
+                write!(f, "{n} trim point(s): at least two are needed for a gradient")
+            }
+            TrimError::NotLinear(name) => write!(
+                f,
+                "`{name}` couples the states the trim points do not give (or is in M): it cannot be derived from trim points"
+            ),
+            TrimError::HiddenStatesSingular => write!(
+                f,
+                "the rows of the states the trim points do not give cannot be solved (singular)"
+            ),
+            TrimError::NotInformed { parameter } => write!(
+                f,
+                "the trim points do not vary what `{parameter}` multiplies: add points that do (see docs/formats.md, trim points)"
+            ),
+            TrimError::Model(message) => write!(f, "{message}"),
+        }
+    }
+}
+
+impl std::error::Error for TrimError {}
+
+impl TrimPoints {
+    /// Parse the CSV form: a header naming the columns (`label` optional, then every one
+    /// of [`STATE_COLUMNS`] and [`CONTROL_COLUMNS`], in any order), one point per line;
+    /// blank lines and lines starting with `#` are skipped. Every number must be finite.
+    pub fn parse_csv(text: &str) -> Result<TrimPoints, TrimError> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, line)| (i + 1, line.trim()))
+            .filter(|(_, line)| !line.is_empty() && !line.starts_with('#'));
+        let Some((header_line, header)) = lines.next() else {
+            return Err(TrimError::Csv {
+                line: 1,
+                reason: "no header line".into(),
+            });
+        };
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        let column = |name: &str| names.iter().position(|n| *n == name);
+        for name in &names {
+            if *name != "label" && !STATE_COLUMNS.contains(name) && !CONTROL_COLUMNS.contains(name)
+            {
+                return Err(TrimError::Csv {
+                    line: header_line,
+                    reason: format!("unknown column `{name}`"),
+                });
+            }
+            if names.iter().filter(|n| *n == name).count() > 1 {
+                return Err(TrimError::Csv {
+                    line: header_line,
+                    reason: format!("column `{name}` appears twice"),
+                });
+            }
+        }
+        let find = |name: &str| {
+            column(name).ok_or_else(|| TrimError::Csv {
+                line: header_line,
+                reason: format!("missing column `{name}`"),
+            })
+        };
+        let state_at = STATE_COLUMNS.map(find);
+        let control_at = CONTROL_COLUMNS.map(find);
+        let mut state_index = [0; 8];
+        for (slot, found) in state_index.iter_mut().zip(state_at) {
+            *slot = found?;
+        }
+        let mut control_index = [0; 4];
+        for (slot, found) in control_index.iter_mut().zip(control_at) {
+            *slot = found?;
+        }
+        let label_index = column("label");
+        let mut points = Vec::new();
+        for (line, text) in lines {
+            let cells: Vec<&str> = text.split(',').map(str::trim).collect();
+            if cells.len() != names.len() {
+                return Err(TrimError::Csv {
+                    line,
+                    reason: format!("{} fields, the header has {}", cells.len(), names.len()),
+                });
+            }
+            let number = |index: usize| -> Result<f64, TrimError> {
+                let cell = cells[index];
+                match cell.parse::<f64>() {
+                    Ok(value) if value.is_finite() => Ok(value),
+                    _ => Err(TrimError::Csv {
+                        line,
+                        reason: format!("`{}` is not a finite number: `{cell}`", names[index]),
+                    }),
+                }
+            };
+            let mut states = [0.0; 8];
+            for (value, &index) in states.iter_mut().zip(&state_index) {
+                *value = number(index)?;
+            }
+            let mut controls = [0.0; 4];
+            for (value, &index) in controls.iter_mut().zip(&control_index) {
+                *value = number(index)?;
+            }
+            points.push(TrimPoint {
+                label: label_index.map_or_else(String::new, |i| cells[i].to_string()),
+                states,
+                controls,
+            });
+        }
+        if points.len() < 2 {
+            return Err(TrimError::TooFewPoints(points.len()));
+        }
+        Ok(TrimPoints { points })
+    }
+
+    /// The CSV form [`Self::parse_csv`] reads (a `label` column first, numbers in
+    /// shortest round-trip form).
+    pub fn to_csv(&self) -> String {
+        let mut out = String::from("label");
+        for name in STATE_COLUMNS.iter().chain(&CONTROL_COLUMNS) {
+            out.push(',');
+            out.push_str(name);
+        }
+        out.push('\n');
+        for point in &self.points {
+            out.push_str(&point.label.replace(',', ";"));
+            for value in point.states.iter().chain(&point.controls) {
+                out.push(',');
+                out.push_str(&format!("{value:?}"));
+            }
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// One parameter derived from trim points.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrimDerivation {
+    /// The parameter.
+    pub name: String,
+    /// Its value.
+    pub value: f64,
+}
+
+/// What the trim-point step of a fit did (`model.json` `trim`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrimOutcome {
+    /// Points used.
+    pub points: usize,
+    /// Derive-and-refit rounds.
+    pub rounds: usize,
+    /// Whether the last round moved no parameter by more than
+    /// [`SETTLED_RELATIVE_CHANGE`].
+    pub settled: bool,
+    /// The derived parameters at the end.
+    pub parameters: Vec<TrimDerivation>,
+}
+
+/// Index of a trim-point state column for a structure state name, if the points give it.
+fn measured_column(state: &str) -> Option<usize> {
+    STATE_COLUMNS.iter().position(|c| *c == state)
+}
+
+/// Residuals of the measured rows at every point for parameter values `values`: one
+/// vector per point, `n_measured` long, centred data (module documentation, step 1–2).
+fn residuals(
+    structure: &ModelStructure,
+    values: &[f64],
+    points: &TrimPoints,
+) -> Result<Vec<DVector<f64>>, TrimError> {
+    let model = structure
+        .model(values)
+        .map_err(|e| TrimError::Model(e.to_string()))?;
+    let n = model.states.len();
+    let measured: Vec<(usize, usize)> = (0..n)
+        .filter_map(|i| measured_column(&model.states[i]).map(|c| (i, c)))
+        .collect();
+    let hidden: Vec<usize> = (0..n)
+        .filter(|&i| measured_column(&model.states[i]).is_none())
+        .collect();
+    let controls: Vec<Option<usize>> = model
+        .controls
+        .iter()
+        .map(|c| CONTROL_COLUMNS.iter().position(|k| k == c))
+        .collect();
+    let count = points.points.len() as f64;
+    let mean_state: Vec<f64> = (0..8)
+        .map(|k| points.points.iter().map(|p| p.states[k]).sum::<f64>() / count)
+        .collect();
+    let mean_control: Vec<f64> = (0..4)
+        .map(|k| points.points.iter().map(|p| p.controls[k]).sum::<f64>() / count)
+        .collect();
+    let f_hh = DMatrix::from_fn(hidden.len(), hidden.len(), |a, b| {
+        model.f[(hidden[a], hidden[b])]
+    });
+    let f_hh_lu = f_hh.lu();
+    if !hidden.is_empty() && !f_hh_lu.is_invertible() {
+        return Err(TrimError::HiddenStatesSingular);
+    }
+    let mut out = Vec::with_capacity(points.points.len());
+    for point in &points.points {
+        let mut x = DVector::zeros(n);
+        for &(i, c) in &measured {
+            x[i] = point.states[c] - mean_state[c];
+        }
+        let u = DVector::from_iterator(
+            controls.len(),
+            controls
+                .iter()
+                .map(|c| c.map_or(0.0, |k| point.controls[k] - mean_control[k])),
+        );
+        if !hidden.is_empty() {
+            // F_hh x_h = −(F_hm x_m + G_h u): x holds x_m and zeros at the hidden states.
+            let rhs = DVector::from_fn(hidden.len(), |a, _| {
+                -((model.f.row(hidden[a]) * &x)[0] + (model.g.row(hidden[a]) * &u)[0])
+            });
+            let x_h = f_hh_lu.solve(&rhs).ok_or(TrimError::HiddenStatesSingular)?;
+            for (a, &i) in hidden.iter().enumerate() {
+                x[i] = x_h[a];
+            }
+        }
+        let full = &model.f * &x + &model.g * &u;
+        out.push(DVector::from_iterator(
+            measured.len(),
+            measured.iter().map(|&(i, _)| full[i]),
+        ));
+    }
+    Ok(out)
+}
+
+/// Derive the parameters named in `names` from `points`, the other parameters at
+/// `values` (module documentation). Returns their values in the order of `names`.
+pub fn derive(
+    structure: &ModelStructure,
+    values: &[f64],
+    points: &TrimPoints,
+    names: &[String],
+) -> Result<Vec<TrimDerivation>, TrimError> {
+    if points.points.len() < 2 {
+        return Err(TrimError::TooFewPoints(points.points.len()));
+    }
+    let indices: Vec<usize> = names
+        .iter()
+        .map(|name| {
+            structure
+                .parameter_index(name)
+                .ok_or_else(|| TrimError::Model(format!("no parameter `{name}`")))
+        })
+        .collect::<Result<_, _>>()?;
+    // The balance must stay affine in the derived parameters: none may enter M or the
+    // hidden states' own block F_hh (through which x_h depends on them non-linearly).
+    // Checked by setting each to 1 and comparing the matrices with all at 0. The rows
+    // used are the moment rows (p, q, r: the paper's equations) and every measured row a
+    // derived parameter enters directly (w for Z_w).
+    let mut base = values.to_vec();
+    for &k in &indices {
+        base[k] = 0.0;
+    }
+    let model_at = |v: &[f64]| {
+        structure
+            .model(v)
+            .map_err(|e| TrimError::Model(e.to_string()))
+    };
+    let base_model = model_at(&base)?;
+    let states = &base_model.states;
+    let is_hidden = |i: usize| measured_column(&states[i]).is_none();
+    let mut direct_rows = vec![false; states.len()];
+    for (&k, name) in indices.iter().zip(names) {
+        let mut one = base.clone();
+        one[k] = 1.0;
+        let moved = model_at(&one)?;
+        let n = states.len();
+        let hidden_block_moved = (0..n).filter(|&i| is_hidden(i)).any(|i| {
+            (0..n)
+                .filter(|&j| is_hidden(j))
+                .any(|j| moved.f[(i, j)] != base_model.f[(i, j)])
+        });
+        if hidden_block_moved || moved.m != base_model.m {
+            return Err(TrimError::NotLinear(name.clone()));
+        }
+        for (i, direct) in direct_rows.iter_mut().enumerate() {
+            if !is_hidden(i)
+                && (moved.f.row(i) != base_model.f.row(i) || moved.g.row(i) != base_model.g.row(i))
+            {
+                *direct = true;
+            }
+        }
+    }
+    // Positions of the used rows among the measured ones (the residual vectors' order).
+    let measured_states: Vec<usize> = (0..states.len()).filter(|&i| !is_hidden(i)).collect();
+    let rows: Vec<usize> = measured_states
+        .iter()
+        .enumerate()
+        .filter(|&(_, &i)| direct_rows[i] || ["p", "q", "r"].contains(&states[i].as_str()))
+        .map(|(position, _)| position)
+        .collect();
+    let r0 = residuals(structure, &base, points)?;
+    let mut columns: Vec<Vec<DVector<f64>>> = Vec::with_capacity(indices.len());
+    for &k in &indices {
+        let mut one = base.clone();
+        one[k] = 1.0;
+        let r1 = residuals(structure, &one, points)?;
+        columns.push(r1.iter().zip(&r0).map(|(a, b)| a - b).collect());
+    }
+    let n_obs = rows.len() * points.points.len();
+    let a = DMatrix::from_fn(n_obs, indices.len(), |obs, k| {
+        let (point, row) = (obs / rows.len(), rows[obs % rows.len()]);
+        columns[k][point][row]
+    });
+    let b = DVector::from_fn(n_obs, |obs, _| {
+        let (point, row) = (obs / rows.len(), rows[obs % rows.len()]);
+        -r0[point][row]
+    });
+    // A derived parameter whose column is numerically zero is not informed by the points
+    // (the state it multiplies does not vary): its size relative to the largest column.
+    let norms: Vec<f64> = (0..indices.len()).map(|k| a.column(k).norm()).collect();
+    let largest = norms.iter().cloned().fold(0.0, f64::max);
+    for (k, norm) in norms.iter().enumerate() {
+        if norm.is_nan() || *norm <= 1e-9 * largest.max(1e-300) || *norm < 1e-12 {
+            return Err(TrimError::NotInformed {
+                parameter: names[k].clone(),
+            });
+        }
+    }
+    let svd = a.svd(true, true);
+    let theta = svd
+        .solve(&b, 1e-12 * svd.singular_values.max())
+        .map_err(|e| TrimError::Model(e.to_string()))?;
+    Ok(names
+        .iter()
+        .zip(theta.iter())
+        .map(|(name, value)| TrimDerivation {
+            name: name.clone(),
+            value: *value,
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests;
+
+/// The speed derivatives the trim points stand for: (name, acceleration row, speed).
+pub const SPEED_DERIVATIVES: [(&str, &str, &str); 3] =
+    [("Mu", "q", "u"), ("Lv", "p", "v"), ("Nv", "r", "v")];
+
+/// The quasi-static derivative ∂(ẋ_row)/∂x_column of `model` with every state a trim
+/// point does not give (the flapping) at its steady value: `A_qs = A_mm − A_mh A_hh⁻¹ A_hm`
+/// with `A = M⁻¹F` — what the paper's Eq. 28–30 and a 6-DOF model call M_u, L_v, N_v,
+/// whichever parameters of the structure carry it. None when a state is missing or the
+/// hidden block is singular.
+pub fn quasi_static_derivative(
+    model: &super::model::Model,
+    row: &str,
+    column: &str,
+) -> Option<f64> {
+    let a = super::modes::state_matrix(model).ok()?;
+    let states = &model.states;
+    let i = states.iter().position(|s| s == row)?;
+    let j = states.iter().position(|s| s == column)?;
+    let hidden: Vec<usize> = (0..states.len())
+        .filter(|&k| measured_column(&states[k]).is_none())
+        .collect();
+    if hidden.is_empty() {
+        return Some(a[(i, j)]);
+    }
+    let a_hh = DMatrix::from_fn(hidden.len(), hidden.len(), |x, y| a[(hidden[x], hidden[y])]);
+    let a_hm = DVector::from_fn(hidden.len(), |x, _| a[(hidden[x], j)]);
+    let steady = a_hh.lu().solve(&a_hm)?;
+    let a_mh = DVector::from_fn(hidden.len(), |x, _| a[(i, hidden[x])]);
+    Some(a[(i, j)] - a_mh.dot(&steady))
+}
