@@ -33,7 +33,8 @@
 //! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
-//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer).
+//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); and for
+//! the board's inputs: [`receiver`] (SBUS decoding, link monitoring, the channel map).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -58,6 +59,7 @@ pub mod hold;
 pub mod mixer;
 pub mod noise;
 pub mod pulse;
+pub mod receiver;
 pub mod safety;
 pub mod sink;
 pub mod sweep;
