@@ -33,7 +33,10 @@
 //! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
-//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer).
+//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); and for
+//! the board's inputs: [`receiver`] (SBUS decoding, link monitoring, the channel map),
+//! [`filters`] (biquads and the IMU filter bank) and [`estimator`] (the attitude
+//! estimator).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -53,11 +56,14 @@ mod fmt;
 pub mod attitude_hold;
 pub mod config;
 pub mod controller;
+pub mod estimator;
 pub mod excitation;
+pub mod filters;
 pub mod hold;
 pub mod mixer;
 pub mod noise;
 pub mod pulse;
+pub mod receiver;
 pub mod safety;
 pub mod sink;
 pub mod sweep;
