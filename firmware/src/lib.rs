@@ -33,7 +33,9 @@
 //! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
-//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer).
+//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer), [`imu`]
+//! (the ICM-42688-P driver, its health monitor, boot calibration and, on the host, a
+//! register-level emulator of the chip).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -55,6 +57,7 @@ pub mod config;
 pub mod controller;
 pub mod excitation;
 pub mod hold;
+pub mod imu;
 pub mod mixer;
 pub mod noise;
 pub mod pulse;
