@@ -34,9 +34,10 @@
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
 //! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); and for
-//! the board's inputs: [`receiver`] (SBUS decoding, link monitoring, the channel map),
-//! [`filters`] (biquads and the IMU filter bank) and [`estimator`] (the attitude
-//! estimator).
+//! the board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot
+//! calibration and, on the host, a register-level emulator of the chip), [`receiver`]
+//! (SBUS decoding, link monitoring, the channel map), [`filters`] (biquads and the IMU
+//! filter bank) and [`estimator`] (the attitude estimator).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -60,6 +61,7 @@ pub mod estimator;
 pub mod excitation;
 pub mod filters;
 pub mod hold;
+pub mod imu;
 pub mod mixer;
 pub mod noise;
 pub mod pulse;
