@@ -33,7 +33,9 @@
 //! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
-//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer).
+//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer), and
+//! [`app`] (the board application: arming, the stabilised pilot mode, failsafes and the
+//! throttle around the sequencer).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -50,6 +52,7 @@
 #[macro_use]
 mod fmt;
 
+pub mod app;
 pub mod attitude_hold;
 pub mod config;
 pub mod controller;
