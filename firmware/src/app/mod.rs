@@ -41,9 +41,10 @@
 //! sequencer's (its pass-through: trim plus stick displacement, the excitation and the
 //! hold removed at once) and the tick reports [`Mode::Test`]. From the next tick the
 //! pilot-mode loops fly again, preloaded so that their first command equals that one.
-//! When the application ends it (receiver lost, IMU fault, arm switch off) it calls
-//! [`FlightController::abort`] with its reason and the failsafe (or disarmed) command
-//! applies in the same tick, taken over bumplessly where loops run.
+//! When the application ends it (receiver lost, IMU fault or invalid attitude, arm
+//! switch off) it calls [`FlightController::abort`] with its reason and the failsafe,
+//! pilot-mode or disarmed command applies in the same tick, taken over bumplessly where
+//! loops run.
 //!
 //! Every tick runs in bounded time, allocates nothing and cannot panic; non-finite
 //! inputs become faults or invalid frames, never non-finite outputs.
