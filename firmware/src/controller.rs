@@ -325,7 +325,7 @@ impl FlightController {
                 },
             );
             if let Some(reason) = verdict {
-                self.abort(reason, tick, sink);
+                self.abort_at(reason, tick, sink);
             }
         }
 
@@ -395,7 +395,22 @@ impl FlightController {
         }
     }
 
-    fn abort(&mut self, reason: AbortReason, tick: u32, sink: &mut impl FrameSink) {
+    /// End a running test from outside the sequencer (the board application's receiver,
+    /// IMU and disarm failsafes): in a guarded phase (Armed, TrimCapture, FadeIn, Sweep,
+    /// FadeOut) emit the Abort Event with `reason`, release every held axis and go to
+    /// Aborted, exactly as the sequencer's own checks do; the Events carry the tick the
+    /// next [`step`](Self::step) will carry. Returns whether a test was ended; in Idle,
+    /// Done and Aborted nothing happens. Like every abort, the switch must then go off
+    /// (→ Idle) before the next test.
+    pub fn abort(&mut self, reason: AbortReason, sink: &mut impl FrameSink) -> bool {
+        if !is_guarded(self.phase) {
+            return false;
+        }
+        self.abort_at(reason, self.tick, sink);
+        true
+    }
+
+    fn abort_at(&mut self, reason: AbortReason, tick: u32, sink: &mut impl FrameSink) {
         warn!("tick {=u32}: abort: {}", tick, reason);
         emit(sink, &Frame::Event(Event::Abort { tick, reason }));
         self.release_all(tick, sink);

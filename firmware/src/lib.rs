@@ -33,11 +33,12 @@
 //! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
-//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); and for
-//! the board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot
-//! calibration and, on the host, a register-level emulator of the chip), [`receiver`]
-//! (SBUS decoding, link monitoring, the channel map), [`filters`] (biquads and the IMU
-//! filter bank) and [`estimator`] (the attitude estimator).
+//! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); for the
+//! board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot calibration
+//! and, on the host, a register-level emulator of the chip), [`receiver`] (SBUS decoding,
+//! link monitoring, the channel map), [`filters`] (biquads and the IMU filter bank) and
+//! [`estimator`] (the attitude estimator); and [`app`] (the board application: arming, the
+//! stabilised pilot mode, failsafes and the throttle around the sequencer).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -54,6 +55,7 @@
 #[macro_use]
 mod fmt;
 
+pub mod app;
 pub mod attitude_hold;
 pub mod config;
 pub mod controller;

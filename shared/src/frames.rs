@@ -185,6 +185,14 @@ pub enum AbortReason {
     PilotOverride,
     /// The pilot's test switch left the test position.
     SwitchReleased,
+    /// The receiver lost the pilot's signal (or delivered an invalid frame) during the
+    /// test.
+    RcLost,
+    /// The IMU reported a fault, stopped delivering samples or delivered non-finite values,
+    /// or the attitude estimate became invalid, during the test.
+    ImuFault,
+    /// The pilot disarmed (arm switch off: throttle cut) during the test.
+    Disarmed,
 }
 
 impl AbortReason {
@@ -197,6 +205,9 @@ impl AbortReason {
             AbortReason::SensorStale => "sensor_stale",
             AbortReason::PilotOverride => "pilot_override",
             AbortReason::SwitchReleased => "switch_released",
+            AbortReason::RcLost => "rc_lost",
+            AbortReason::ImuFault => "imu_fault",
+            AbortReason::Disarmed => "disarmed",
         }
     }
 }

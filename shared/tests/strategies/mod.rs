@@ -47,6 +47,9 @@ pub fn reason() -> impl Strategy<Value = AbortReason> {
         Just(AbortReason::SensorStale),
         Just(AbortReason::PilotOverride),
         Just(AbortReason::SwitchReleased),
+        Just(AbortReason::RcLost),
+        Just(AbortReason::ImuFault),
+        Just(AbortReason::Disarmed),
     ]
 }
 

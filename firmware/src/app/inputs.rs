@@ -1,0 +1,199 @@
+//! The board application's plain input and output types.
+//!
+//! The board's drivers (IMU, attitude estimator, receiver) fill a [`TickInput`] once per
+//! control tick; [`BoardApp::tick`](super::BoardApp::tick) answers with a
+//! [`TickOutput`]. Nothing here knows a driver: the types carry what the flight logic
+//! needs, in SI units (rad, rad/s, m/s²) and stick fractions.
+//!
+//! Stick conventions are the command's ([`Controls`]): each stick in [−1, 1], a positive
+//! stick asks for a positive moment (lat → roll right, lon → pitch nose up, ped → yaw
+//! nose right), collective up is positive. The receiver driver maps the transmitter's
+//! channels (and their reversals) onto this.
+
+use sweephold_protocol::{AbortReason, Controls, Phase};
+
+use super::arming::Refusal;
+use super::modes::Mode;
+use super::pilot_mode::StickMode;
+
+/// Why the IMU driver says its data cannot be used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ImuFaultKind {
+    /// The IMU does not answer (bus error, not detected).
+    Missing,
+    /// The IMU answers with samples that do not change (a hung sensor).
+    Stuck,
+    /// A gyro or accelerometer axis is at the end of its range: the rates are wrong.
+    Saturated,
+    /// The IMU has not finished its start-up (configuration, self-test).
+    NotReady,
+}
+
+/// The IMU driver's verdict on this tick's sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ImuStatus {
+    /// Bias-corrected rates and specific force are valid.
+    Ok,
+    /// The gyro bias is being measured (vehicle must be still); the rates are not yet
+    /// bias-corrected. Blocks arming; in flight it counts as a fault.
+    Calibrating,
+    /// The sample is not usable.
+    Fault(ImuFaultKind),
+}
+
+/// One tick's IMU sample and attitude estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ImuInput {
+    /// The driver's status.
+    pub status: ImuStatus,
+    /// The IMU produced a new sample since the last tick. A tick without one reuses the
+    /// values below; more than `SafetyLimits::stale_limit_ticks` such ticks in a row
+    /// count as a fault.
+    pub fresh: bool,
+    /// Bias-corrected body roll rate p [rad/s].
+    pub p: f32,
+    /// Bias-corrected body pitch rate q [rad/s].
+    pub q: f32,
+    /// Bias-corrected body yaw rate r [rad/s].
+    pub r: f32,
+    /// Specific force along body x [m/s²].
+    pub ax: f32,
+    /// Specific force along body y [m/s²].
+    pub ay: f32,
+    /// Specific force along body z [m/s²] (≈ −g at rest).
+    pub az: f32,
+    /// Roll attitude φ \[rad\].
+    pub phi: f32,
+    /// Pitch attitude θ \[rad\].
+    pub theta: f32,
+    /// Heading ψ \[rad\].
+    pub psi: f32,
+    /// The estimator's φ, θ, ψ are valid (converged, not diverged).
+    pub attitude_valid: bool,
+}
+
+impl ImuInput {
+    /// A healthy, fresh sample of a vehicle at rest, level, heading north.
+    pub const AT_REST: ImuInput = ImuInput {
+        status: ImuStatus::Ok,
+        fresh: true,
+        p: 0.0,
+        q: 0.0,
+        r: 0.0,
+        ax: 0.0,
+        ay: 0.0,
+        az: -9.81,
+        phi: 0.0,
+        theta: 0.0,
+        psi: 0.0,
+        attitude_valid: true,
+    };
+}
+
+/// The transmitter's three-position mode switch. What each position selects is
+/// [`PilotModeGains::switch_modes`](super::pilot_mode::PilotModeGains::switch_modes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ModeSwitch {
+    /// Position 0.
+    Low,
+    /// Position 1.
+    Mid,
+    /// Position 2.
+    High,
+}
+
+impl ModeSwitch {
+    /// Position number 0, 1 or 2.
+    pub const fn index(self) -> usize {
+        match self {
+            ModeSwitch::Low => 0,
+            ModeSwitch::Mid => 1,
+            ModeSwitch::High => 2,
+        }
+    }
+}
+
+/// One valid receiver frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RcInput {
+    /// Sticks lat, lon, ped, col, each in [−1, 1].
+    pub sticks: Controls,
+    /// Throttle channel in [0, 1] (the ESC governor's set point; 0 is motor off).
+    pub throttle: f32,
+    /// Arm switch: `true` armed, `false` disarmed (the pilot's throttle hold).
+    pub arm: bool,
+    /// Test switch: `true` asks for a test.
+    pub test_switch: bool,
+    /// Mode switch.
+    pub mode: ModeSwitch,
+}
+
+impl RcInput {
+    /// Sticks centred, collective mid, throttle 0, both switches off, mode switch low.
+    pub const NEUTRAL: RcInput = RcInput {
+        sticks: Controls {
+            lat: 0.0,
+            lon: 0.0,
+            ped: 0.0,
+            col: 0.0,
+        },
+        throttle: 0.0,
+        arm: false,
+        test_switch: false,
+        mode: ModeSwitch::Low,
+    };
+}
+
+/// The receiver's state this tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Receiver {
+    /// No valid frame: the receiver reports signal loss (its failsafe flag or a frame
+    /// timeout in the driver).
+    Lost,
+    /// A frame. A frame with a non-finite channel counts as lost.
+    Valid(RcInput),
+}
+
+/// Everything one tick reads.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TickInput {
+    /// IMU sample and attitude estimate.
+    pub imu: ImuInput,
+    /// Receiver state.
+    pub rc: Receiver,
+}
+
+/// What one tick commands and reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TickOutput {
+    /// The mode whose logic produced this tick's command (on the tick a test ends, the
+    /// sequencer's [`Mode::Test`]; the next tick carries the mode it ended into).
+    pub mode: Mode,
+    /// The pilot-mode loops' stick interpretation when they produced the command
+    /// (Pilot, receiver failsafe, and a test before its excitation); `None` otherwise.
+    pub stick_mode: Option<StickMode>,
+    /// The sequencer's phase after the tick.
+    pub phase: Phase,
+    /// The command, each value in [−1, 1] and finite.
+    pub command: Controls,
+    /// Servo pulse widths \[µs\] from the CCPM mixer: swash servos 1 (front), 2
+    /// (right-rear), 3 (left-rear), tail.
+    pub servo_us: [u16; 4],
+    /// Throttle sent to the ESC, in [0, 1].
+    pub throttle: f32,
+    /// ESC pulse width \[µs\].
+    pub esc_us: u16,
+    /// The host link (hardware in the loop) may be obeyed: only while disarmed.
+    pub host_link_allowed: bool,
+    /// Set on the tick a test ended with an abort: why.
+    pub abort: Option<AbortReason>,
+    /// Set on the tick an arm or test request was refused: which check failed.
+    pub refused: Option<Refusal>,
+}

@@ -1,0 +1,648 @@
+//! The board application: the flight-mode logic that makes the test sequencer
+//! ([`FlightController`]) a flight controller a pilot can fly.
+//!
+//! [`BoardApp::tick`] runs once per control tick on plain inputs ([`TickInput`]: the
+//! IMU sample, attitude estimate and receiver frame) and returns a [`TickOutput`]: the
+//! mode, the command, the four servo pulses through the CCPM mixer, the ESC pulse,
+//! whether the host link may be obeyed, and an abort reason or a refused request.
+//!
+//! * [`modes`]: the modes (Disarmed, Pilot, Test, RcFailsafe, ImuFailsafe) and the
+//!   transition rule;
+//! * [`pilot_mode`]: the stabilised pilot mode's rate loops and heading hold;
+//! * [`arming`]: pre-arm and test-entry checks, switch edges;
+//! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
+//! * [`throttle`]: the ESC channel and its soft start;
+//! * [`inputs`]: the input and output types.
+//!
+//! # The sequencer inside the application
+//!
+//! The sequencer is stepped every tick, in every mode, so that its telemetry (one
+//! Sample per tick, Events, the Header at a test start) is continuous. Its `pilot`
+//! input is the command the bare airframe gets when no test flies it; outside a test
+//! the sequencer passes that through (Idle), so every Sample's `command` is the command
+//! the board sent:
+//!
+//! * outside a test: the mode's own command (safe servos, pilot-mode loops, failsafe);
+//! * in a test, before the excitation (Idle → Armed → TrimCapture): the pilot-mode
+//!   loops' command. The pilot keeps flying the stabilised mode while the trim is
+//!   captured, and the captured trim is the command that holds the aircraft there;
+//! * during the excitation (FadeIn, Sweep, FadeOut): the captured trim plus the pilot's
+//!   stick displacement from the sticks' mean during the capture. The sequencer ignores
+//!   it but for its pilot-override check, which therefore aborts when the pilot moves a
+//!   stick more than the override threshold. The loops are off: the sweep is flown on
+//!   the bare airframe under the sequencer's conditional attitude hold.
+//!
+//! The measurements it gets are the IMU's rates, attitude and specific force, with
+//! u = v = w = 0 (no air data on the board) and `seq` counting fresh IMU samples, so its
+//! stale check works. The test switch it sees is the pilot's, in Test mode only.
+//!
+//! When the sequencer ends the test itself (Done, or an abort by one of its checks,
+//! including the pilot releasing the test switch), the command of that tick is the
+//! sequencer's (its pass-through: trim plus stick displacement, the excitation and the
+//! hold removed at once) and the tick reports [`Mode::Test`]. From the next tick the
+//! pilot-mode loops fly again, preloaded so that their first command equals that one.
+//! When the application ends it (receiver lost, IMU fault or invalid attitude, arm
+//! switch off) it calls [`FlightController::abort`] with its reason and the failsafe,
+//! pilot-mode or disarmed command applies in the same tick, taken over bumplessly where
+//! loops run.
+//!
+//! Every tick runs in bounded time, allocates nothing and cannot panic; non-finite
+//! inputs become faults or invalid frames, never non-finite outputs.
+
+pub mod arming;
+pub mod failsafe;
+pub mod inputs;
+pub mod modes;
+pub mod pilot_mode;
+pub mod throttle;
+
+#[cfg(test)]
+mod tests;
+
+use sweephold_protocol::codec::EncodeError;
+use sweephold_protocol::{
+    AbortReason, Axis, Controls, Event, Frame, Measurements, Phase, PilotInput, SensorIn,
+};
+
+use crate::attitude_hold::clamp_finite;
+use crate::config::{Config, ConfigError};
+use crate::controller::FlightController;
+use crate::mixer::mix;
+use crate::sink::FrameSink;
+use crate::trim::Trim;
+
+use arming::{CheckInput, SwitchEdge};
+use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
+use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
+use throttle::{Throttle, ThrottleSettings};
+
+pub use arming::{CheckFailure, Refusal};
+pub use failsafe::ImuProblem;
+pub use inputs::{
+    ImuFaultKind, ImuInput, ImuStatus, ModeSwitch, RcInput, Receiver, TickInput, TickOutput,
+};
+pub use modes::Mode;
+pub use pilot_mode::StickMode;
+
+/// The command while disarmed ("servos safe"): cyclic centred, collective at mid
+/// travel, tail centred, i.e. every servo at its centre pulse through the mixer. The
+/// rotor is unpowered, the swash is at its mechanical reference, and it is the output
+/// the board puts out before the first tick and after a fault.
+pub const SAFE_COMMAND: Controls = Controls {
+    lat: 0.0,
+    lon: 0.0,
+    ped: 0.0,
+    col: 0.0,
+};
+
+/// Everything the board application needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AppConfig {
+    /// The sequencer's configuration (rate, test, hold gains, abort limits, mixer).
+    pub flight: Config,
+    /// Stabilised pilot mode.
+    pub pilot: PilotModeGains,
+    /// Throttle channel.
+    pub throttle: ThrottleSettings,
+    /// Failsafes.
+    pub failsafe: FailsafeSettings,
+}
+
+impl AppConfig {
+    /// TREX 700L: [`Config::trex700l_default`], [`PilotModeGains::trex700l`], standard
+    /// throttle and failsafe settings.
+    pub const fn trex700l(primary: Axis) -> Self {
+        AppConfig {
+            flight: Config::trex700l_default(primary),
+            pilot: PilotModeGains::trex700l(),
+            throttle: ThrottleSettings::standard(),
+            failsafe: FailsafeSettings::standard(),
+        }
+    }
+
+    /// Bo-105 (simulator): [`Config::bo105_default`], [`PilotModeGains::bo105`],
+    /// standard throttle and failsafe settings.
+    pub const fn bo105(primary: Axis) -> Self {
+        AppConfig {
+            flight: Config::bo105_default(primary),
+            pilot: PilotModeGains::bo105(),
+            throttle: ThrottleSettings::standard(),
+            failsafe: FailsafeSettings::standard(),
+        }
+    }
+
+    /// Check the application's own settings (the sequencer's are checked by
+    /// [`FlightController::new`]).
+    pub fn validate(&self) -> Result<(), AppConfigError> {
+        if !self.pilot.is_valid() {
+            return Err(AppConfigError::PilotGainsInvalid);
+        }
+        if !self.throttle.is_valid() {
+            return Err(AppConfigError::ThrottleInvalid);
+        }
+        if !self.failsafe.is_valid() {
+            return Err(AppConfigError::FailsafeInvalid);
+        }
+        Ok(())
+    }
+}
+
+/// Why a configuration was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AppConfigError {
+    /// The sequencer refused its configuration.
+    Flight(ConfigError),
+    /// A pilot-mode gain or limit is out of range.
+    PilotGainsInvalid,
+    /// A throttle setting is out of range.
+    ThrottleInvalid,
+    /// A failsafe setting is out of range.
+    FailsafeInvalid,
+}
+
+impl AppConfigError {
+    /// Human-readable explanation.
+    pub const fn message(self) -> &'static str {
+        match self {
+            AppConfigError::Flight(error) => error.message(),
+            AppConfigError::PilotGainsInvalid => "pilot-mode gains or limits invalid",
+            AppConfigError::ThrottleInvalid => "throttle settings invalid",
+            AppConfigError::FailsafeInvalid => "failsafe settings invalid",
+        }
+    }
+}
+
+impl core::fmt::Display for AppConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+#[cfg(any(test, feature = "std"))]
+impl std::error::Error for AppConfigError {}
+
+/// Running mean of the pilot's raw sticks during a trim capture.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct StickMean {
+    sum: [f32; 4],
+    count: u32,
+}
+
+impl StickMean {
+    fn add(&mut self, sticks: &Controls) {
+        for (sum, value) in self.sum.iter_mut().zip(sticks.to_array()) {
+            *sum += value;
+        }
+        self.count = self.count.saturating_add(1);
+    }
+
+    fn mean(&self) -> Option<[f32; 4]> {
+        let n = self.count as f32;
+        (self.count > 0).then(|| self.sum.map(|sum| sum / n))
+    }
+}
+
+/// Passes frames on and notes the reason of an Abort Event among them.
+struct AbortTap<'a, S: FrameSink> {
+    inner: &'a mut S,
+    reason: Option<AbortReason>,
+}
+
+impl<S: FrameSink> FrameSink for AbortTap<'_, S> {
+    fn write_frame(&mut self, bytes: &[u8]) {
+        self.inner.write_frame(bytes);
+    }
+
+    fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {
+        if let Frame::Event(Event::Abort { reason, .. }) = frame {
+            self.reason = Some(*reason);
+        }
+        self.inner.send_frame(frame)
+    }
+}
+
+/// The board application. See the [module documentation](self).
+#[derive(Clone, Debug)]
+pub struct BoardApp {
+    config: AppConfig,
+    fc: FlightController,
+    factors: LoopFactors,
+    dt_s: f32,
+    stale_limit_ticks: u32,
+    regain_ticks: u32,
+    recover_ticks: u32,
+    /// Largest throttle rise per tick (the soft start).
+    throttle_rise: f32,
+    mode: Mode,
+    loops: PilotLoops,
+    throttle: Throttle,
+    imu: ImuMonitor,
+    rc: RcMonitor,
+    arm_switch: SwitchEdge,
+    test_switch: SwitchEdge,
+    /// The command applied last tick.
+    last_command: Controls,
+    /// The loops take over from `last_command` on their next step.
+    preload: bool,
+    /// The trim the sequencer captured in this armed period.
+    trim: Option<Trim>,
+    /// What the receiver failsafe holds, from a loss until the signal is regained.
+    loss: Option<RcLossHold>,
+    /// The pilot's raw sticks during the running test's trim capture.
+    stick_reference: StickMean,
+    /// Trim sticks (lat, lon, ped) of the IMU failsafe.
+    imu_trim: [f32; 3],
+}
+
+/// Ticks in `seconds` at `dt_s`, at least one.
+fn ticks_in(seconds: f32, dt_s: f32) -> u32 {
+    // Validated settings: finite, ≥ 0, at most hours; `as` saturates anyway.
+    (libm::roundf(seconds / dt_s) as u32).max(1)
+}
+
+/// Phases in which the sequencer flies the excitation (its command, loops off).
+fn is_excitation(phase: Phase) -> bool {
+    matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
+}
+
+/// Phases in which a test is running.
+fn is_running(phase: Phase) -> bool {
+    matches!(phase, Phase::Armed | Phase::TrimCapture) || is_excitation(phase)
+}
+
+impl BoardApp {
+    /// Validate `config` and build the application: Disarmed, throttle cut, sequencer
+    /// Idle at tick 0.
+    pub fn new(config: AppConfig) -> Result<BoardApp, AppConfigError> {
+        config.validate()?;
+        let fc = FlightController::new(config.flight).map_err(AppConfigError::Flight)?;
+        let dt_s = config.flight.dt_s();
+        Ok(BoardApp {
+            factors: LoopFactors::new(&config.pilot, dt_s),
+            dt_s,
+            stale_limit_ticks: u32::from(config.flight.safety.stale_limit_ticks),
+            regain_ticks: ticks_in(config.failsafe.rc_regain_s, dt_s),
+            recover_ticks: ticks_in(config.failsafe.imu_recover_s, dt_s),
+            throttle_rise: dt_s / config.throttle.soft_start_s,
+            mode: Mode::Disarmed,
+            loops: PilotLoops::default(),
+            throttle: Throttle::default(),
+            imu: ImuMonitor::default(),
+            rc: RcMonitor::default(),
+            arm_switch: SwitchEdge::default(),
+            test_switch: SwitchEdge::default(),
+            last_command: SAFE_COMMAND,
+            preload: false,
+            trim: None,
+            loss: None,
+            stick_reference: StickMean::default(),
+            imu_trim: [0.0; 3],
+            fc,
+            config,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &AppConfig {
+        &self.config
+    }
+
+    /// The current mode (the one the next tick starts from).
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// The sequencer (phase, trim, tick, header).
+    pub fn flight_controller(&self) -> &FlightController {
+        &self.fc
+    }
+
+    /// Whether the host link (hardware in the loop) may be obeyed: only while
+    /// disarmed, never a takeover in flight.
+    pub fn host_link_allowed(&self) -> bool {
+        self.mode == Mode::Disarmed
+    }
+
+    /// The command applied by the last tick.
+    pub fn last_command(&self) -> Controls {
+        self.last_command
+    }
+
+    /// The throttle output of the last tick, in [0, 1].
+    pub fn throttle(&self) -> f32 {
+        self.throttle.output()
+    }
+
+    /// The pilot-mode loops' state.
+    pub fn pilot_loops(&self) -> &PilotLoops {
+        &self.loops
+    }
+
+    /// Run one tick: monitors, mode transition, the mode's command, the sequencer's step
+    /// (telemetry into `sink`), throttle and mixer. Bounded time, no allocation, no
+    /// panic for any input.
+    pub fn tick<S: FrameSink>(&mut self, input: &TickInput, sink: &mut S) -> TickOutput {
+        let mut sink = AbortTap {
+            inner: sink,
+            reason: None,
+        };
+        let imu = self
+            .imu
+            .observe(&input.imu, self.stale_limit_ticks, self.recover_ticks);
+        let rc = self.rc.observe(&input.rc);
+        let arm_rising = self.arm_switch.update(rc.map(|frame| frame.arm));
+        let test_rising = self.test_switch.update(rc.map(|frame| frame.test_switch));
+        self.track_loss(rc.is_some());
+
+        let checks = CheckInput {
+            imu: imu.health,
+            attitude_valid: imu.attitude.is_some(),
+            rc: rc.as_ref(),
+        };
+        let failsafe = &self.config.failsafe;
+        let conditions = modes::Conditions {
+            rc_valid: rc.is_some(),
+            rc_regained: rc.is_some() && self.loss.is_none(),
+            rc_loss_expired: self
+                .loss
+                .is_some_and(|hold| hold.expired(failsafe, self.dt_s)),
+            arm_on: rc.is_some_and(|frame| frame.arm),
+            arm_rising,
+            test_rising,
+            imu_healthy: imu.health.is_ok(),
+            imu_recovered: imu.recovered,
+            attitude_valid: imu.attitude.is_some(),
+            pre_arm: arming::pre_arm(&checks, self.config.throttle.arm_max),
+            test_ready: arming::test_entry(
+                &checks,
+                rc.is_some_and(|frame| self.throttle.settled(frame.throttle)),
+                self.fc.phase() == Phase::Idle,
+            ),
+        };
+        let transition = modes::next(self.mode, &conditions);
+        self.enter(transition.to);
+        if let Some(reason) = transition.abort {
+            self.fc.abort(reason, &mut sink);
+        }
+
+        let throttle = self.update_throttle(rc.as_ref());
+        let integrate = throttle >= self.config.throttle.spooled_min;
+        let (command, stick_mode, test_switch) = self.mode_command(rc.as_ref(), &imu, integrate);
+
+        let sensor = SensorIn {
+            seq: self.imu.seq(),
+            meas: Measurements {
+                p: input.imu.p,
+                q: input.imu.q,
+                r: input.imu.r,
+                phi: input.imu.phi,
+                theta: input.imu.theta,
+                psi: input.imu.psi,
+                u: 0.0,
+                v: 0.0,
+                w: 0.0,
+                ax: input.imu.ax,
+                ay: input.imu.ay,
+                az: input.imu.az,
+            },
+            pilot: PilotInput {
+                sticks: command,
+                test_switch,
+            },
+        };
+        let out = self.fc.step(&sensor, &mut sink);
+        let reported_mode = self.mode;
+        let command = if self.mode == Mode::Test {
+            let phase = self.fc.phase();
+            if is_excitation(phase) {
+                self.trim = Some(self.fc.trim());
+            }
+            if !is_running(phase) {
+                // The sequencer ended the test: the loops take over from its command.
+                self.mode = Mode::Pilot;
+                self.preload = true;
+            }
+            out.command
+        } else {
+            command
+        };
+
+        self.last_command = command;
+        TickOutput {
+            mode: reported_mode,
+            stick_mode,
+            phase: self.fc.phase(),
+            command,
+            servo_us: mix(&self.config.flight.mixer, &command),
+            throttle,
+            esc_us: self.config.throttle.pulse_us(throttle),
+            host_link_allowed: self.host_link_allowed(),
+            abort: sink.reason,
+            refused: transition.refused,
+        }
+    }
+
+    /// Start, count and end the receiver-loss hold (armed only).
+    fn track_loss(&mut self, rc_valid: bool) {
+        if !self.mode.is_armed() {
+            self.loss = None;
+            return;
+        }
+        match &mut self.loss {
+            Some(hold) => hold.ticks = hold.ticks.saturating_add(1),
+            None if !rc_valid => {
+                self.loss = Some(RcLossHold {
+                    collective: self.last_command.col,
+                    throttle: self.throttle.output(),
+                    ticks: 0,
+                });
+            }
+            None => {}
+        }
+        if rc_valid && self.rc.valid_ticks() >= self.regain_ticks {
+            self.loss = None;
+        }
+    }
+
+    /// The effects of entering mode `to` (nothing if it is the current one).
+    fn enter(&mut self, to: Mode) {
+        let from = self.mode;
+        if to == from {
+            return;
+        }
+        match to {
+            Mode::Disarmed => {
+                self.throttle.cut();
+                self.loops.reset();
+                self.trim = None;
+                self.loss = None;
+                self.preload = false;
+            }
+            Mode::Pilot | Mode::RcFailsafe => {
+                if from == Mode::Disarmed {
+                    self.throttle.cut();
+                    self.loops.reset();
+                }
+                self.preload = true;
+            }
+            Mode::ImuFailsafe => {
+                self.imu_trim = if from == Mode::Test && is_excitation(self.fc.phase()) {
+                    let [lat, lon, ped, _] = self.fc.trim().sticks;
+                    [lat, lon, ped]
+                } else {
+                    self.loops.steady()
+                };
+            }
+            Mode::Test => self.stick_reference = StickMean::default(),
+        }
+        self.mode = to;
+    }
+
+    /// This tick's throttle output.
+    fn update_throttle(&mut self, rc: Option<&RcInput>) -> f32 {
+        if self.mode == Mode::Disarmed {
+            self.throttle.cut();
+            return 0.0;
+        }
+        match (self.loss, rc) {
+            (Some(hold), _) => self.throttle.hold(hold.throttle),
+            (None, Some(frame)) => self.throttle.follow(frame.throttle, self.throttle_rise),
+            (None, None) => self.throttle.output(),
+        }
+    }
+
+    /// The collective while the receiver is lost or not yet regained, else `None`.
+    fn held_collective(&self) -> Option<f32> {
+        self.loss
+            .map(|hold| hold.collective(&self.config.failsafe, self.dt_s))
+    }
+
+    /// The command of the current mode (for Test: the sequencer's pilot input), the
+    /// loops' stick mode if they produced it, and the test switch the sequencer sees.
+    fn mode_command(
+        &mut self,
+        rc: Option<&RcInput>,
+        imu: &ImuView,
+        integrate: bool,
+    ) -> (Controls, Option<StickMode>, bool) {
+        let sensors = LoopSensors {
+            rates: imu.rates,
+            attitude: imu.attitude,
+        };
+        match self.mode {
+            Mode::Disarmed => (SAFE_COMMAND, None, false),
+            Mode::Pilot => {
+                let (command, mode) = self.fly_loops(rc, &sensors, integrate);
+                (command, Some(mode), false)
+            }
+            Mode::RcFailsafe => {
+                let (command, mode) = self.fly_loops(None, &sensors, integrate);
+                (command, Some(mode), false)
+            }
+            Mode::ImuFailsafe => {
+                let usable = rc.filter(|_| self.loss.is_none());
+                let collective = self
+                    .held_collective()
+                    .or(usable.map(|frame| frame.sticks.col))
+                    .unwrap_or(self.last_command.col);
+                let command = failsafe::imu_failsafe_command(
+                    self.imu_trim,
+                    usable.map(|frame| &frame.sticks),
+                    self.config.failsafe.imu_direct_authority,
+                    collective,
+                );
+                (command, None, false)
+            }
+            Mode::Test => {
+                let phase = self.fc.phase();
+                let test_switch = rc.is_some_and(|frame| frame.test_switch);
+                if is_excitation(phase) {
+                    let [t_lat, t_lon, t_ped, t_col] = self.fc.trim().sticks;
+                    let trim = [t_lat, t_lon, t_ped, t_col];
+                    let raw = rc.map_or(trim, |frame| frame.sticks.to_array());
+                    let reference = self.stick_reference.mean().unwrap_or(raw);
+                    let mut feed = [0.0; 4];
+                    for (((feed, trim), raw), reference) in
+                        feed.iter_mut().zip(trim).zip(raw).zip(reference)
+                    {
+                        *feed = clamp_finite(trim + (raw - reference), 1.0);
+                    }
+                    (Controls::from_array(feed), None, test_switch)
+                } else {
+                    if matches!(phase, Phase::Armed | Phase::TrimCapture) {
+                        if let Some(frame) = rc {
+                            self.stick_reference.add(&frame.sticks);
+                        }
+                    }
+                    let (command, mode) = self.fly_loops(rc, &sensors, integrate);
+                    (command, Some(mode), test_switch)
+                }
+            }
+        }
+    }
+
+    /// One step of the pilot-mode loops: on the pilot's sticks (`rc`), or, without
+    /// them, the receiver failsafe's demand (trim attitude, heading held, held
+    /// collective).
+    fn fly_loops(
+        &mut self,
+        rc: Option<&RcInput>,
+        sensors: &LoopSensors,
+        integrate: bool,
+    ) -> (Controls, StickMode) {
+        let gains = &self.config.pilot;
+        let (demand, mode) = match rc {
+            Some(frame) => {
+                let switched = gains
+                    .switch_modes
+                    .get(frame.mode.index())
+                    .copied()
+                    .unwrap_or(StickMode::Rate);
+                let mode = if sensors.attitude.is_some() {
+                    switched
+                } else {
+                    StickMode::Rate
+                };
+                (Demand::from_sticks(&frame.sticks, mode, gains), mode)
+            }
+            None => {
+                let (phi, theta) = self.trim.map_or((0.0, 0.0), |trim| (trim.phi, trim.theta));
+                let collective = self.held_collective().unwrap_or(self.last_command.col);
+                let (roll, pitch, mode) = if sensors.attitude.is_some() {
+                    (
+                        AxisDemand::Angle(phi),
+                        AxisDemand::Angle(theta),
+                        StickMode::Level,
+                    )
+                } else {
+                    (
+                        AxisDemand::Rate(0.0),
+                        AxisDemand::Rate(0.0),
+                        StickMode::Rate,
+                    )
+                };
+                (
+                    Demand {
+                        roll,
+                        pitch,
+                        pedal: 0.0,
+                        collective,
+                    },
+                    mode,
+                )
+            }
+        };
+        let command = self.loops.step(
+            gains,
+            &self.factors,
+            &demand,
+            sensors,
+            &self.last_command,
+            integrate,
+            self.preload,
+        );
+        self.preload = false;
+        (command, mode)
+    }
+}
