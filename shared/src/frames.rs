@@ -25,8 +25,10 @@ pub struct ProtocolVersion {
 }
 
 /// The protocol version this crate speaks.
-/// 1.1 added [`Frame::Configure`] and [`Frame::ConfigureResult`].
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 1 };
+/// 1.1 added [`Frame::Configure`] and [`Frame::ConfigureResult`]; 1.2 the board
+/// application's abort reasons [`AbortReason::RcLost`], [`AbortReason::ImuFault`] and
+/// [`AbortReason::Disarmed`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 2 };
 
 impl core::fmt::Display for ProtocolVersion {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
