@@ -416,14 +416,14 @@ pub fn derive(
         let (point, row) = (obs / rows.len(), rows[obs % rows.len()]);
         -r0[point][row]
     });
-    // A derived parameter whose column is numerically zero is not informed by the points
-    // (the state it multiplies does not vary): its size relative to the largest column.
-    let norms: Vec<f64> = (0..indices.len()).map(|k| a.column(k).norm()).collect();
-    let largest = norms.iter().cloned().fold(0.0, f64::max);
-    for (k, norm) in norms.iter().enumerate() {
-        if norm.is_nan() || *norm <= 1e-9 * largest.max(1e-300) || *norm < 1e-12 {
+    // A derived parameter whose column is (numerically) zero is not informed by the
+    // points: the state it multiplies does not vary. Judged on the column alone — not
+    // against the others, whose size a poorly identified flapping (x_h of 10⁶) can blow up.
+    for (k, name) in names.iter().enumerate() {
+        let norm = a.column(k).norm();
+        if norm.is_nan() || norm < 1e-12 {
             return Err(TrimError::NotInformed {
-                parameter: names[k].clone(),
+                parameter: name.clone(),
             });
         }
     }
