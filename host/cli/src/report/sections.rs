@@ -18,7 +18,7 @@ use super::html::{figure, note, section, table, Cell, Mark};
 use super::inputs::ReportInputs;
 use super::svg::{colors, min_max_decimate, BarChart, Figure, Panel, Scale, Series};
 use crate::campaign::stage::Stage;
-use crate::campaign::summary::{FitSummary, ModeSummary};
+use crate::campaign::summary::{FitSummary, ModeSummary, ParameterSummary};
 
 /// Section ids of the plot sections, in page order (each holds at least one `<svg>`).
 pub const PLOT_SECTIONS: [&str; 4] = ["sweep-input", "cross-coherence", "bode", "verification"];
@@ -200,17 +200,25 @@ fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
         Some(fit.cost_ave <= 50.0),
     )];
     let free: Vec<_> = fit.params.iter().filter(|p| p.status == "free").collect();
+    // A parameter the reduction kept because the fit needs it is accepted, and counted apart.
+    let needed = |p: &&&ParameterSummary| p.flags.iter().any(|f| f == "needed");
     let over_cr = free
         .iter()
         .filter(|p| p.cr_percent.is_none_or(|v| v > 20.0))
+        .filter(|p| !needed(p))
         .count();
     let over_insensitivity = free
         .iter()
         .filter(|p| p.insensitivity_percent.is_none_or(|v| v > 10.0))
+        .filter(|p| !needed(p))
         .count();
+    let needed_count = free.iter().filter(|p| needed(p)).count();
     rows.push(bar_row(
-        "free parameters with CR > 20 % / insensitivity > 10 %",
-        format!("{over_cr} / {over_insensitivity} of {}", free.len()),
+        "free parameters with CR > 20 % / insensitivity > 10 %, not flagged needed",
+        format!(
+            "{over_cr} / {over_insensitivity} of {} ({needed_count} needed)",
+            free.len()
+        ),
         "0 / 0",
         Some(over_cr == 0 && over_insensitivity == 0),
     ));
@@ -227,6 +235,24 @@ fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
     }
     if let Some(row) = hover_mode_bar(fit) {
         rows.push(row);
+    }
+    for derivative in fit.speed_derivatives.iter().filter(|d| d.truth.is_some()) {
+        rows.push(bar_row(
+            &format!(
+                "quasi-static {}: error against the truth{}",
+                derivative.name,
+                if fit.trim.is_some() {
+                    " (from trim points)"
+                } else {
+                    ""
+                }
+            ),
+            derivative
+                .error_percent
+                .map_or("-".to_string(), |e| format!("{e:+.1} %")),
+            "within ±25 %",
+            derivative.error_percent.map(|e| e.abs() <= 25.0),
+        ));
     }
     let rate_pairs: Vec<_> = fit
         .pairs
@@ -1114,6 +1140,55 @@ mod tests {
             speed_derivatives: Vec::new(),
             trim: None,
         }
+    }
+
+    #[test]
+    fn a_needed_parameter_is_counted_apart_and_the_speed_derivatives_are_judged() {
+        let parameter = |name: &str, flags: &[&str]| ParameterSummary {
+            name: name.into(),
+            value: 1.0,
+            status: "free".into(),
+            cr_percent: Some(12.0),
+            insensitivity_percent: Some(11.0),
+            truth: None,
+            error_percent: None,
+            flags: flags.iter().map(|f| f.to_string()).collect(),
+        };
+        let hover = HoverModeScore {
+            matched: 4,
+            of: 4,
+            worst_error_percent: Some(3.0),
+        };
+        let mut fit = fit_with_modes(Vec::new(), Vec::new(), hover, 0);
+        fit.params = vec![
+            parameter("Zw", &["insensitive", "needed"]),
+            parameter("Xr", &["insensitive"]),
+        ];
+        fit.speed_derivatives = vec![
+            crate::campaign::summary::SpeedDerivativeSummary {
+                name: "Mu".into(),
+                value: Some(0.11),
+                truth: Some(0.10),
+                error_percent: Some(10.0),
+            },
+            crate::campaign::summary::SpeedDerivativeSummary {
+                name: "Nv".into(),
+                value: Some(0.07),
+                truth: Some(0.05),
+                error_percent: Some(40.0),
+            },
+        ];
+        let rows = fit_bar_rows(&fit);
+        let find = |prefix: &str| {
+            rows.iter()
+                .find(|row| row[0].text.starts_with(prefix))
+                .unwrap_or_else(|| panic!("no row {prefix}"))
+        };
+        let flagged = find("free parameters");
+        assert_eq!(flagged[1].text, "0 / 1 of 2 (1 needed)");
+        assert_eq!(flagged[1].mark, Mark::Bad);
+        assert_eq!(find("quasi-static Mu")[1].mark, Mark::Good);
+        assert_eq!(find("quasi-static Nv")[1].mark, Mark::Bad);
     }
 
     #[test]
