@@ -105,10 +105,12 @@ pub struct CampaignArgs {
     /// Short records (20 s instead of 90 s) for tests and a first look.
     #[arg(long)]
     pub quick: bool,
-    /// Fit L_v, M_u, N_v, Z_w and N_r like every other parameter instead of deriving them
-    /// from trim points (the default: the simulator's steady flights, `trim-points.csv`).
-    #[arg(long)]
-    pub no_trim_points: bool,
+    /// Derive the hybrid's hover derivatives (M_fu, L_fu, N_v, Z_w, N_r) from trim points,
+    /// the simulator's steady flights (`trim-points.csv`): `on`, `off` (fitted like the
+    /// others), or `default`: on for the Bo-105, off for the TREX 700L, whose fit they make
+    /// worse today (docs/decisions/2026-11-24-trim-points.md).
+    #[arg(long, value_enum, default_value_t = TrimPointsArg::Default, value_name = "WHEN")]
+    pub trim_points: TrimPointsArg,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -376,6 +378,17 @@ pub fn flag_name(flag: &sysid::fit::AccuracyFlag) -> String {
     }
 }
 
+/// `campaign --trim-points`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TrimPointsArg {
+    /// On for the Bo-105, off for the TREX 700L.
+    Default,
+    /// Derive from trim points.
+    On,
+    /// Fit like the other parameters.
+    Off,
+}
+
 impl<'a> Campaign<'a> {
     fn new(args: &'a CampaignArgs) -> Campaign<'a> {
         Campaign {
@@ -489,7 +502,12 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
         Ok((analysis.document, line))
     })?;
 
-    let trim_points: Option<TrimPoints> = if args.no_trim_points {
+    let use_trim_points = match args.trim_points {
+        TrimPointsArg::On => true,
+        TrimPointsArg::Off => false,
+        TrimPointsArg::Default => args.vehicle == VehicleArg::Bo105,
+    };
+    let trim_points: Option<TrimPoints> = if !use_trim_points {
         None
     } else {
         Some(run.stage(Stage::TrimPoints, |run| {
@@ -681,7 +699,7 @@ mod tests {
             out: out.clone(),
             seed: 7,
             quick: true,
-            no_trim_points: false,
+            trim_points: TrimPointsArg::Default,
             quiet: true,
         };
         let mut run = Campaign::new(&args);
