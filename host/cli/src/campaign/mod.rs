@@ -30,7 +30,7 @@ use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions};
 
 use crate::fly::link::InProcessLink;
 use crate::fly::plan::PAPER_T_REC_S;
-use crate::fly::{self, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
+use crate::fly::{self, AmplitudeArg, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
 use crate::output::{write_atomic, write_json, StagedFolder};
 use error::CampaignError;
 use stage::{Stage, StageProgress};
@@ -109,6 +109,10 @@ pub struct CampaignArgs {
     /// from trim points (the default: the simulator's steady flights, `trim-points.csv`).
     #[arg(long)]
     pub no_trim_points: bool,
+    /// Sweep amplitude of the fit records (cah, standard, noise): `fixed` (the paper's)
+    /// or `adaptive` (see `fly --amplitude`); the held-out doublets are never shaped.
+    #[arg(long, value_enum, default_value_t = AmplitudeArg::Fixed)]
+    pub amplitude: AmplitudeArg,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -270,6 +274,11 @@ impl Campaign<'_> {
             mode,
             axes: Axis::ALL.to_vec(),
             input,
+            amplitude: if input == InputArg::Sweep {
+                self.args.amplitude
+            } else {
+                AmplitudeArg::Fixed
+            },
             seed,
             t_rec_s: self.args.t_rec_s(),
             rate_hz: 200,
@@ -682,6 +691,7 @@ mod tests {
             seed: 7,
             quick: true,
             no_trim_points: false,
+            amplitude: AmplitudeArg::Fixed,
             quiet: true,
         };
         let mut run = Campaign::new(&args);
