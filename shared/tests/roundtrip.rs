@@ -71,7 +71,10 @@ proptest! {
 #[test]
 fn adaptive_sweep_is_appended_and_announced_only_when_used() {
     use sweephold_protocol::{InputKind, ProtocolVersion, PROTOCOL_VERSION};
-    let encoded = |kind: InputKind| postcard::to_allocvec(&kind).unwrap();
+    let encoded = |kind: InputKind| {
+        let mut buffer = [0u8; 4];
+        postcard::to_slice(&kind, &mut buffer).unwrap().to_vec()
+    };
     assert_eq!(encoded(InputKind::Sweep), [0]);
     assert_eq!(encoded(InputKind::ThreeTwoOneOne), [2]);
     assert_eq!(encoded(InputKind::AdaptiveSweep), [3]);
