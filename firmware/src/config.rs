@@ -5,6 +5,7 @@ use sweephold_protocol::{
     WARN_RECORD_SHORT,
 };
 
+use crate::amplitude::AdaptiveSettings;
 use crate::attitude_hold::{AxisGains, Gains};
 use crate::excitation::Excitation;
 use crate::hold::HoldThresholds;
@@ -56,6 +57,8 @@ pub struct Config {
     pub safety: SafetyLimits,
     /// Swashplate mixer.
     pub mixer: MixerConfig,
+    /// The adaptive amplitude's law (used by [`InputKind::AdaptiveSweep`]).
+    pub adaptive: AdaptiveSettings,
 }
 
 /// What the conditional-hold thresholds (engage 6°, release 4°) apply to on the roll and
@@ -111,6 +114,8 @@ pub enum ConfigError {
     SafetyLimitsInvalid,
     /// A servo's limits or throw invalid, or a mixer scale negative or non-finite.
     MixerInvalid,
+    /// The adaptive amplitude's settings out of range (see `AdaptiveSettings::is_valid`).
+    AdaptiveAmplitudeInvalid,
 }
 
 impl ConfigError {
@@ -135,6 +140,7 @@ impl ConfigError {
             ConfigError::GainsInvalid => "attitude-hold gains or limits invalid",
             ConfigError::SafetyLimitsInvalid => "safety limits must be positive and finite",
             ConfigError::MixerInvalid => "mixer settings invalid",
+            ConfigError::AdaptiveAmplitudeInvalid => "adaptive amplitude settings invalid",
         }
     }
 }
@@ -192,6 +198,7 @@ impl Config {
             gains: Gains::bo105(),
             safety: SafetyLimits::bo105(),
             mixer: MixerConfig::trex700l(),
+            adaptive: AdaptiveSettings::PRESET,
         }
     }
 
@@ -211,6 +218,7 @@ impl Config {
             gains: Gains::trex700l(),
             safety: SafetyLimits::trex700l(),
             mixer: MixerConfig::trex700l(),
+            adaptive: AdaptiveSettings::PRESET,
         }
     }
 
@@ -309,12 +317,13 @@ impl Config {
         if !self.mixer.is_valid() {
             return Err(ConfigError::MixerInvalid);
         }
+        if !self.adaptive.is_valid() {
+            return Err(ConfigError::AdaptiveAmplitudeInvalid);
+        }
         // Record-length rule T_rec ≥ 4·T_max, T_max = 2π/ω_min: shorter is flown, flagged.
         let longest_period = core::f32::consts::TAU / sweep.omega_min;
         let mut warnings = 0;
-        if test.input == InputKind::Sweep
-            && sweep.t_rec_s < RECORD_PERIODS_OF_OMEGA_MIN * longest_period
-        {
+        if test.input.is_sweep() && sweep.t_rec_s < RECORD_PERIODS_OF_OMEGA_MIN * longest_period {
             warnings |= WARN_RECORD_SHORT;
         }
         Ok(warnings)
@@ -466,6 +475,14 @@ mod tests {
         );
         assert_eq!(refused(|c| c.mixer.swash[1].min_us = 2000), MixerInvalid);
         assert_eq!(refused(|c| c.mixer.cyclic_scale = -0.5), MixerInvalid);
+        assert_eq!(
+            refused(|c| c.adaptive.min_scale = f32::NAN),
+            AdaptiveAmplitudeInvalid
+        );
+        assert_eq!(
+            refused(|c| c.adaptive.max_slope_per_s = 0.0),
+            AdaptiveAmplitudeInvalid
+        );
     }
 
     #[test]

@@ -48,9 +48,10 @@
 
 use sweephold_protocol::{
     AbortReason, ActuatorOut, Axis, Controls, Event, ExcitationMode, FirmwareVersion, Frame,
-    Header, HoldState, Measurements, Phase, Sample, SensorIn, PROTOCOL_VERSION,
+    Header, HoldState, InputKind, Measurements, Phase, ProtocolVersion, Sample, SensorIn,
 };
 
+use crate::amplitude::{AmplitudeShaper, AxisEnvelope};
 use crate::attitude_hold::{AttitudeController, AxisGains};
 use crate::config::{Config, ConfigError, HoldReference};
 use crate::excitation::{Excitation, ExcitationSample, ExcitationTicker};
@@ -190,6 +191,8 @@ pub struct FlightController {
     header: Header,
     /// The excitation at this loop's ticks (no `f64` on the tick path).
     excitation: ExcitationTicker,
+    /// The adaptive amplitude of an [`InputKind::AdaptiveSweep`] (`None`: fixed).
+    shaper: Option<AmplitudeShaper>,
     /// The noise generator as configured; copied at each test start so that every test
     /// with the same seed gets the same noise.
     noise_at_start: OffAxisNoise,
@@ -233,13 +236,21 @@ impl FlightController {
         let trim_capture_ticks = libm::roundf(config.trim_capture_s * rate).max(1.0) as u32;
         Ok(FlightController {
             header: Header {
-                protocol: PROTOCOL_VERSION,
+                protocol: ProtocolVersion::for_test(&config.test),
                 firmware: FIRMWARE_VERSION,
                 vehicle: config.vehicle,
                 rate_hz: config.rate_hz,
                 test: config.test,
             },
             excitation: Excitation::from_test(&config.test).ticker(config.rate_hz),
+            shaper: (config.test.input == InputKind::AdaptiveSweep).then(|| {
+                AmplitudeShaper::new(
+                    config.adaptive,
+                    config.test.sweep.amplitude,
+                    config.test.hold_release_rad,
+                    config.safety.rate_limit_rad_s,
+                )
+            }),
             noise_at_start: noise,
             noise,
             thresholds: config.hold_thresholds(),
@@ -443,6 +454,9 @@ impl FlightController {
             }),
         );
         self.excitation_tick = 0;
+        if let Some(shaper) = &mut self.shaper {
+            shaper.reset();
+        }
         self.noise = self.noise_at_start;
         self.axes = [HeldAxis::RELEASED; 3];
     }
@@ -457,7 +471,7 @@ impl FlightController {
     ) -> TickParts {
         // Tick n of the excitation, t = n / rate: an integer count, no accumulated
         // rounding over a long record.
-        let sample = self.excitation.sample(self.excitation_tick);
+        let mut sample = self.excitation.sample(self.excitation_tick);
         let Some(phase) = sample.segment.phase() else {
             self.release_all(tick, sink);
             self.set_phase(Phase::Done, tick, sink);
@@ -509,6 +523,21 @@ impl FlightController {
         ];
 
         let primary = self.config.test.primary;
+        if let Some(shaper) = &mut self.shaper {
+            let envelopes = inputs.map(|input| AxisEnvelope {
+                deviation: input.deviation,
+                rate: input.rate,
+            });
+            let trim_stick = trim.sticks.get(primary.index()).copied().unwrap_or(0.0);
+            let quadrature = self.excitation.quadrature();
+            sample.value = shaper.shape(
+                sample.value,
+                quadrature,
+                sample.omega,
+                trim_stick,
+                &envelopes,
+            );
+        }
         let mode = self.config.test.mode;
         let mut parts = TickParts {
             command: [0.0; 4],

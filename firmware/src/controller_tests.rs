@@ -455,6 +455,48 @@ fn doublet_runs_on_the_same_sequencer() {
     assert!(pulse[100..].iter().all(|&v| v == -0.05));
 }
 
+/// An adaptive sweep announces itself (input and protocol 1.3) in the Header, applies
+/// the configured amplitude until it has measured a cycle, then shapes it: with a roll
+/// that follows the input strongly the applied amplitude falls; it stays within its
+/// bounds and the same inputs give the same telemetry. A fixed sweep announces 1.2.
+#[test]
+fn adaptive_sweep_is_announced_and_shapes_the_amplitude() {
+    let mut config = short_config();
+    config.test.sweep.omega_min = 3.0;
+    assert_eq!(
+        Rig::new(config).fc.header().protocol,
+        ProtocolVersion { major: 1, minor: 2 }
+    );
+    config.test.input = InputKind::AdaptiveSweep;
+    let run = || {
+        let mut rig = Rig::new(config);
+        assert_eq!(rig.fc.header().protocol, PROTOCOL_VERSION_FOR_TESTS);
+        assert_eq!(rig.fc.header().test.input, InputKind::AdaptiveSweep);
+        let mut applied = Vec::new();
+        while rig.fc.phase() != Phase::Done {
+            rig.step();
+            let s = rig.sample();
+            // The "aircraft": 200° of roll per unit stick, in phase.
+            rig.input.meas.phi = rig.fc.trim().phi + 200.0 * DEG * s.sweep.lat;
+            if s.phase == Phase::Sweep {
+                applied.push(s.sweep.lat);
+            }
+            assert!(s.command.lat.abs() <= 1.0 && s.sweep.lat.abs() <= 0.1 + 1e-6);
+        }
+        (applied, rig.frames)
+    };
+    let (applied, frames) = run();
+    let peak = |part: &[f32]| part.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    // ω_min = 3 rad/s: the first cycle (2 s) is flown at the configured amplitude.
+    let (early, late) = applied.split_at(applied.len() / 2);
+    assert!(peak(early) > 0.045, "early {}", peak(early));
+    // 200°/stick: 2° (half the release angle) at 0.01 of stick.
+    assert!(peak(late) < 0.02, "late {}", peak(late));
+    assert_eq!(frames, run().1);
+}
+
+const PROTOCOL_VERSION_FOR_TESTS: ProtocolVersion = sweephold_protocol::PROTOCOL_VERSION;
+
 /// Drive into the sweep, apply `fault`, step once (or `ticks` times), and check the abort.
 fn assert_aborts(reason: AbortReason, fault: impl FnOnce(&mut SensorIn)) -> Rig {
     let mut rig = Rig::into_sweep(short_config());

@@ -69,7 +69,7 @@ impl Excitation {
     pub fn from_test(test: &TestConfig) -> Self {
         let fade_s = f64::from(test.sweep.fade_s);
         match test.input {
-            InputKind::Sweep => Excitation::Sweep(SweepSignal::new(
+            InputKind::Sweep | InputKind::AdaptiveSweep => Excitation::Sweep(SweepSignal::new(
                 test.sweep.amplitude,
                 f64::from(test.sweep.omega_min),
                 f64::from(test.sweep.omega_max),
@@ -131,6 +131,14 @@ impl Excitation {
 }
 
 impl ExcitationTicker {
+    /// A·e·cos θ of the last sample of a sweep ([`SweepTicker::quadrature`]); 0 for pulses.
+    pub fn quadrature(&self) -> f32 {
+        match self {
+            ExcitationTicker::Sweep(sweep) => sweep.quadrature(),
+            ExcitationTicker::Pulse(_) => 0.0,
+        }
+    }
+
     /// The excitation at tick `n` since it started (t = n/rate). Cheapest in order.
     pub fn sample(&mut self, n: u32) -> ExcitationSample {
         match self {

@@ -30,7 +30,8 @@
 //! Modules, one concept each: [`sweep`] (the sweep, its closed-form phase and its
 //! `f64`-free tick evaluation), [`turns`] (angles as fixed-point fractions of a turn and
 //! their `f32` sine),
-//! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`noise`] (PRNG,
+//! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`amplitude`] (the
+//! adaptive sweep amplitude), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
 //! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); for the
@@ -55,6 +56,7 @@
 #[macro_use]
 mod fmt;
 
+pub mod amplitude;
 pub mod app;
 pub mod attitude_hold;
 pub mod config;

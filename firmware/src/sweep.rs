@@ -306,6 +306,9 @@ pub struct SweepTicker {
     /// Record state of the tick `next_tick` (valid when it is in the record).
     next_tick: u32,
     state: RecordState,
+    /// Phase and envelope of the last sample, for [`quadrature`](Self::quadrature).
+    last_phase: Turns,
+    last_envelope: f32,
 }
 
 /// The record's recurrence state at one tick.
@@ -378,6 +381,8 @@ impl SweepTicker {
                 phase: Turns::ZERO,
                 growth: 0,
             },
+            last_phase: Turns::ZERO,
+            last_envelope: 0.0,
         };
         ticker.record_anchor = ticker.closed_form_state(record_start);
         ticker.next_tick = record_start;
@@ -482,12 +487,21 @@ impl SweepTicker {
         }
         let (phase, omega) = self.phase_and_omega(segment, n);
         let envelope = self.envelope(segment, n);
+        self.last_phase = phase;
+        self.last_envelope = envelope;
         ExcitationSample {
             segment,
             value: self.amplitude * envelope * phase.sin(),
             omega,
             envelope,
         }
+    }
+
+    /// The quadrature A·e·cos θ of the last [`sample`](Self::sample) (whose value is
+    /// A·e·sin θ): with it the adaptive amplitude measures the response at the sweep's
+    /// frequency in phase and in quadrature.
+    pub fn quadrature(&self) -> f32 {
+        self.amplitude * self.last_envelope * self.last_phase.cos()
     }
 
     /// Phase θ of tick `n` reduced to [0, 2π) (`f64`, for tests and diagnostics); the

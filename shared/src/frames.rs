@@ -27,8 +27,23 @@ pub struct ProtocolVersion {
 /// The protocol version this crate speaks.
 /// 1.1 added [`Frame::Configure`] and [`Frame::ConfigureResult`]; 1.2 the board
 /// application's abort reasons [`AbortReason::RcLost`], [`AbortReason::ImuFault`] and
-/// [`AbortReason::Disarmed`].
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 2 };
+/// [`AbortReason::Disarmed`]; 1.3 [`InputKind::AdaptiveSweep`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 3 };
+
+impl ProtocolVersion {
+    /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
+    /// everything the test streams. A test that uses nothing added since 1.2 announces
+    /// 1.2, so its dumps are byte for byte those of a 1.2 flight controller and every
+    /// 1.2 host reads them whole; [`InputKind::AdaptiveSweep`] needs 1.3.
+    pub const fn for_test(test: &TestConfig) -> ProtocolVersion {
+        match test.input {
+            InputKind::AdaptiveSweep => PROTOCOL_VERSION,
+            InputKind::Sweep | InputKind::Doublet | InputKind::ThreeTwoOneOne => {
+                ProtocolVersion { major: 1, minor: 2 }
+            }
+        }
+    }
+}
 
 impl core::fmt::Display for ProtocolVersion {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -135,6 +150,17 @@ pub enum InputKind {
     Doublet,
     /// 3-2-1-1 multistep: +A 3w, −A 2w, +A 1w, −A 1w.
     ThreeTwoOneOne,
+    /// The same exponential sweep with its amplitude adapted online from the attitude and
+    /// rate envelope of its last cycle, around A (the firmware's `amplitude` module).
+    /// Since protocol 1.3.
+    AdaptiveSweep,
+}
+
+impl InputKind {
+    /// Whether the input is a frequency sweep (fixed or adaptive amplitude).
+    pub const fn is_sweep(self) -> bool {
+        matches!(self, InputKind::Sweep | InputKind::AdaptiveSweep)
+    }
 }
 
 /// Phase of the test sequencer.

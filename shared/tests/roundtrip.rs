@@ -64,3 +64,35 @@ proptest! {
         prop_assert!(stats.good_frames + stats.corrupt_frames >= n as u64);
     }
 }
+
+/// Protocol 1.3 appended `InputKind::AdaptiveSweep`: the older variants keep their
+/// encoding, the new one is the next index, and a test without it announces 1.2 so its
+/// dumps stay those of a 1.2 flight controller.
+#[test]
+fn adaptive_sweep_is_appended_and_announced_only_when_used() {
+    use sweephold_protocol::{InputKind, ProtocolVersion, PROTOCOL_VERSION};
+    let encoded = |kind: InputKind| {
+        let mut buffer = [0u8; 4];
+        postcard::to_slice(&kind, &mut buffer).unwrap().to_vec()
+    };
+    assert_eq!(encoded(InputKind::Sweep), [0]);
+    assert_eq!(encoded(InputKind::ThreeTwoOneOne), [2]);
+    assert_eq!(encoded(InputKind::AdaptiveSweep), [3]);
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 3 });
+    let mut test = sweephold_protocol::synthetic::header().test;
+    for kind in [
+        InputKind::Sweep,
+        InputKind::Doublet,
+        InputKind::ThreeTwoOneOne,
+    ] {
+        test.input = kind;
+        assert_eq!(
+            ProtocolVersion::for_test(&test),
+            ProtocolVersion { major: 1, minor: 2 }
+        );
+        assert!(kind.is_sweep() == (kind == InputKind::Sweep));
+    }
+    test.input = InputKind::AdaptiveSweep;
+    assert_eq!(ProtocolVersion::for_test(&test), PROTOCOL_VERSION);
+    assert!(test.input.is_sweep());
+}

@@ -88,7 +88,8 @@ pub fn test_config() -> impl Strategy<Value = TestConfig> {
     let input = prop_oneof![
         Just(InputKind::Sweep),
         Just(InputKind::Doublet),
-        Just(InputKind::ThreeTwoOneOne)
+        Just(InputKind::ThreeTwoOneOne),
+        Just(InputKind::AdaptiveSweep)
     ];
     let sweep = (real(), real(), real(), real(), real(), any::<u8>()).prop_map(
         |(t_rec_s, amplitude, omega_min, omega_max, fade_s, start_hold_cycles)| SweepSettings {

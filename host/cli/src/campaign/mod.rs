@@ -30,7 +30,7 @@ use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions};
 
 use crate::fly::link::InProcessLink;
 use crate::fly::plan::PAPER_T_REC_S;
-use crate::fly::{self, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
+use crate::fly::{self, AmplitudeArg, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
 use crate::output::{write_atomic, write_json, StagedFolder};
 use error::CampaignError;
 use stage::{Stage, StageProgress};
@@ -111,6 +111,10 @@ pub struct CampaignArgs {
     /// worse today (docs/decisions/2026-11-24-trim-points.md).
     #[arg(long, value_enum, default_value_t = TrimPointsArg::Default, value_name = "WHEN")]
     pub trim_points: TrimPointsArg,
+    /// Sweep amplitude of the fit records (cah, standard, noise): `fixed` (the paper's)
+    /// or `adaptive` (see `fly --amplitude`); the held-out doublets are never shaped.
+    #[arg(long, value_enum, default_value_t = AmplitudeArg::Fixed)]
+    pub amplitude: AmplitudeArg,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -272,6 +276,11 @@ impl Campaign<'_> {
             mode,
             axes: Axis::ALL.to_vec(),
             input,
+            amplitude: if input == InputArg::Sweep {
+                self.args.amplitude
+            } else {
+                AmplitudeArg::Fixed
+            },
             seed,
             t_rec_s: self.args.t_rec_s(),
             rate_hz: 200,
@@ -700,6 +709,7 @@ mod tests {
             seed: 7,
             quick: true,
             trim_points: TrimPointsArg::Default,
+            amplitude: AmplitudeArg::Fixed,
             quiet: true,
         };
         let mut run = Campaign::new(&args);

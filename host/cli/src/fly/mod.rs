@@ -80,6 +80,35 @@ impl InputArg {
     }
 }
 
+/// Sweep amplitude law on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum AmplitudeArg {
+    /// The paper's constant amplitude A.
+    #[default]
+    Fixed,
+    /// Shaped online by the firmware so that the attitudes stay inside the hold's
+    /// release band (`InputKind::AdaptiveSweep`; docs/hil.md).
+    Adaptive,
+}
+
+impl AmplitudeArg {
+    /// The input kind a sweep is flown as under this law.
+    pub fn sweep_kind(self) -> InputKind {
+        match self {
+            AmplitudeArg::Fixed => InputKind::Sweep,
+            AmplitudeArg::Adaptive => InputKind::AdaptiveSweep,
+        }
+    }
+
+    /// Name on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            AmplitudeArg::Fixed => "fixed",
+            AmplitudeArg::Adaptive => "adaptive",
+        }
+    }
+}
+
 /// Vehicle on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum VehicleArg {
@@ -139,6 +168,10 @@ pub struct FlyArgs {
     /// Primary input signal.
     #[arg(long, value_enum, default_value_t = InputArg::Sweep)]
     pub input: InputArg,
+    /// Sweep amplitude: `fixed` (the paper's A = 0.05) or `adaptive` (shaped online by
+    /// the firmware to keep the attitudes inside the hold's release band; sweeps only).
+    #[arg(long, value_enum, default_value_t = AmplitudeArg::Fixed)]
+    pub amplitude: AmplitudeArg,
     /// Campaign seed (firmware noise, sensor noise, gusts).
     #[arg(long, default_value_t = 1, value_parser = arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
@@ -257,18 +290,19 @@ fn parse_axis(text: &str) -> Result<Axis, String> {
 impl FlyArgs {
     /// The records these arguments fly, in flying order.
     pub fn plans(&self) -> Vec<RecordPlan> {
-        plan_records(
-            &self.axes,
-            self.mode.mode(),
-            self.input.kind(),
-            self.t_rec_s,
-            self.seed,
-        )
+        let input = match self.input {
+            InputArg::Sweep => self.amplitude.sweep_kind(),
+            other => other.kind(),
+        };
+        plan_records(&self.axes, self.mode.mode(), input, self.t_rec_s, self.seed)
     }
 
     fn check(&self) -> anyhow::Result<()> {
         if self.axes.is_empty() {
             bail!("--axes names no axis");
+        }
+        if self.amplitude == AmplitudeArg::Adaptive && self.input != InputArg::Sweep {
+            bail!("--amplitude adaptive shapes a sweep: drop it or use --input sweep");
         }
         for (i, axis) in self.axes.iter().enumerate() {
             if self.axes[..i].contains(axis) {
@@ -596,7 +630,7 @@ fn finish_record(
     flown: record::FlownRecord,
 ) -> anyhow::Result<RunSummary> {
     write_atomic(&args.out.join(plan.file_name()), &flown.dump)?;
-    let cross_coherence = if plan.input == InputKind::Sweep && flown.abort.is_none() {
+    let cross_coherence = if plan.input.is_sweep() && flown.abort.is_none() {
         record_cross_coherence(&flown.dump, &plan.file_name())?
     } else {
         BTreeMap::new()

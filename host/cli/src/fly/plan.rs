@@ -55,7 +55,7 @@ pub fn plan_records(
     let mut plans = Vec::new();
     for &axis in axes {
         let bands: &[(f64, f64)] = match input {
-            InputKind::Sweep => &PAPER_BANDS,
+            InputKind::Sweep | InputKind::AdaptiveSweep => &PAPER_BANDS,
             InputKind::Doublet | InputKind::ThreeTwoOneOne => &PAPER_BANDS[..1],
         };
         for (n, &(omega_min, omega_max)) in bands.iter().enumerate() {

@@ -13,9 +13,7 @@
 
 use std::path::Path;
 
-use sweephold_protocol::{
-    tick_step, Decoder, Frame, FrameError, Header, InputKind, Phase, Sample, TickStep,
-};
+use sweephold_protocol::{tick_step, Decoder, Frame, FrameError, Header, Phase, Sample, TickStep};
 
 use super::records::{Channel, Record};
 use super::FrfError;
@@ -220,7 +218,7 @@ fn record_from_samples_at(
         .count();
     let samples = &all[first - before..=last + after];
     let test = header.test;
-    if excitation == Excitation::Sweep && test.input != InputKind::Sweep {
+    if excitation == Excitation::Sweep && !test.input.is_sweep() {
         return Err(FrfError::NoSweep {
             path: source.into(),
             detail: format!("the test is a {:?}, not a sweep", test.input),
@@ -529,7 +527,7 @@ mod tests {
         let err = load_dump_bytes(b"not a dump at all", "junk").unwrap_err();
         assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
         let doublet = DumpSpec {
-            input: InputKind::Doublet,
+            input: sweephold_protocol::InputKind::Doublet,
             ..DumpSpec::default()
         };
         let err = load_dump_bytes(&dump_bytes(&doublet), "d.dump").unwrap_err();
