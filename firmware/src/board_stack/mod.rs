@@ -50,6 +50,20 @@
 //! * φ, θ, ψ: the estimate (ψ relative: no magnetometer);
 //! * `fresh`: at least one sample was read since the previous control tick.
 //!
+//! # The accelerometer during a test
+//!
+//! The estimator takes the specific force for the direction of gravity. On a helicopter
+//! that holds only in unaccelerated flight: the rotor's thrust dominates the specific
+//! force, so a banked aircraft accelerating sideways reads close to "level", and the
+//! correction (at K_p = 0.5 rad/s) pulls the estimate towards the thrust's tilt with a
+//! 2 s time constant. A sweep does exactly that for tens of seconds (its low band
+//! excites periods of a minute), and the conditional attitude hold flies on the
+//! estimate. While the sequencer flies the excitation (FadeIn, Sweep, FadeOut) the
+//! estimator therefore propagates on the gyro alone ([`Mahony::propagate`]); the gyro
+//! bias was measured at boot, so the drift over a record is that of the gyro's noise
+//! and scale error, a small fraction of a degree. The correction resumes when the
+//! excitation ends.
+//!
 //! # The receiver path
 //!
 //! The bytes the UART received since the previous tick are fed to the [`SbusDecoder`];
@@ -78,10 +92,22 @@ use crate::imu::{
 };
 use crate::receiver::{ChannelMap, ChannelMapError, ModeSwitch, RcInput, Receiver, SbusDecoder};
 use crate::sink::FrameSink;
-use sweephold_protocol::Axis;
+use sweephold_protocol::{Axis, Phase};
 
 /// IMU sample rate the stack runs at \[Hz\]: the driver configures the chip for 1 kHz.
 pub const IMU_RATE_HZ: f32 = 1000.0;
+
+/// The board's estimator: [`MahonyConfig::helicopter`] at the IMU rate without the
+/// in-flight bias integrator (K_i = 0). The gyro bias is measured at boot, rotor
+/// stopped, and subtracted before the filters; the integrator would learn from the
+/// specific force, which on a helicopter in manoeuvres is not the vertical (see the
+/// module documentation), and a bias learnt wrongly in the hover before a test makes the
+/// attitude drift through the test's excitation, where the estimator runs on the gyro
+/// alone.
+pub const BOARD_ESTIMATOR: MahonyConfig = MahonyConfig {
+    ki: 0.0,
+    ..MahonyConfig::helicopter(IMU_RATE_HZ)
+};
 
 /// Everything the stack needs besides its devices.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,7 +133,7 @@ pub struct StackConfig {
 
 impl StackConfig {
     /// TREX 700L: [`AppConfig::trex700l`], identity mounting, default monitor limits and
-    /// calibration, [`FilterBankConfig::trex700l`], [`MahonyConfig::helicopter`] at 1 kHz,
+    /// calibration, [`FilterBankConfig::trex700l`], [`BOARD_ESTIMATOR`],
     /// [`ChannelMap::flybarless_default`], 100 ms link timeout.
     pub const fn trex700l(primary: Axis) -> Self {
         Self::with_app(AppConfig::trex700l(primary))
@@ -127,7 +153,7 @@ impl StackConfig {
             monitor: MonitorLimits::DEFAULT,
             calibration: CalibrationConfig::DEFAULT,
             filters: FilterBankConfig::trex700l(),
-            estimator: MahonyConfig::helicopter(IMU_RATE_HZ),
+            estimator: BOARD_ESTIMATOR,
             channel_map: ChannelMap::flybarless_default(),
             rc_timeout_us: crate::receiver::sbus::LINK_TIMEOUT_US,
         }
@@ -326,7 +352,11 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
             BootState::Running(bias) => {
                 let gyro = bias.correct_gyro(sample.gyro_rad_s);
                 let (gyro, accel) = self.filters.process_imu(gyro, sample.accel_m_s2);
-                let kind = self.estimator.update(gyro, accel);
+                let kind = if is_excitation(self.app.flight_controller().phase()) {
+                    self.estimator.propagate(gyro)
+                } else {
+                    self.estimator.update(gyro, accel)
+                };
                 let estimate = self.estimator.estimate();
                 self.latest = ImuValues {
                     rates: [estimate.p, estimate.q, estimate.r],
@@ -484,6 +514,11 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
     pub fn imu_spi_mut(&mut self) -> &mut SPI {
         self.imu.spi_mut()
     }
+}
+
+/// Phases in which the sequencer flies the excitation.
+fn is_excitation(phase: Phase) -> bool {
+    matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
 }
 
 /// The monitor's fault as the application's fault kind.
