@@ -112,6 +112,22 @@ pub struct CampaignArgs {
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Flight controller of the fly stages: `in-process` (the sequencer called
+    /// directly) or `board-sim` (the board application on emulated devices, see
+    /// `fly --fc board-sim`).
+    #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_campaign_fc)]
+    pub fc: FcArg,
+}
+
+/// Parse the campaign's `--fc`: `in-process` or `board-sim`.
+fn parse_campaign_fc(text: &str) -> Result<FcArg, String> {
+    match fly::parse_fc(text)? {
+        fc @ (FcArg::InProcess | FcArg::BoardSim) => Ok(fc),
+        _ => Err(format!(
+            "the campaign flies `in-process` or `board-sim`, not `{text}` (fly the board \
+             links with `sweephold fly --fc`)"
+        )),
+    }
 }
 
 impl CampaignArgs {
@@ -282,7 +298,7 @@ impl Campaign<'_> {
             perfect_sensors: false,
             linearized_plant: false,
             quiet: true,
-            fc: FcArg::InProcess,
+            fc: self.args.fc.clone(),
             elf: None,
             vibration: None,
             rc_loss_at_s: None,
@@ -293,7 +309,10 @@ impl Campaign<'_> {
 }
 
 fn fly_in_process(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
-    fly::fly(args, &|| Box::new(InProcessLink::new()))
+    match args.fc {
+        FcArg::BoardSim => fly::fly_board_sim(args),
+        _ => fly::fly(args, &|| Box::new(InProcessLink::new())),
+    }
 }
 
 /// The `fit` section of the summary from the final fit (truth filled in later).
@@ -687,6 +706,7 @@ mod tests {
             quick: true,
             no_trim_points: false,
             quiet: true,
+            fc: FcArg::InProcess,
         };
         let mut run = Campaign::new(&args);
         run.stage(Stage::Setup, Campaign::set_up).unwrap();

@@ -467,6 +467,19 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 run.max_abs_deg.theta,
                 if coherence.is_empty() { "-".to_string() } else { coherence.join(", ") }
             );
+            if let Some(estimator) = &run.estimator {
+                let e = estimator.max_error_deg;
+                eprintln!(
+                    "{:>9}  board estimate: max error phi {:.2} deg, theta {:.2} deg",
+                    "", e.phi, e.theta
+                );
+            }
+            if let Some(after) = &run.after {
+                eprintln!(
+                    "{:>9}  after the test: {:.1} s in {}, max |phi| {:4.1} deg, |theta| {:4.1} deg",
+                    "", after.duration_s, after.mode, after.max_abs_deg.phi, after.max_abs_deg.theta
+                );
+            }
         }
         eprintln!(
             "wrote {} records and summary.json to {}",
@@ -501,13 +514,16 @@ fn fly_on_link(args: &FlyArgs, image: Option<&std::path::Path>) -> anyhow::Resul
             &|| Box::new(link_serial::SerialLink::new(port.clone())),
             1,
         ),
-        FcArg::BoardSim => {
-            let settings = board_sim_settings(args)?;
-            fly(args, &|| {
-                Box::new(link_board_sim::BoardSimLink::new(settings.clone()))
-            })
-        }
+        FcArg::BoardSim => fly_board_sim(args),
     }
+}
+
+/// Fly `args` into `args.out` on the board-sim link (one per worker).
+pub fn fly_board_sim(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
+    let settings = board_sim_settings(args)?;
+    fly(args, &|| {
+        Box::new(link_board_sim::BoardSimLink::new(settings.clone()))
+    })
 }
 
 /// The board-sim link's settings for `args`.
