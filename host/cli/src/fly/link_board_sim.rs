@@ -38,8 +38,10 @@
 //! simulated tick, so every record starts in Pilot mode at the hover trim:
 //!
 //! 1. ground, rotor stopped, level and still: boot, gyro calibration (1 s), arm switch off,
-//!    throttle 0; the emulator has its bench imperfections (bias, noise, scale errors)
-//!    or none (`--vibration none`);
+//!    throttle 0; the emulator has its bench imperfections (bias, noise, scale errors),
+//!    or with `--vibration none` its white noise alone: an ideal chip's output at rest
+//!    is constant, which the IMU monitor rightly takes for a hung chip (stuck after
+//!    20 identical reads), so the board would never arm;
 //! 2. rotor running (the emulator's rotor vibration lines from now on, unless `none`):
 //!    arm switch on with the throttle low, then throttle 0.8: the soft start (4 s);
 //! 3. lift-off: the IMU turns smoothly from level to the trim attitude in 2 s, the
@@ -178,8 +180,8 @@ pub struct BoardSimSettings {
     pub trim: Trim,
     /// The simulator's options for the gimbal hover (sensors, actuators, plant).
     pub sim_options: SimOptions,
-    /// Rotor vibration and the chip's imperfections (`--vibration default`), or an ideal
-    /// chip (`none`).
+    /// Rotor vibration and the chip's imperfections (`--vibration default`), or a chip
+    /// with its white noise only (`none`).
     pub vibration: bool,
     /// Record time from which no SBUS frame is sent \[s\].
     pub rc_loss_at_s: Option<f64>,
@@ -324,7 +326,13 @@ impl BoardSimLink {
                 },
             )
         } else {
-            (Imperfections::IDEAL, Imperfections::IDEAL)
+            let quiet = Imperfections {
+                gyro_noise_rad_s: Imperfections::BENCH.gyro_noise_rad_s,
+                accel_noise_m_s2: Imperfections::BENCH.accel_noise_m_s2,
+                seed,
+                ..Imperfections::IDEAL
+            };
+            (quiet, quiet)
         };
         let mut emulator = Icm42688Emulator::new(rotor_stopped);
         if let Some(ImuFaultPlan { kind, at_s: None }) = settings.imu_fault {

@@ -202,8 +202,8 @@ pub struct FlyArgs {
     #[arg(long, value_name = "PATH")]
     pub elf: Option<PathBuf>,
     /// `--fc board-sim`: the emulated IMU's imperfections: `default` (bias, noise, scale
-    /// errors and the TREX 700L's rotor vibration lines) or `none` (an ideal chip)
-    /// [default: default].
+    /// errors and the TREX 700L's rotor vibration lines) or `none` (the chip's white noise
+    /// alone) [default: default].
     #[arg(long, value_enum, value_name = "LEVEL")]
     pub vibration: Option<VibrationArg>,
     /// `--fc board-sim`: stop sending SBUS frames from this record time on [s], >= 0.
@@ -225,7 +225,8 @@ pub struct FlyArgs {
 pub enum VibrationArg {
     /// Bias, noise, scale errors and the rotor vibration lines.
     Default,
-    /// An ideal chip: the quantised truth.
+    /// The chip's white noise alone (no bias, scale error or vibration): an ideal chip
+    /// reads constant at rest, which the IMU monitor takes for a hung chip.
     None,
 }
 
