@@ -112,22 +112,6 @@ pub struct CampaignArgs {
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
-    /// Flight controller of the fly stages: `in-process` (the sequencer called
-    /// directly) or `board-sim` (the board application on emulated devices, see
-    /// `fly --fc board-sim`).
-    #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_campaign_fc)]
-    pub fc: FcArg,
-}
-
-/// Parse the campaign's `--fc`: `in-process` or `board-sim`.
-fn parse_campaign_fc(text: &str) -> Result<FcArg, String> {
-    match fly::parse_fc(text)? {
-        fc @ (FcArg::InProcess | FcArg::BoardSim) => Ok(fc),
-        _ => Err(format!(
-            "the campaign flies `in-process` or `board-sim`, not `{text}` (fly the board \
-             links with `sweephold fly --fc`)"
-        )),
-    }
 }
 
 impl CampaignArgs {
@@ -298,7 +282,7 @@ impl Campaign<'_> {
             perfect_sensors: false,
             linearized_plant: false,
             quiet: true,
-            fc: self.args.fc.clone(),
+            fc: FcArg::InProcess,
             elf: None,
             vibration: None,
             rc_loss_at_s: None,
@@ -309,10 +293,7 @@ impl Campaign<'_> {
 }
 
 fn fly_in_process(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
-    match args.fc {
-        FcArg::BoardSim => fly::fly_board_sim(args),
-        _ => fly::fly(args, &|| Box::new(InProcessLink::new())),
-    }
+    fly::fly(args, &|| Box::new(InProcessLink::new()))
 }
 
 /// The `fit` section of the summary from the final fit (truth filled in later).
@@ -706,7 +687,6 @@ mod tests {
             quick: true,
             no_trim_points: false,
             quiet: true,
-            fc: FcArg::InProcess,
         };
         let mut run = Campaign::new(&args);
         run.stage(Stage::Setup, Campaign::set_up).unwrap();
