@@ -193,7 +193,10 @@ pub struct FlyArgs {
     /// directly), `qemu` (the board image in qemu-system-arm, one per worker; its defmt
     /// log is decoded into OUT/<record>.log), `qemu-usart` (the same over its emulated
     /// USART: slow, no log) or `serial:PATH[@BAUD]` (a real board on a serial port,
-    /// default 460800 Bd; records flown one at a time).
+    /// default 460800 Bd; records flown one at a time) or `board-sim` (the board
+    /// application's sensor-to-servo stack on an emulated IMU and SBUS receiver, booted,
+    /// armed and hovering before each record; see --vibration, --rc-loss, --imu-fault,
+    /// --fly-on).
     #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_fc)]
     pub fc: FcArg,
     /// Board image for `--fc qemu` (a 32-bit ARM ELF, checked before QEMU starts) [default:
