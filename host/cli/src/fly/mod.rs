@@ -192,7 +192,7 @@ pub struct FlyArgs {
     /// Flight controller in the loop: `in-process` (the firmware library called
     /// directly), `qemu` (the board image in qemu-system-arm, one per worker; its defmt
     /// log is decoded into OUT/<record>.log), `qemu-usart` (the same over its emulated
-    /// USART: slow, no log) or `serial:PATH[@BAUD]` (a real board on a serial port,
+    /// USART: slow, no log), `serial:PATH[@BAUD]` (a real board on a serial port,
     /// default 460800 Bd; records flown one at a time) or `board-sim` (the board
     /// application's sensor-to-servo stack on an emulated IMU and SBUS receiver, booted,
     /// armed and hovering before each record; see --vibration, --rc-loss, --imu-fault,
