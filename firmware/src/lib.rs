@@ -38,8 +38,11 @@
 //! board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot calibration
 //! and, on the host, a register-level emulator of the chip), [`receiver`] (SBUS decoding,
 //! link monitoring, the channel map), [`filters`] (biquads and the IMU filter bank) and
-//! [`estimator`] (the attitude estimator); and [`app`] (the board application: arming, the
-//! stabilised pilot mode, failsafes and the throttle around the sequencer).
+//! [`estimator`] (the attitude estimator); [`app`] (the board application: arming, the
+//! stabilised pilot mode, failsafes and the throttle around the sequencer); and
+//! [`board_stack`] (all of these wired together: the IMU polled at 1 kHz through the
+//! monitor, calibration, filters and estimator, the receiver bytes through the SBUS
+//! decoder and channel map, and the application's control tick).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -59,6 +62,7 @@ mod fmt;
 pub mod amplitude;
 pub mod app;
 pub mod attitude_hold;
+pub mod board_stack;
 pub mod config;
 pub mod controller;
 pub mod estimator;

@@ -152,6 +152,9 @@ pub enum UpdateKind {
     AccelOutOfBand,
     /// Gyro propagation only: an accelerometer component is NaN or infinite.
     AccelNotFinite,
+    /// Gyro propagation only: the caller gated the accelerometer
+    /// ([`Mahony::propagate`]).
+    AccelGated,
     /// Nothing changed: a gyro component is NaN, infinite or beyond
     /// [`MAX_GYRO_RAD_S`].
     GyroRejected,
@@ -182,7 +185,8 @@ pub struct Estimate {
 pub struct UpdateCounts {
     /// [`UpdateKind::Fused`].
     pub fused: u32,
-    /// [`UpdateKind::AccelOutOfBand`] and [`UpdateKind::AccelNotFinite`].
+    /// [`UpdateKind::AccelOutOfBand`], [`UpdateKind::AccelNotFinite`] and
+    /// [`UpdateKind::AccelGated`].
     pub gyro_only: u32,
     /// [`UpdateKind::GyroRejected`].
     pub rejected: u32,
@@ -319,6 +323,18 @@ impl Mahony {
     /// One IMU sample: `gyro` \[rad/s\] and specific force `accel` \[m/s²\], IMU axes.
     /// Bounded time: one exponential map, one square root, no loops over data.
     pub fn update(&mut self, gyro: [f32; 3], accel: [f32; 3]) -> UpdateKind {
+        self.step(gyro, Some(accel))
+    }
+
+    /// One IMU sample propagated on the gyro alone, the accelerometer gated by the caller
+    /// (a manoeuvre in which the specific force is known not to point along gravity): as
+    /// [`update`](Self::update) with the correction and the bias update off. Returns
+    /// [`UpdateKind::AccelGated`], or [`UpdateKind::GyroRejected`] for a corrupt gyro.
+    pub fn propagate(&mut self, gyro: [f32; 3]) -> UpdateKind {
+        self.step(gyro, None)
+    }
+
+    fn step(&mut self, gyro: [f32; 3], accel: Option<[f32; 3]>) -> UpdateKind {
         if !gyro
             .iter()
             .all(|w| w.is_finite() && w.abs() <= MAX_GYRO_RAD_S)
@@ -327,7 +343,11 @@ impl Mahony {
             return UpdateKind::GyroRejected;
         }
         let corrected = zip3(gyro, self.bias, |w, b| w - b);
-        let (error, kind) = match self.accel_direction(accel) {
+        let direction = match accel {
+            Some(accel) => self.accel_direction(accel),
+            None => Err(UpdateKind::AccelGated),
+        };
+        let (error, kind) = match direction {
             Ok(measured) => (
                 cross(measured, self.attitude.down_in_body()),
                 UpdateKind::Fused,

@@ -456,3 +456,27 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn propagate_is_update_with_the_accelerometer_gated() {
+    let config = MahonyConfig::helicopter(1000.0);
+    let mut gated = Mahony::new(config).unwrap();
+    let mut by_nan = Mahony::new(config).unwrap();
+    gated.set_bias([0.01, -0.02, 0.005]);
+    by_nan.set_bias([0.01, -0.02, 0.005]);
+    for k in 0..500 {
+        let gyro = [0.3, -0.1 * (k as f32 * 0.01).sin(), 0.05];
+        assert_eq!(gated.propagate(gyro), UpdateKind::AccelGated);
+        assert_eq!(
+            by_nan.update(gyro, [f32::NAN; 3]),
+            UpdateKind::AccelNotFinite
+        );
+    }
+    assert_eq!(gated.imu_attitude(), by_nan.imu_attitude());
+    assert_eq!(gated.bias(), by_nan.bias());
+    assert_eq!(gated.counts().gyro_only, 500);
+    assert_eq!(
+        gated.propagate([f32::NAN, 0.0, 0.0]),
+        UpdateKind::GyroRejected
+    );
+}

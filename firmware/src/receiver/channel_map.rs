@@ -309,6 +309,80 @@ impl ChannelMap {
         }
     }
 
+    /// The transmitter's side of [`map`](Self::map): the frame a radio sends for
+    /// `input` (a transmitter model for the host and the tests). Sticks, throttle and
+    /// switches are written to their channels, reversal included: a stick `s` becomes
+    /// `centre + round(s·span)` with the span of its half, the throttle
+    /// `min + round(t·(max − min))`, a two-position switch full travel on (+1) or off
+    /// (−1), the mode switch −1, 0 or +1. Non-finite values write the centre (throttle:
+    /// the minimum); other channels stay at the centre; no flag is set. For a valid map,
+    /// `map(encode(x))` returns `x` with each stick and the throttle rounded to the
+    /// nearest raw count.
+    pub fn encode(&self, input: &RcInput) -> SbusFrame {
+        let range = self.range;
+        let mut frame = SbusFrame {
+            channels: [range.centre; CHANNELS],
+            ..SbusFrame::default()
+        };
+        let stick_raw = |source: &ChannelSource, value: f32| -> u16 {
+            let s = if value.is_finite() {
+                value.clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
+            let s = if source.reversed { -s } else { s };
+            let centre = f32::from(range.centre);
+            let span = if s < 0.0 {
+                centre - f32::from(range.min)
+            } else {
+                f32::from(range.max) - centre
+            };
+            libm::roundf(centre + s * span).clamp(0.0, f32::from(super::sbus::CHANNEL_MAX)) as u16
+        };
+        let throttle_raw = |source: &ChannelSource, value: f32| -> u16 {
+            let t = if value.is_finite() {
+                value.clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let t = if source.reversed { 1.0 - t } else { t };
+            let min = f32::from(range.min);
+            libm::roundf(min + t * (f32::from(range.max) - min))
+                .clamp(0.0, f32::from(super::sbus::CHANNEL_MAX)) as u16
+        };
+        let switch = |on: bool| if on { 1.0 } else { -1.0 };
+        let mode = match input.mode {
+            ModeSwitch::Low => -1.0,
+            ModeSwitch::Middle => 0.0,
+            ModeSwitch::High => 1.0,
+        };
+        let writes = [
+            (self.lateral, stick_raw(&self.lateral, input.sticks.lat)),
+            (
+                self.longitudinal,
+                stick_raw(&self.longitudinal, input.sticks.lon),
+            ),
+            (self.throttle, throttle_raw(&self.throttle, input.throttle)),
+            (self.pedal, stick_raw(&self.pedal, input.sticks.ped)),
+            (self.arm, stick_raw(&self.arm, switch(input.arm))),
+            (
+                self.collective,
+                stick_raw(&self.collective, input.sticks.col),
+            ),
+            (self.test, stick_raw(&self.test, switch(input.test_switch))),
+            (self.mode, stick_raw(&self.mode, mode)),
+        ];
+        for (source, raw) in writes {
+            let slot = usize::from(source.channel)
+                .checked_sub(1)
+                .and_then(|index| frame.channels.get_mut(index));
+            if let Some(slot) = slot {
+                *slot = raw;
+            }
+        }
+        frame
+    }
+
     fn stick(&self, source: &ChannelSource, frame: &SbusFrame) -> f32 {
         match source.raw(frame) {
             Some(raw) => {

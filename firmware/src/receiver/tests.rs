@@ -783,3 +783,83 @@ fn every_raw_value_maps_to_a_finite_in_range_monotone_output() {
         previous = (input.sticks.lat, input.throttle);
     }
 }
+
+// ---------------------------------------------------------------------------------
+// The transmitter model: ChannelMap::encode is map's inverse up to one raw count.
+// ---------------------------------------------------------------------------------
+
+fn arb_mode() -> impl Strategy<Value = ModeSwitch> {
+    prop_oneof![
+        Just(ModeSwitch::Low),
+        Just(ModeSwitch::Middle),
+        Just(ModeSwitch::High)
+    ]
+}
+
+proptest! {
+    #[test]
+    fn encode_then_map_returns_the_input(
+        sticks in proptest::array::uniform4(-1.0f32..=1.0),
+        throttle in 0.0f32..=1.0,
+        arm in any::<bool>(),
+        test_switch in any::<bool>(),
+        mode in arb_mode(),
+        reversed in any::<[bool; 8]>(),
+    ) {
+        let mut map = ChannelMap::flybarless_default();
+        map.lateral.reversed = reversed[0];
+        map.longitudinal.reversed = reversed[1];
+        map.throttle.reversed = reversed[2];
+        map.pedal.reversed = reversed[3];
+        map.arm.reversed = reversed[4];
+        map.collective.reversed = reversed[5];
+        map.test.reversed = reversed[6];
+        map.mode.reversed = reversed[7];
+        let [lat, lon, ped, col] = sticks;
+        let input = RcInput {
+            sticks: sweephold_protocol::Controls { lat, lon, ped, col },
+            throttle,
+            arm,
+            test_switch,
+            mode,
+        };
+        let frame = map.encode(&input);
+        prop_assert!(frame.is_intact());
+        let back = map.map(&frame);
+        // One raw count: 1/819 of a half travel, 1/1639 of the throttle's.
+        for (a, b) in input.sticks.to_array().iter().zip(back.sticks.to_array()) {
+            prop_assert!((a - b).abs() <= 0.5 / 819.0 + 1e-6, "{a} -> {b}");
+        }
+        prop_assert!((input.throttle - back.throttle).abs() <= 0.5 / 1639.0 + 1e-6);
+        prop_assert_eq!(back.arm, arm);
+        prop_assert_eq!(back.test_switch, test_switch);
+        prop_assert_eq!(back.mode, mode);
+    }
+}
+
+#[test]
+fn encode_writes_the_centre_for_non_finite_sticks_and_the_minimum_throttle() {
+    let map = ChannelMap::flybarless_default();
+    let input = RcInput {
+        sticks: sweephold_protocol::Controls {
+            lat: f32::NAN,
+            lon: f32::INFINITY,
+            ped: f32::NEG_INFINITY,
+            col: 0.5,
+        },
+        throttle: f32::NAN,
+        arm: false,
+        test_switch: false,
+        mode: ModeSwitch::Middle,
+    };
+    let frame = map.encode(&input);
+    assert_eq!(&frame.channels[..4], &[992, 992, 172, 992]);
+    assert_eq!(frame.channels[4], 172, "arm off: full negative travel");
+    assert_eq!(
+        frame.channels[5],
+        992 + 410,
+        "collective 0.5: 992 + round(409.5)"
+    );
+    assert_eq!(frame.channels[7], 992, "mode Middle: centre");
+    assert_eq!(frame.channels[8..], [992; 8]);
+}

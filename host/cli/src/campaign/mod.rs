@@ -295,6 +295,10 @@ impl Campaign<'_> {
             quiet: true,
             fc: FcArg::InProcess,
             elf: None,
+            vibration: None,
+            rc_loss_at_s: None,
+            imu_fault: None,
+            fly_on_s: None,
         }
     }
 }

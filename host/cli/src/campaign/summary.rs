@@ -306,6 +306,8 @@ mod tests {
             },
             hold_fraction: HoldFraction::default(),
             cross_coherence: lon.map(|c| ("lon".to_string(), c)).into_iter().collect(),
+            estimator: None,
+            after: None,
         }
     }
 

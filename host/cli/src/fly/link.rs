@@ -26,6 +26,12 @@ pub trait FlightControllerLink {
         telemetry: &mut Vec<u8>,
     ) -> anyhow::Result<ActuatorOut>;
 
+    /// The board application's mode after the last tick (`pilot`, `rc_failsafe`, …), for
+    /// a link that runs one (`board-sim`). Default: none.
+    fn board_mode(&self) -> Option<&'static str> {
+        None
+    }
+
     /// The record begun last is over (flown, aborted or failed); its dump is
     /// `dump_name` (e.g. `lat-1.bin`). A link that captures the flight controller's log
     /// writes it beside the dump here. Default: nothing.

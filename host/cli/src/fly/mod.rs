@@ -4,6 +4,7 @@
 pub mod defmt_log;
 pub mod frame_channel;
 pub mod link;
+pub mod link_board_sim;
 pub mod link_qemu;
 pub mod link_serial;
 pub mod plan;
@@ -224,8 +225,11 @@ pub struct FlyArgs {
     /// Flight controller in the loop: `in-process` (the firmware library called
     /// directly), `qemu` (the board image in qemu-system-arm, one per worker; its defmt
     /// log is decoded into OUT/<record>.log), `qemu-usart` (the same over its emulated
-    /// USART: slow, no log) or `serial:PATH[@BAUD]` (a real board on a serial port,
-    /// default 460800 Bd; records flown one at a time).
+    /// USART: slow, no log), `serial:PATH[@BAUD]` (a real board on a serial port,
+    /// default 460800 Bd; records flown one at a time) or `board-sim` (the board
+    /// application's sensor-to-servo stack on an emulated IMU and SBUS receiver, booted,
+    /// armed and hovering before each record; see --vibration, --rc-loss, --imu-fault,
+    /// --fly-on).
     #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_fc)]
     pub fc: FcArg,
     /// Board image for `--fc qemu` (a 32-bit ARM ELF, checked before QEMU starts) [default:
@@ -233,6 +237,43 @@ pub struct FlyArgs {
     /// workspace this binary was built in, else of the current folder].
     #[arg(long, value_name = "PATH")]
     pub elf: Option<PathBuf>,
+    /// `--fc board-sim`: the emulated IMU's imperfections: `default` (bias, noise, scale
+    /// errors and the TREX 700L's rotor vibration lines) or `none` (the chip's white noise
+    /// alone) [default: default].
+    #[arg(long, value_enum, value_name = "LEVEL")]
+    pub vibration: Option<VibrationArg>,
+    /// `--fc board-sim`: stop sending SBUS frames from this record time on [s], >= 0.
+    #[arg(long = "rc-loss", value_name = "AT_S", value_parser = arg_values::non_negative, allow_hyphen_values = true)]
+    pub rc_loss_at_s: Option<f64>,
+    /// `--fc board-sim`: IMU fault of the emulated chip: `stuck@AT_S`, `saturate@AT_S`,
+    /// `missing@AT_S` (from that record time on) or `missing` (no chip from power-on:
+    /// the board cannot arm).
+    #[arg(long = "imu-fault", value_name = "FAULT", value_parser = link_board_sim::ImuFaultPlan::parse)]
+    pub imu_fault: Option<link_board_sim::ImuFaultPlan>,
+    /// `--fc board-sim`: keep flying this long after the test ended (Done or an abort),
+    /// the pilot's hands at trim [s], 0–600.
+    #[arg(long = "fly-on", value_name = "SECONDS", value_parser = parse_fly_on, allow_hyphen_values = true)]
+    pub fly_on_s: Option<f64>,
+}
+
+/// `--vibration` on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VibrationArg {
+    /// Bias, noise, scale errors and the rotor vibration lines.
+    Default,
+    /// The chip's white noise alone (no bias, scale error or vibration): an ideal chip
+    /// reads constant at rest, which the IMU monitor takes for a hung chip.
+    None,
+}
+
+/// Longest `--fly-on` [s].
+pub const MAX_FLY_ON_S: f64 = 600.0;
+
+fn parse_fly_on(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(t) if (0.0..=MAX_FLY_ON_S).contains(&t) => Ok(t),
+        _ => Err(format!("expected seconds from 0 to {MAX_FLY_ON_S}")),
+    }
 }
 
 /// Flight controller on the command line.
@@ -246,19 +287,23 @@ pub enum FcArg {
     QemuUsart,
     /// A real board on a serial port (`serial:PATH[@BAUD]`).
     Serial(link_serial::SerialPort),
+    /// The board application (the firmware's `BoardStack`) in-process on an emulated IMU
+    /// and an SBUS byte stream.
+    BoardSim,
 }
 
-/// Parse `--fc`: `in-process`, `qemu`, `qemu-usart` or `serial:PATH[@BAUD]`.
+/// Parse `--fc`: `in-process`, `qemu`, `qemu-usart`, `serial:PATH[@BAUD]` or `board-sim`.
 pub fn parse_fc(text: &str) -> Result<FcArg, String> {
     match text {
         "in-process" => Ok(FcArg::InProcess),
+        "board-sim" => Ok(FcArg::BoardSim),
         "qemu" => Ok(FcArg::Qemu),
         "qemu-usart" => Ok(FcArg::QemuUsart),
         _ => match text.strip_prefix("serial:") {
             Some(port) => link_serial::SerialPort::parse(port).map(FcArg::Serial),
             None => Err(format!(
-                "unknown flight controller `{text}` (expected in-process, qemu, qemu-usart \
-                 or serial:PATH[@BAUD])"
+                "unknown flight controller `{text}` (expected in-process, qemu, qemu-usart, \
+                 serial:PATH[@BAUD] or board-sim)"
             )),
         },
     }
@@ -339,6 +384,33 @@ impl FlyArgs {
                 "--t-rec {}: expected a record length from {MIN_T_REC_S} to {MAX_T_REC_S} s",
                 self.t_rec_s
             );
+        }
+        if self.fc != FcArg::BoardSim {
+            let board_only = [
+                ("--vibration", self.vibration.is_some()),
+                ("--rc-loss", self.rc_loss_at_s.is_some()),
+                ("--imu-fault", self.imu_fault.is_some()),
+                ("--fly-on", self.fly_on_s.is_some()),
+            ];
+            if let Some((flag, _)) = board_only.iter().find(|(_, given)| *given) {
+                bail!("{flag} is for --fc board-sim only");
+            }
+        } else if self.rate_hz == 0 || 1000 % self.rate_hz != 0 {
+            bail!(
+                "--fc board-sim needs a --rate that divides the IMU's 1000 Hz (50, 100, 125, \
+                 200, 250, 500 or 1000), not {}",
+                self.rate_hz
+            );
+        }
+        if let Some(t) = self.rc_loss_at_s {
+            if !t.is_finite() || t < 0.0 {
+                bail!("--rc-loss {t}: expected a record time >= 0 s");
+            }
+        }
+        if let Some(t) = self.fly_on_s {
+            if !(0.0..=MAX_FLY_ON_S).contains(&t) {
+                bail!("--fly-on {t}: expected seconds from 0 to {MAX_FLY_ON_S}");
+            }
         }
         if let Some(at) = self.pilot_override_at_s {
             let shortest = self
@@ -433,6 +505,19 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 run.max_abs_deg.theta,
                 if coherence.is_empty() { "-".to_string() } else { coherence.join(", ") }
             );
+            if let Some(estimator) = &run.estimator {
+                let e = estimator.max_error_deg;
+                eprintln!(
+                    "{:>9}  board estimate: max error phi {:.2} deg, theta {:.2} deg",
+                    "", e.phi, e.theta
+                );
+            }
+            if let Some(after) = &run.after {
+                eprintln!(
+                    "{:>9}  after the test: {:.1} s in {}, max |phi| {:4.1} deg, |theta| {:4.1} deg",
+                    "", after.duration_s, after.mode, after.max_abs_deg.phi, after.max_abs_deg.theta
+                );
+            }
         }
         eprintln!(
             "wrote {} records and summary.json to {}",
@@ -467,7 +552,43 @@ fn fly_on_link(args: &FlyArgs, image: Option<&std::path::Path>) -> anyhow::Resul
             &|| Box::new(link_serial::SerialLink::new(port.clone())),
             1,
         ),
+        FcArg::BoardSim => fly_board_sim(args),
     }
+}
+
+/// Fly `args` into `args.out` on the board-sim link (one per worker).
+pub fn fly_board_sim(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
+    let settings = board_sim_settings(args)?;
+    fly(args, &|| {
+        Box::new(link_board_sim::BoardSimLink::new(settings.clone()))
+    })
+}
+
+/// The board-sim link's settings for `args`.
+pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::BoardSimSettings> {
+    let heli = args.vehicle.sim().helicopter();
+    let trim = bo105::trim(&heli, 0.0)
+        .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
+    Ok(link_board_sim::BoardSimSettings {
+        bo105: args.vehicle == VehicleArg::Bo105,
+        heli,
+        trim,
+        sim_options: sim_options(args),
+        vibration: args.vibration != Some(VibrationArg::None),
+        rc_loss_at_s: args.rc_loss_at_s,
+        imu_fault: args.imu_fault,
+    })
+}
+
+/// The simulator's options for `args` (before the seed and the disturbances).
+fn sim_options(args: &FlyArgs) -> bo105::SimOptions {
+    let mut sim_options = bo105::SimOptions::default();
+    if args.perfect_sensors {
+        // Sensors only: the actuators keep their servo dynamics and delay.
+        sim_options.sensor_noise = bo105::SensorNoise::perfect();
+    }
+    sim_options.linearized_plant = args.linearized_plant;
+    sim_options
 }
 
 /// Refuse a bad command line or a configuration the firmware would refuse, before
@@ -512,18 +633,14 @@ pub fn fly_with_workers(
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
 
-    let mut sim_options = bo105::SimOptions::default();
-    if args.perfect_sensors {
-        // Sensors only: the actuators keep their servo dynamics and delay.
-        sim_options.sensor_noise = bo105::SensorNoise::perfect();
-    }
-    sim_options.linearized_plant = args.linearized_plant;
+    let sim_options = sim_options(args);
     let disturbances = Disturbances {
         gust_level: args.gust,
         sensor_dropout: args.sensor_dropout,
         sensor_spike: args.sensor_spike,
         pilot_override_at_s: args.pilot_override_at_s,
         pilot_stick_noise: args.pilot_noise,
+        fly_on_s: args.fly_on_s.unwrap_or(0.0),
     };
 
     let bars = MultiProgress::with_draw_target(if args.quiet {
@@ -648,6 +765,10 @@ fn finish_record(
         max_abs_deg: flown.max_abs_deg,
         hold_fraction: flown.hold_fraction,
         cross_coherence,
+        estimator: (args.fc == FcArg::BoardSim).then_some(summary::EstimatorSummary {
+            max_error_deg: flown.attitude_error_deg,
+        }),
+        after: flown.after,
     })
 }
 

@@ -8,7 +8,7 @@ use sweephold_protocol::{
 use sysid::random::SplitMix64;
 
 use super::link::FlightControllerLink;
-use super::summary::{HoldFraction, MaxAbsDeg};
+use super::summary::{AfterTest, AttitudeDeg, HoldFraction, MaxAbsDeg};
 
 /// Disturbances and faults injected into one record.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -23,6 +23,9 @@ pub struct Disturbances {
     pub pilot_override_at_s: Option<f64>,
     /// RMS of random pilot stick motion around trim, fraction of travel (0: hands still).
     pub pilot_stick_noise: f64,
+    /// Seconds flown on after the test ended (Done or Aborted), the pilot's hands at trim
+    /// (0: the record ends with the test).
+    pub fly_on_s: f64,
 }
 
 /// What one record produced.
@@ -40,8 +43,14 @@ pub struct FlownRecord {
     pub max_abs_deg: MaxAbsDeg,
     /// Share of excitation ticks with the hold engaged.
     pub hold_fraction: HoldFraction,
-    /// The final sequencer phase.
+    /// The final sequencer phase (at the end of the test).
     pub final_phase: Phase,
+    /// Largest |estimate − simulator| of φ and θ over the excitation (over the whole test
+    /// if it had none): what the flight controller measured (the Samples' φ, θ) against
+    /// the simulated aircraft's attitude.
+    pub attitude_error_deg: AttitudeDeg,
+    /// The flight after the test (`Disturbances::fly_on_s` > 0).
+    pub after: Option<AfterTest>,
 }
 
 /// Watches the telemetry as it streams, as a ground station would.
@@ -54,6 +63,8 @@ struct TelemetryMonitor {
     max_abs: MaxAbsDeg,
     excitation_ticks: u64,
     engaged_ticks: [u64; 3],
+    /// The last Sample seen.
+    last: Option<Sample>,
 }
 
 impl TelemetryMonitor {
@@ -61,14 +72,17 @@ impl TelemetryMonitor {
         let decoder = &mut self.decoder;
         for frame in decoder.feed(bytes).flatten() {
             match frame {
-                Frame::Sample(sample) => Self::sample(
-                    &sample,
-                    &mut self.phase,
-                    &mut self.start_psi,
-                    &mut self.max_abs,
-                    &mut self.excitation_ticks,
-                    &mut self.engaged_ticks,
-                ),
+                Frame::Sample(sample) => {
+                    Self::sample(
+                        &sample,
+                        &mut self.phase,
+                        &mut self.start_psi,
+                        &mut self.max_abs,
+                        &mut self.excitation_ticks,
+                        &mut self.engaged_ticks,
+                    );
+                    self.last = Some(sample);
+                }
                 Frame::Event(Event::Abort { reason, .. }) => self.abort = Some(reason),
                 _ => {}
             }
@@ -115,6 +129,40 @@ impl TelemetryMonitor {
     }
 }
 
+/// Largest |measured − true| φ and θ over ticks, kept separately for the excitation and
+/// the whole test.
+#[derive(Default)]
+struct AttitudeErrors {
+    excitation: Option<AttitudeDeg>,
+    test: AttitudeDeg,
+}
+
+impl AttitudeErrors {
+    fn add(&mut self, sample: &Sample, truth: [f64; 3]) {
+        let error = |measured: f32, truth: f64| {
+            bo105::sim::wrap_angle(f64::from(measured) - truth)
+                .abs()
+                .to_degrees()
+        };
+        let (phi, theta) = (
+            error(sample.meas.phi, truth[0]),
+            error(sample.meas.theta, truth[1]),
+        );
+        let grow = |max: &mut AttitudeDeg| {
+            max.phi = max.phi.max(phi);
+            max.theta = max.theta.max(theta);
+        };
+        grow(&mut self.test);
+        if matches!(sample.phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut) {
+            grow(self.excitation.get_or_insert_with(AttitudeDeg::default));
+        }
+    }
+
+    fn result(&self) -> AttitudeDeg {
+        self.excitation.unwrap_or(self.test)
+    }
+}
+
 /// Ticks flown in Idle before the pilot flips the test switch.
 const IDLE_TICKS: u64 = 10;
 
@@ -130,7 +178,8 @@ pub struct Aircraft<'a> {
 }
 
 /// Fly one record: start the simulator at trim, arm the flight controller, and run the
-/// lockstep loop until the test is done or aborted (or `max_s` of flight time passed).
+/// lockstep loop until the test is done or aborted (or `max_s` of flight time passed),
+/// then `fly_on_s` more seconds with the pilot's hands at trim.
 pub fn fly_record(
     link: &mut dyn FlightControllerLink,
     config: &Config,
@@ -157,16 +206,24 @@ pub fn fly_record(
     let mut monitor = TelemetryMonitor::default();
     let mut reading = sim.step(dt, trim.controls);
     let max_ticks = (max_s * rate).ceil() as u64;
+    let fly_on_ticks = (disturbances.fly_on_s.max(0.0) * rate).round() as u64;
+    let mut truth = sim.state().attitude();
+    let mut errors = AttitudeErrors::default();
+    // The tick count and final phase when the test ended, and the flight after it.
+    let mut ended: Option<(u64, Phase)> = None;
+    let mut after = AttitudeDeg::default();
     let mut ticks = 0;
-    while ticks < max_ticks {
+    while ticks < max_ticks + fly_on_ticks {
         let armed_s = ticks.saturating_sub(IDLE_TICKS) as f64 * dt;
         let mut sticks = trim_sticks;
-        if disturbances.pilot_stick_noise > 0.0 {
+        if ended.is_some() {
+            // Flying on: the pilot's hands at trim.
+        } else if disturbances.pilot_stick_noise > 0.0 {
             for s in &mut sticks {
                 *s += (disturbances.pilot_stick_noise * pilot_rng.gaussian()) as f32;
             }
         }
-        if let Some(at) = disturbances.pilot_override_at_s {
+        if let (Some(at), None) = (disturbances.pilot_override_at_s, ended) {
             if ticks >= IDLE_TICKS && armed_s >= at {
                 sticks[0] += 0.2;
             }
@@ -182,24 +239,63 @@ pub fn fly_record(
         let start = dump.len();
         let out = link.exchange(&input, &mut dump)?;
         monitor.observe(&dump[start..]);
+        if ended.is_none() {
+            if let Some(sample) = &monitor.last {
+                errors.add(sample, truth);
+            }
+        }
         let command = out.command.to_array().map(f64::from);
         reading = sim.step(dt, command);
+        truth = sim.state().attitude();
         ticks += 1;
         if ticks % 200 == 0 {
             progress(ticks as f64 * dt);
         }
-        if ticks > IDLE_TICKS && matches!(monitor.phase, Some(Phase::Done | Phase::Aborted)) {
-            break;
+        match ended {
+            Some((end, _)) => {
+                after.phi = after.phi.max(truth[0].abs().to_degrees());
+                after.theta = after.theta.max(truth[1].abs().to_degrees());
+                if ticks >= end + fly_on_ticks {
+                    break;
+                }
+            }
+            None => {
+                // The board application's own aborts (receiver, IMU) leave the sequencer
+                // Idle within the tick: the Abort Event ends the test too.
+                let over = matches!(monitor.phase, Some(Phase::Done | Phase::Aborted))
+                    || monitor.abort.is_some();
+                if ticks > IDLE_TICKS && over {
+                    let phase = if monitor.abort.is_some() {
+                        Phase::Aborted
+                    } else {
+                        monitor.phase.unwrap_or(Phase::Idle)
+                    };
+                    ended = Some((ticks, phase));
+                    if fly_on_ticks == 0 {
+                        break;
+                    }
+                } else if ticks >= max_ticks {
+                    break;
+                }
+            }
         }
     }
     monitor.decoder.finish();
+    let (test_ticks, final_phase) = ended.unwrap_or((ticks, monitor.phase.unwrap_or(Phase::Idle)));
+    let after = (fly_on_ticks > 0).then(|| AfterTest {
+        mode: link.board_mode().unwrap_or("unknown").to_string(),
+        duration_s: ticks.saturating_sub(test_ticks) as f64 * dt,
+        max_abs_deg: after,
+    });
     Ok(FlownRecord {
         frames: monitor.decoder.stats().good_frames,
-        ticks,
+        ticks: test_ticks,
         abort: monitor.abort,
         max_abs_deg: monitor.max_abs,
         hold_fraction: monitor.hold_fraction(),
-        final_phase: monitor.phase.unwrap_or(Phase::Idle),
+        final_phase,
+        attitude_error_deg: errors.result(),
+        after,
         dump,
     })
 }

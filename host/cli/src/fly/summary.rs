@@ -27,6 +27,35 @@ pub struct HoldFraction {
     pub ped: f64,
 }
 
+/// A pair of roll and pitch angles [deg].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AttitudeDeg {
+    /// Roll φ [deg].
+    pub phi: f64,
+    /// Pitch θ [deg].
+    pub theta: f64,
+}
+
+/// The board's attitude estimate against the simulator (`--fc board-sim`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EstimatorSummary {
+    /// Largest |estimate − simulator| over the excitation (over the whole test if it
+    /// had none) [deg].
+    pub max_error_deg: AttitudeDeg,
+}
+
+/// The flight after the test (`fly --fly-on`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AfterTest {
+    /// The board application's mode at the end (`pilot`, `rc_failsafe`,
+    /// `imu_failsafe`, `disarmed`).
+    pub mode: String,
+    /// Time flown after the test ended [s].
+    pub duration_s: f64,
+    /// Peak |φ|, |θ| of the simulated aircraft over that time [deg].
+    pub max_abs_deg: AttitudeDeg,
+}
+
 /// One flown record.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSummary {
@@ -40,7 +69,8 @@ pub struct RunSummary {
     pub omega_min: f64,
     /// Sweep end frequency [rad/s].
     pub omega_max: f64,
-    /// Flown duration, arming to the end of the record [s].
+    /// Flown duration, from the record's start to the end of the test (Done or the abort)
+    /// [s]; the time flown on after it is `after.duration_s`.
     pub duration_s: f64,
     /// Frames in the dump.
     pub frames: u64,
@@ -55,6 +85,12 @@ pub struct RunSummary {
     /// Average coherence between the primary control and each other control over the
     /// sweep band, keyed by control name.
     pub cross_coherence: BTreeMap<String, f64>,
+    /// The board's attitude estimate against the simulator (`--fc board-sim` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorSummary>,
+    /// The flight after the test (`--fly-on` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub after: Option<AfterTest>,
 }
 
 /// The whole `summary.json`.
@@ -68,7 +104,7 @@ pub struct FlySummary {
     pub rate_hz: u32,
     /// Campaign seed.
     pub seed: u64,
-    /// Flight-controller link (`in-process`, `qemu`, `serial:PATH`).
+    /// Flight-controller link (`in-process`, `qemu`, `serial:PATH`, `board-sim`).
     pub link: String,
     /// The aircraft flown: `nonlinear` (the simulator) or `linearized` (its expansion
     /// about the hover trim, `--linearized-plant`). Absent in older files: `nonlinear`.

@@ -1,0 +1,565 @@
+//! `--fc board-sim`: the board application flown on the host against emulated devices.
+//!
+//! The firmware's [`BoardStack`] — the code the board's runner calls: IMU driver,
+//! monitor, calibration, filter bank, estimator, SBUS decoder, link monitor, channel map
+//! and the board application — runs in-process on a register-level ICM-42688-P emulator
+//! and an SBUS byte stream. Per lockstep tick (one [`SensorIn`] at the record's rate):
+//!
+//! 1. the emulator is given the simulator's body rates and specific force (`input.meas`:
+//!    p, q, r and a_x, a_y, a_z, specific force, ≈ (0, 0, −g) in hover) as its truth;
+//! 2. it advances 1 ms at a time and the stack polls it after each sample
+//!    (`imu_sample`, 1 kHz: 5 samples per tick at 200 Hz);
+//! 3. the simulated transmitter sends an SBUS frame every 7 ms (high-speed mode); the
+//!    frames complete by the tick go into the tick's byte stream;
+//! 4. `control_tick` runs the application; its command and servo pulses are the reply,
+//!    and the sequencer's telemetry goes into the dump as with the in-process link.
+//!
+//! # The simulated pilot and transmitter
+//!
+//! The fly loop's pilot holds the bare airframe's trim sticks (plus noise or an
+//! override). On the transmitter the pilot flies the stabilised mode, mode switch in the
+//! middle (Level), so the same hands become:
+//!
+//! ```text
+//! lat = φ_trim/angle_max + (stick_lat − trim_lat)      Level: the trim attitude
+//! lon = θ_trim/angle_max + (stick_lon − trim_lon)
+//! ped = stick_ped − trim_ped                           centred: heading hold
+//! col = stick_col                                      the collective passes straight
+//! throttle 0.8 (the governor's set point), arm switch on, test switch the loop's
+//! ```
+//!
+//! During a test's excitation the application feeds the sequencer the captured trim plus
+//! the sticks' displacement from their mean during the capture, so the sweep flies as
+//! with the other links and a stick moved off trim is still a pilot override.
+//!
+//! # Before the record (`begin_record`)
+//!
+//! The board is booted and the aircraft brought into the hover before the first
+//! simulated tick, so every record starts in Pilot mode at the hover trim:
+//!
+//! 1. ground, rotor stopped, level and still: boot, gyro calibration (1 s), arm switch off,
+//!    throttle 0; the emulator has its bench imperfections (bias, noise, scale errors),
+//!    or with `--vibration none` its white noise alone: an ideal chip's output at rest
+//!    is constant, which the IMU monitor rightly takes for a hung chip (stuck after
+//!    20 identical reads), so the board would never arm;
+//! 2. rotor running (the emulator's rotor vibration lines from now on, unless `none`):
+//!    arm switch on with the throttle low, then throttle 0.8: the soft start (4 s);
+//! 3. lift-off: the IMU turns smoothly from level to the trim attitude in 2 s, the
+//!    Level sticks with it;
+//! 4. hover on a gimbal for 10 s: the stack flies a copy of the simulated aircraft,
+//!    started at the trim, whose translation is held (velocity and position reset every
+//!    tick) while it rotates freely. The rate loops' integrators take up the trim
+//!    controls and the estimator settles; the record's own simulator then starts at the
+//!    trim with the stack in that state.
+//!
+//! The telemetry of these ticks is not recorded. A boot that fails (no IMU) or an arming
+//! the board refuses fails the record with the board's reason.
+//!
+//! # Faults
+//!
+//! `--rc-loss T`: no SBUS frame is sent from record time T on (the receiver's link
+//! timeout, 100 ms, then declares the loss). `--imu-fault stuck@T|saturate@T|missing@T`:
+//! the emulator's fault from record time T on; `missing` without a time: no chip from
+//! power-on (the boot fails). Record time counts the record's ticks from its first.
+
+use bo105::{Helicopter, Sim, SimOptions, Trim};
+use embedded_hal::delay::DelayNs;
+use sweephold_firmware::app::{AppConfig, Mode, TickOutput};
+use sweephold_firmware::board_stack::{BoardStack, BootState, StackConfig};
+use sweephold_firmware::imu::emulator::{Fault, Icm42688Emulator, Imperfections};
+use sweephold_firmware::imu::GRAVITY_M_S2;
+use sweephold_firmware::receiver::{ChannelMap, ModeSwitch, RcInput};
+use sweephold_firmware::{Config, FrameSink};
+use sweephold_protocol::{ActuatorOut, Controls, SensorIn};
+
+use super::link::FlightControllerLink;
+
+/// The transmitter's frame period \[µs\] (SBUS high-speed mode).
+pub const FRAME_PERIOD_US: u32 = 7_000;
+/// Time one 25-byte frame takes on the wire \[µs\] (12 bits of 10 µs per byte).
+const FRAME_WIRE_US: u32 = 3_000;
+/// The throttle the pilot flies with: the governor's set point.
+pub const HOVER_THROTTLE: f32 = 0.8;
+/// IMU sample period \[µs\].
+const IMU_PERIOD_US: u32 = 1_000;
+/// The lift-off turn from level to the trim attitude \[s\].
+const LIFT_OFF_S: f64 = 2.0;
+/// The hover on the gimbal before the record \[s\].
+const GIMBAL_HOVER_S: f64 = 10.0;
+/// Longest wait for the calibration \[s\] (its own timeout is 10 s).
+const CALIBRATION_WAIT_S: f64 = 11.0;
+
+/// An IMU fault injected into the emulator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ImuFaultKind {
+    /// Data registers frozen.
+    Stuck,
+    /// Every axis at positive full scale.
+    Saturate,
+    /// No chip on the bus.
+    Missing,
+}
+
+impl ImuFaultKind {
+    /// The emulator's fault.
+    fn fault(self) -> Fault {
+        match self {
+            ImuFaultKind::Stuck => Fault::Stuck,
+            ImuFaultKind::Saturate => Fault::Saturate,
+            ImuFaultKind::Missing => Fault::Missing,
+        }
+    }
+
+    /// Name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImuFaultKind::Stuck => "stuck",
+            ImuFaultKind::Saturate => "saturate",
+            ImuFaultKind::Missing => "missing",
+        }
+    }
+}
+
+/// `--imu-fault KIND@AT_S` (or `missing`: from power-on).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuFaultPlan {
+    /// Which fault.
+    pub kind: ImuFaultKind,
+    /// Record time it starts \[s\]; `None`: from power-on.
+    pub at_s: Option<f64>,
+}
+
+impl ImuFaultPlan {
+    /// Parse `stuck@T`, `saturate@T`, `missing@T` or `missing`.
+    pub fn parse(text: &str) -> Result<ImuFaultPlan, String> {
+        let (kind, at) = match text.split_once('@') {
+            Some((kind, at)) => (kind, Some(at)),
+            None => (text, None),
+        };
+        let kind = match kind {
+            "stuck" => ImuFaultKind::Stuck,
+            "saturate" => ImuFaultKind::Saturate,
+            "missing" => ImuFaultKind::Missing,
+            _ => {
+                return Err(format!(
+                    "unknown IMU fault `{kind}` (expected stuck@AT_S, saturate@AT_S, \
+                     missing@AT_S or missing)"
+                ))
+            }
+        };
+        let at_s = match at {
+            None if kind == ImuFaultKind::Missing => None,
+            None => {
+                return Err(format!(
+                    "`{}` needs a time: {}@AT_S (seconds of record time)",
+                    kind.name(),
+                    kind.name()
+                ))
+            }
+            Some(at) => match at.trim().parse::<f64>() {
+                Ok(t) if t.is_finite() && t >= 0.0 => Some(t),
+                _ => {
+                    return Err(format!(
+                        "`{at}` is not a time: expected seconds of record time >= 0"
+                    ))
+                }
+            },
+        };
+        Ok(ImuFaultPlan { kind, at_s })
+    }
+}
+
+/// What the board-sim link needs besides the record's configuration.
+#[derive(Clone, Debug)]
+pub struct BoardSimSettings {
+    /// `true` for the Bo-105 presets, `false` for the TREX 700L's.
+    pub bo105: bool,
+    /// The simulated aircraft (the gimbal hover flies a copy).
+    pub heli: Helicopter,
+    /// Its hover trim.
+    pub trim: Trim,
+    /// The simulator's options for the gimbal hover (sensors, actuators, plant).
+    pub sim_options: SimOptions,
+    /// Rotor vibration and the chip's imperfections (`--vibration default`), or a chip
+    /// with its white noise only (`none`).
+    pub vibration: bool,
+    /// Record time from which no SBUS frame is sent \[s\].
+    pub rc_loss_at_s: Option<f64>,
+    /// IMU fault to inject.
+    pub imu_fault: Option<ImuFaultPlan>,
+}
+
+/// A delay that returns at once: the emulator's time moves only with `advance`.
+struct NoDelay;
+
+impl DelayNs for NoDelay {
+    fn delay_ns(&mut self, _ns: u32) {}
+}
+
+/// Drops every frame (the telemetry of the ticks before the record).
+struct Discard;
+
+impl FrameSink for Discard {
+    fn write_frame(&mut self, _bytes: &[u8]) {}
+}
+
+type Stack = BoardStack<Icm42688Emulator, NoDelay>;
+
+/// One record's board, emulator and transmitter.
+struct Board {
+    stack: Stack,
+    /// The board's µs clock.
+    now_us: u32,
+    /// When the transmitter starts its next frame.
+    next_frame_us: u32,
+    /// Bytes on the wire not yet read by a control tick.
+    wire: Vec<u8>,
+    /// IMU samples per control tick.
+    samples_per_tick: u32,
+    /// Control tick period \[s\].
+    dt: f64,
+    /// Ticks of the record so far.
+    record_ticks: u64,
+    /// The output of the last tick.
+    last: Option<TickOutput>,
+    /// The pilot's Level sticks at the trim attitude (lat, lon).
+    level_neutral: [f32; 2],
+    /// The fly loop's trim sticks.
+    trim_sticks: [f32; 4],
+    /// The transmitter sends frames.
+    transmitting: bool,
+}
+
+impl Board {
+    fn emulator(&mut self) -> &mut Icm42688Emulator {
+        self.stack.imu_spi_mut()
+    }
+
+    /// One control tick with the transmitter sending `rc` (if transmitting): the
+    /// samples and frames that fall due, then the stack's control tick.
+    fn tick(&mut self, rc: &RcInput, sink: &mut impl FrameSink) -> TickOutput {
+        let map = ChannelMap::flybarless_default();
+        for _ in 0..self.samples_per_tick {
+            self.emulator().advance_ns(u64::from(IMU_PERIOD_US) * 1000);
+            self.now_us = self.now_us.wrapping_add(IMU_PERIOD_US);
+            self.stack.imu_sample(self.now_us);
+            // A frame is read once it is complete on the wire.
+            while self.now_us.wrapping_sub(self.next_frame_us) as i32 >= FRAME_WIRE_US as i32 {
+                if self.transmitting {
+                    self.wire.extend_from_slice(&map.encode(rc).encode());
+                }
+                self.next_frame_us = self.next_frame_us.wrapping_add(FRAME_PERIOD_US);
+            }
+        }
+        let out = self.stack.control_tick(self.now_us, &self.wire, sink);
+        self.wire.clear();
+        self.last = Some(out);
+        out
+    }
+
+    /// The pilot's transmitter for the fly loop's `sticks` and test switch.
+    fn transmitter(&self, sticks: &Controls, test_switch: bool) -> RcInput {
+        let [lat, lon, ped, col] = sticks.to_array();
+        let [t_lat, t_lon, t_ped, _] = self.trim_sticks;
+        let [n_lat, n_lon] = self.level_neutral;
+        RcInput {
+            sticks: Controls {
+                lat: n_lat + (lat - t_lat),
+                lon: n_lon + (lon - t_lon),
+                ped: ped - t_ped,
+                col,
+            },
+            throttle: HOVER_THROTTLE,
+            arm: true,
+            test_switch,
+            mode: ModeSwitch::Middle,
+        }
+    }
+}
+
+/// The board application on emulated devices. See the [module documentation](self).
+pub struct BoardSimLink {
+    settings: BoardSimSettings,
+    board: Option<Board>,
+}
+
+impl BoardSimLink {
+    /// A link with no record started yet.
+    pub fn new(settings: BoardSimSettings) -> Self {
+        BoardSimLink {
+            settings,
+            board: None,
+        }
+    }
+
+    /// Boot, arm and hover the board for a record flown with `config` (see the module
+    /// documentation).
+    fn prepare(&self, config: &Config) -> anyhow::Result<Board> {
+        let settings = &self.settings;
+        let rate = u32::from(config.rate_hz);
+        if rate == 0 || 1000 % rate != 0 {
+            anyhow::bail!(
+                "--fc board-sim needs a rate that divides the IMU's 1000 Hz, not {rate} Hz"
+            );
+        }
+        let primary = config.test.primary;
+        let preset = if settings.bo105 {
+            AppConfig::bo105(primary)
+        } else {
+            AppConfig::trex700l(primary)
+        };
+        let app = AppConfig {
+            flight: *config,
+            ..preset
+        };
+        let stack_config = StackConfig::with_app(app);
+        let seed = 0xB0A2_D51A_u64 ^ u64::from(config.test.seed).rotate_left(23);
+        let (rotor_stopped, rotor_running) = if settings.vibration {
+            (
+                Imperfections {
+                    seed,
+                    ..Imperfections::BENCH
+                },
+                Imperfections {
+                    seed,
+                    ..Imperfections::TREX700L_ROTOR_RUNNING
+                },
+            )
+        } else {
+            let quiet = Imperfections {
+                gyro_noise_rad_s: Imperfections::BENCH.gyro_noise_rad_s,
+                accel_noise_m_s2: Imperfections::BENCH.accel_noise_m_s2,
+                seed,
+                ..Imperfections::IDEAL
+            };
+            (quiet, quiet)
+        };
+        let mut emulator = Icm42688Emulator::new(rotor_stopped);
+        if let Some(ImuFaultPlan { kind, at_s: None }) = settings.imu_fault {
+            emulator.set_fault(kind.fault());
+        }
+        let mut stack = BoardStack::new(emulator, NoDelay, stack_config)
+            .map_err(|e| anyhow::anyhow!("the board refuses its configuration: {e}"))?;
+        if let Err(error) = stack.boot() {
+            anyhow::bail!("the board's IMU did not start ({error:?}): the board cannot arm");
+        }
+        let max_angle = app.pilot.max_angle_rad;
+        let trim = &settings.trim;
+        let mut board = Board {
+            stack,
+            now_us: 0,
+            next_frame_us: 0,
+            wire: Vec::with_capacity(64),
+            samples_per_tick: 1000 / rate,
+            dt: 1.0 / f64::from(rate),
+            record_ticks: 0,
+            last: None,
+            level_neutral: [
+                (trim.phi / f64::from(max_angle)) as f32,
+                (trim.theta / f64::from(max_angle)) as f32,
+            ],
+            trim_sticks: trim.controls.map(|c| c as f32),
+            transmitting: true,
+        };
+        let ticks_in = |seconds: f64| (seconds * f64::from(rate)).ceil() as u64;
+        let col = board.trim_sticks[3];
+        let ground = |arm: bool, throttle: f32| RcInput {
+            sticks: Controls {
+                lat: 0.0,
+                lon: 0.0,
+                ped: 0.0,
+                col,
+            },
+            throttle,
+            arm,
+            test_switch: false,
+            mode: ModeSwitch::Middle,
+        };
+
+        // 1. Ground, rotor stopped: calibration.
+        let mut waited = 0;
+        while !matches!(board.stack.boot_state(), BootState::Running(_)) {
+            if waited > ticks_in(CALIBRATION_WAIT_S) {
+                anyhow::bail!(
+                    "the board's gyro calibration did not finish ({:?})",
+                    board.stack.boot_state()
+                );
+            }
+            board.tick(&ground(false, 0.0), &mut Discard);
+            waited += 1;
+        }
+        for _ in 0..ticks_in(0.2) {
+            board.tick(&ground(false, 0.0), &mut Discard);
+        }
+
+        // 2. Rotor running: arm, soft start.
+        board.emulator().set_imperfections(rotor_running);
+        let mut refused = None;
+        for _ in 0..ticks_in(0.1) {
+            let out = board.tick(&ground(true, 0.0), &mut Discard);
+            refused = refused.or(out.refused);
+        }
+        if board.stack.app().mode() != Mode::Pilot {
+            anyhow::bail!(
+                "the board refused to arm ({})",
+                refused.map_or_else(|| "no reason given".to_string(), |r| format!("{r:?}"))
+            );
+        }
+        let spool_s = f64::from(HOVER_THROTTLE * app.throttle.soft_start_s) + 0.2;
+        for _ in 0..ticks_in(spool_s) {
+            board.tick(&ground(true, HOVER_THROTTLE), &mut Discard);
+        }
+
+        // 3. Lift-off: the IMU turns from level to the trim attitude.
+        let lift_ticks = ticks_in(LIFT_OFF_S);
+        let g = f64::from(GRAVITY_M_S2);
+        for k in 1..=lift_ticks {
+            let s = k as f64 / lift_ticks as f64;
+            let shape = 0.5 * (1.0 - (std::f64::consts::PI * s).cos());
+            let rate_shape =
+                0.5 * std::f64::consts::PI * (std::f64::consts::PI * s).sin() / LIFT_OFF_S;
+            let (phi, theta) = (trim.phi * shape, trim.theta * shape);
+            let (phi_dot, theta_dot) = (trim.phi * rate_shape, trim.theta * rate_shape);
+            let rates = [phi_dot, theta_dot * phi.cos(), -theta_dot * phi.sin()];
+            let force = [
+                g * theta.sin(),
+                -g * phi.sin() * theta.cos(),
+                -g * phi.cos() * theta.cos(),
+            ];
+            board
+                .emulator()
+                .set_truth(rates.map(|v| v as f32), force.map(|v| v as f32));
+            let mut rc = board.transmitter(&Controls::from_array(board.trim_sticks), false);
+            rc.sticks.lat = (phi / f64::from(max_angle)) as f32;
+            rc.sticks.lon = (theta / f64::from(max_angle)) as f32;
+            board.tick(&rc, &mut Discard);
+        }
+
+        // 4. Hover on the gimbal: a copy of the aircraft, translation held.
+        let mut options = settings.sim_options;
+        options.seed = seed ^ 0x6_1AB1;
+        options.gust_level = 0.0;
+        options.dropout_probability = 0.0;
+        options.spike_probability = 0.0;
+        let mut sim = Sim::at_trim(settings.heli.clone(), trim, options);
+        let held = trim.state;
+        let mut reading = sim.step(board.dt, trim.controls);
+        let rc = board.transmitter(&Controls::from_array(board.trim_sticks), false);
+        for _ in 0..ticks_in(GIMBAL_HOVER_S) {
+            board.emulator().set_truth(
+                [reading.p, reading.q, reading.r].map(|v| v as f32),
+                [reading.ax, reading.ay, reading.az].map(|v| v as f32),
+            );
+            let out = board.tick(&rc, &mut Discard);
+            reading = sim.step(board.dt, out.command.to_array().map(f64::from));
+            let mut state = sim.state();
+            for i in [
+                bo105::model::U,
+                bo105::model::V,
+                bo105::model::W,
+                bo105::model::NORTH,
+                bo105::model::EAST,
+                bo105::model::DOWN,
+            ] {
+                state.0[i] = held.0[i];
+            }
+            sim.set_state(state);
+        }
+        let mode = board.stack.app().mode();
+        if mode != Mode::Pilot {
+            anyhow::bail!(
+                "the board left the pilot mode before the record ({})",
+                mode.name()
+            );
+        }
+        Ok(board)
+    }
+}
+
+impl FlightControllerLink for BoardSimLink {
+    fn describe(&self) -> String {
+        "board-sim".to_string()
+    }
+
+    fn begin_record(&mut self, config: &Config) -> anyhow::Result<()> {
+        self.board = None;
+        self.board = Some(self.prepare(config)?);
+        Ok(())
+    }
+
+    fn exchange(
+        &mut self,
+        input: &SensorIn,
+        telemetry: &mut Vec<u8>,
+    ) -> anyhow::Result<ActuatorOut> {
+        let settings = &self.settings;
+        let board = self
+            .board
+            .as_mut()
+            .ok_or_else(|| anyhow::anyhow!("no record started on the board-sim link"))?;
+        let t = board.record_ticks as f64 * board.dt;
+        if let Some(ImuFaultPlan {
+            kind,
+            at_s: Some(at),
+        }) = settings.imu_fault
+        {
+            if t >= at {
+                board.emulator().set_fault(kind.fault());
+            }
+        }
+        if let Some(at) = settings.rc_loss_at_s {
+            board.transmitting = t < at;
+        }
+        let m = &input.meas;
+        board
+            .emulator()
+            .set_truth([m.p, m.q, m.r], [m.ax, m.ay, m.az]);
+        let rc = board.transmitter(&input.pilot.sticks, input.pilot.test_switch);
+        let out = board.tick(&rc, telemetry);
+        board.record_ticks += 1;
+        let tick = board.stack.app().flight_controller().tick().wrapping_sub(1);
+        Ok(ActuatorOut {
+            tick,
+            seq: input.seq,
+            command: out.command,
+            servo_us: out.servo_us,
+        })
+    }
+
+    fn board_mode(&self) -> Option<&'static str> {
+        self.board
+            .as_ref()
+            .and_then(|board| board.last)
+            .map(|out| out.mode.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn imu_fault_specs_parse_and_bad_ones_are_refused() {
+        assert_eq!(
+            ImuFaultPlan::parse("stuck@15"),
+            Ok(ImuFaultPlan {
+                kind: ImuFaultKind::Stuck,
+                at_s: Some(15.0)
+            })
+        );
+        assert_eq!(
+            ImuFaultPlan::parse("missing"),
+            Ok(ImuFaultPlan {
+                kind: ImuFaultKind::Missing,
+                at_s: None
+            })
+        );
+        assert_eq!(
+            ImuFaultPlan::parse("saturate@0.5").map(|p| p.at_s),
+            Ok(Some(0.5))
+        );
+        for bad in ["stuck", "stuck@", "stuck@-1", "stuck@nan", "hot@3", ""] {
+            assert!(ImuFaultPlan::parse(bad).is_err(), "{bad}");
+        }
+    }
+}
