@@ -445,17 +445,28 @@ pub fn sweep_input_section(inputs: &ReportInputs) -> String {
         ("col", "collective (off-axis)"),
     ] {
         if let Some(values) = record.input(name) {
-            let color = if name == record.primary.as_str() {
+            let primary = name == record.primary.as_str();
+            let color = if primary {
                 colors::MODEL
             } else {
                 colors::TRUTH
             };
-            let mut panel = Panel::new(
-                label,
-                time(),
-                "fraction of travel",
-                vec![Series::new(name, color, series_of(values, 1.0)).width(1.0)],
-            );
+            let mut series = vec![Series::new(name, color, series_of(values, 1.0)).width(1.0)];
+            // The sweep's applied amplitude (fixed, or shaped by `--amplitude adaptive`):
+            // the peak of the injected excitation over each of its half cycles, about the
+            // trim the stick holds at the start.
+            if let Some(reference) = record.reference(name).filter(|_| primary) {
+                let trim = values.first().copied().unwrap_or(0.0);
+                let envelope = half_cycle_envelope(reference);
+                let upper: Vec<f64> = envelope.iter().map(|a| trim + a).collect();
+                let lower: Vec<f64> = envelope.iter().map(|a| trim - a).collect();
+                series.push(
+                    Series::new("applied amplitude", colors::TRUTH, series_of(&upper, 1.0))
+                        .width(1.0),
+                );
+                series.push(Series::new("", colors::TRUTH, series_of(&lower, 1.0)).width(1.0));
+            }
+            let mut panel = Panel::new(label, time(), "fraction of travel", series);
             panel.y = panel.y.with_intervals(4);
             panel.height = 90.0;
             panels.push(panel);
@@ -483,15 +494,19 @@ pub fn sweep_input_section(inputs: &ReportInputs) -> String {
     fig.legend = vec![
         ("swept control".into(), colors::MODEL, false),
         (
-            "off-axis controls (hold corrections and noise)".into(),
+            "off-axis controls (hold corrections and noise); on the swept control: the applied amplitude"
+                .into(),
             colors::TRUTH,
             false,
         ),
     ];
     let caption = format!(
         "{}: the applied commands of the first lateral sweep in cah mode ({:.0} s at {:.0} Hz, \
-min/max per pixel column) and the attitudes. The off-axis controls move only when the \
-hold engages (attitude beyond its threshold) and with the small off-axis noise.",
+min/max per pixel column) and the attitudes. On the swept control, the red envelope is the \
+applied sweep amplitude about the starting trim: the peak of the injected excitation over \
+each of its half cycles (constant for the paper's fixed amplitude, shaped with frequency by \
+`--amplitude adaptive`). The off-axis controls move only when the hold engages (attitude \
+beyond its threshold) and with the small off-axis noise.",
         Path::new(&record.source)
             .strip_prefix(&inputs.dir)
             .map_or(record.source.clone(), |p| p.display().to_string()),
@@ -503,6 +518,23 @@ hold engages (attitude beyond its threshold) and with the small off-axis noise."
         "Sweep input time history (paper Fig. 1/6)",
         &figure(&fig.to_svg(), &caption),
     )
+}
+
+/// The peak |x| of each half cycle of `values` (the stretches between sign changes),
+/// repeated over that half cycle: the amplitude of a sweep whose amplitude changes only at
+/// its zero crossings.
+pub fn half_cycle_envelope(values: &[f64]) -> Vec<f64> {
+    let mut envelope = vec![0.0; values.len()];
+    let mut start = 0;
+    for k in 1..=values.len() {
+        let crossed = k == values.len() || (values[k] > 0.0) != (values[k - 1] > 0.0);
+        if crossed {
+            let peak = values[start..k].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            envelope[start..k].iter_mut().for_each(|e| *e = peak);
+            start = k;
+        }
+    }
+    envelope
 }
 
 /// Cross-control coherence: bars of the average per mode, curves versus frequency.
@@ -1140,6 +1172,24 @@ mod tests {
             speed_derivatives: Vec::new(),
             trim: None,
         }
+    }
+
+    #[test]
+    fn the_half_cycle_envelope_is_each_half_cycles_peak() {
+        // Two half cycles of amplitude 1, then two of amplitude 3 (a step at a zero
+        // crossing, as the adaptive sweep makes it).
+        let values: Vec<f64> = (0..40)
+            .map(|k| {
+                let amplitude = if k < 20 { 1.0 } else { 3.0 };
+                amplitude * (std::f64::consts::PI * (k as f64 + 0.5) / 10.0).sin()
+            })
+            .collect();
+        let envelope = half_cycle_envelope(&values);
+        let peak_1 = (std::f64::consts::PI * 4.5 / 10.0).sin();
+        assert!((envelope[0] - peak_1).abs() < 1e-12 && (envelope[19] - peak_1).abs() < 1e-12);
+        assert!((envelope[20] - 3.0 * peak_1).abs() < 1e-12);
+        assert!((envelope[39] - 3.0 * peak_1).abs() < 1e-12);
+        assert!(half_cycle_envelope(&[]).is_empty());
     }
 
     #[test]
