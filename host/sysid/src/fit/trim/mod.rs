@@ -230,7 +230,8 @@ impl TrimPoints {
             out.push_str(&point.label.replace(',', ";"));
             for value in point.states.iter().chain(&point.controls) {
                 out.push(',');
-                out.push_str(&format!("{value:?}"));
+                // + 0.0 writes a negative zero as 0.0.
+                out.push_str(&format!("{:?}", value + 0.0));
             }
             out.push('\n');
         }

@@ -81,20 +81,19 @@ fn names(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()
 }
 
-#[test]
-fn derivation_is_exact_on_a_linear_model() {
-    // Points from the hybrid model at its reference values; the derived parameters start
-    // anywhere (here zero) and come back exactly, flapping residualized.
-    let structure = hybrid_structure();
-    let truth = hybrid_truth_values(&structure);
-    let points = linear_trim_points(&structure, &truth, &STEPS);
-    let derived_names = names(&["Lv", "Mu", "Nv", "Zw", "Nr"]);
-    let mut start = truth.clone();
+/// Derive `derived` from `points` starting with them at zero, and compare with `truth`.
+fn assert_derived_exactly(
+    structure: &ModelStructure,
+    truth: &[f64],
+    points: &TrimPoints,
+    derived: &[&str],
+) {
+    let derived_names = names(derived);
+    let mut start = truth.to_vec();
     for name in &derived_names {
         start[structure.parameter_index(name).unwrap()] = 0.0;
     }
-    let derived = derive(&structure, &start, &points, &derived_names).unwrap();
-    for d in &derived {
+    for d in derive(structure, &start, points, &derived_names).unwrap() {
         let want = truth[structure.parameter_index(&d.name).unwrap()];
         assert!(
             (d.value - want).abs() <= 1e-9 * want.abs().max(1e-6),
@@ -103,6 +102,16 @@ fn derivation_is_exact_on_a_linear_model() {
             d.value
         );
     }
+}
+
+#[test]
+fn derivation_is_exact_on_a_linear_model() {
+    // Points from the hybrid model at its reference values; the derived parameters start
+    // anywhere (here zero) and come back exactly, flapping residualized.
+    let structure = hybrid_structure();
+    let truth = hybrid_truth_values(&structure);
+    let points = linear_trim_points(&structure, &truth, &STEPS);
+    assert_derived_exactly(&structure, &truth, &points, &["Lv", "Mu", "Nv", "Zw", "Nr"]);
 }
 
 #[test]
@@ -173,20 +182,12 @@ fn the_rotors_flap_back_is_derived_exactly_through_the_flapping() {
     let structure = hybrid_structure();
     let truth = hybrid_truth_values(&structure);
     let points = linear_trim_points(&structure, &truth, &STEPS);
-    let derived_names = names(&["Mfu", "Lfu", "Nv", "Zw", "Nr"]);
-    let mut start = truth.clone();
-    for name in &derived_names {
-        start[structure.parameter_index(name).unwrap()] = 0.0;
-    }
-    for d in derive(&structure, &start, &points, &derived_names).unwrap() {
-        let want = truth[structure.parameter_index(&d.name).unwrap()];
-        assert!(
-            (d.value - want).abs() <= 1e-9 * want.abs().max(1e-6),
-            "{}: derived {}, truth {want}",
-            d.name,
-            d.value
-        );
-    }
+    assert_derived_exactly(
+        &structure,
+        &truth,
+        &points,
+        &["Mfu", "Lfu", "Nv", "Zw", "Nr"],
+    );
 }
 
 #[test]
