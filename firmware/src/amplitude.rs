@@ -1,4 +1,4 @@
-//! The adaptive sweep amplitude ([`InputKind::AdaptiveSweep`]): the sweep's amplitude
+//! The adaptive sweep amplitude ([`InputKind::AdaptiveSweep`](sweephold_protocol::InputKind::AdaptiveSweep)): the sweep's amplitude
 //! shaped with frequency so that the attitudes stay inside the conditional hold's release
 //! band — small where the aircraft answers strongly (low frequency), larger where it
 //! barely answers (high frequency, where the flapping response is small) — as a pilot

@@ -93,61 +93,10 @@ impl ImuInput {
     };
 }
 
-/// The transmitter's three-position mode switch. What each position selects is
-/// [`PilotModeGains::switch_modes`](super::pilot_mode::PilotModeGains::switch_modes).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ModeSwitch {
-    /// Position 0.
-    Low,
-    /// Position 1.
-    Mid,
-    /// Position 2.
-    High,
-}
-
-impl ModeSwitch {
-    /// Position number 0, 1 or 2.
-    pub const fn index(self) -> usize {
-        match self {
-            ModeSwitch::Low => 0,
-            ModeSwitch::Mid => 1,
-            ModeSwitch::High => 2,
-        }
-    }
-}
-
-/// One valid receiver frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct RcInput {
-    /// Sticks lat, lon, ped, col, each in [−1, 1].
-    pub sticks: Controls,
-    /// Throttle channel in [0, 1] (the ESC governor's set point; 0 is motor off).
-    pub throttle: f32,
-    /// Arm switch: `true` armed, `false` disarmed (the pilot's throttle hold).
-    pub arm: bool,
-    /// Test switch: `true` asks for a test.
-    pub test_switch: bool,
-    /// Mode switch.
-    pub mode: ModeSwitch,
-}
-
-impl RcInput {
-    /// Sticks centred, collective mid, throttle 0, both switches off, mode switch low.
-    pub const NEUTRAL: RcInput = RcInput {
-        sticks: Controls {
-            lat: 0.0,
-            lon: 0.0,
-            ped: 0.0,
-            col: 0.0,
-        },
-        throttle: 0.0,
-        arm: false,
-        test_switch: false,
-        mode: ModeSwitch::Low,
-    };
-}
+/// The pilot's inputs and the mode switch are the receiver's own types: the channel map
+/// produces them, the application reads them (what each mode-switch position selects is
+/// [`PilotModeGains::switch_modes`](super::pilot_mode::PilotModeGains::switch_modes)).
+pub use crate::receiver::{ModeSwitch, RcInput};
 
 /// The receiver's state this tick.
 #[derive(Clone, Copy, Debug, PartialEq)]

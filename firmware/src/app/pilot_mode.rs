@@ -150,7 +150,7 @@ pub struct PilotModeGains {
     /// Time constant of the integrators' leak while the rotor is not under power \[s\]
     /// (0: emptied at once).
     pub ground_leak_time_s: f32,
-    /// Stick mode of the mode switch's positions Low, Mid, High.
+    /// Stick mode of the mode switch's positions Low, Middle, High.
     pub switch_modes: [StickMode; 3],
 }
 
@@ -182,7 +182,7 @@ impl PilotModeGains {
     /// rate loop); heading hold 2.5 /s on at most 20° of error with a 5 % pedal dead
     /// band; tail servo 4 /s, the actuator rate limit the project's simulator models;
     /// transfer τ_B 0.5 s; integrators leak with 0.5 s on the ground. Mode switch: Low
-    /// Rate, Mid and High Level.
+    /// Rate, Middle and High Level.
     pub const fn trex700l() -> Self {
         PilotModeGains {
             roll: RateAxisGains {

@@ -411,7 +411,7 @@ fn transition_rows() -> Vec<Row> {
             name: "pilot: attitude invalid → pilot, Level stick flies as Rate",
             from: Mode::Pilot,
             condition: |rig| {
-                rig.rc.mode = ModeSwitch::Mid;
+                rig.rc.mode = ModeSwitch::Middle;
                 rig.imu.attitude_valid = false;
             },
             ticks: 5,
@@ -421,7 +421,7 @@ fn transition_rows() -> Vec<Row> {
         Row {
             name: "pilot: mode switch mid → pilot, Level stick",
             from: Mode::Pilot,
-            condition: |rig| rig.rc.mode = ModeSwitch::Mid,
+            condition: |rig| rig.rc.mode = ModeSwitch::Middle,
             ticks: 1,
             to: Mode::Pilot,
             check: |_, out| assert_eq!(out.stick_mode, Some(StickMode::Level)),
@@ -1368,7 +1368,7 @@ fn any_status() -> impl Strategy<Value = ImuStatus> {
 fn any_mode_switch() -> impl Strategy<Value = ModeSwitch> {
     prop_oneof![
         Just(ModeSwitch::Low),
-        Just(ModeSwitch::Mid),
+        Just(ModeSwitch::Middle),
         Just(ModeSwitch::High)
     ]
 }

@@ -81,8 +81,8 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
 
 use crate::app::{
-    AppConfig, AppConfigError, BoardApp, ImuFaultKind, ImuInput, ImuStatus, ModeSwitch as AppMode,
-    RcInput as AppRcInput, Receiver as AppReceiver, TickInput, TickOutput,
+    AppConfig, AppConfigError, BoardApp, ImuFaultKind, ImuInput, ImuStatus,
+    Receiver as AppReceiver, TickInput, TickOutput,
 };
 use crate::estimator::{EstimatorError, LevelOffset, Mahony, MahonyConfig, Quaternion, UpdateKind};
 use crate::filters::{FilterBank, FilterBankConfig, FilterError};
@@ -90,7 +90,7 @@ use crate::imu::{
     Bias, CalibrationConfig, CalibrationStatus, GyroCalibration, Icm42688, ImuError, ImuFault,
     ImuMonitor, MonitorLimits, Orientation,
 };
-use crate::receiver::{ChannelMap, ChannelMapError, ModeSwitch, RcInput, Receiver, SbusDecoder};
+use crate::receiver::{ChannelMap, ChannelMapError, Receiver, SbusDecoder};
 use crate::sink::FrameSink;
 use sweephold_protocol::{Axis, Phase};
 
@@ -417,7 +417,7 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
             }
         }
         let rc = match self.receiver.frame(now_us) {
-            Some(frame) => AppReceiver::Valid(app_rc_input(&self.config.channel_map.map(&frame))),
+            Some(frame) => AppReceiver::Valid(self.config.channel_map.map(&frame)),
             None => AppReceiver::Lost,
         };
         let input = TickInput {
@@ -528,21 +528,6 @@ const fn fault_kind(fault: ImuFault) -> ImuFaultKind {
         ImuFault::Stuck => ImuFaultKind::Stuck,
         ImuFault::Saturated => ImuFaultKind::Saturated,
         ImuFault::NotReady => ImuFaultKind::NotReady,
-    }
-}
-
-/// The channel map's pilot input as the application's.
-fn app_rc_input(input: &RcInput) -> AppRcInput {
-    AppRcInput {
-        sticks: input.sticks,
-        throttle: input.throttle,
-        arm: input.arm,
-        test_switch: input.test_switch,
-        mode: match input.mode {
-            ModeSwitch::Low => AppMode::Low,
-            ModeSwitch::Middle => AppMode::Mid,
-            ModeSwitch::High => AppMode::High,
-        },
     }
 }
 

@@ -10,6 +10,7 @@ use super::*;
 use crate::app::{CheckFailure, ImuProblem, Mode, Refusal};
 use crate::imu::emulator::{Fault, Icm42688Emulator, Imperfections};
 use crate::imu::GRAVITY_M_S2;
+use crate::receiver::{ModeSwitch, RcInput};
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 

@@ -152,6 +152,17 @@ pub enum ModeSwitch {
     High,
 }
 
+impl ModeSwitch {
+    /// Position number 0 (low), 1 (middle) or 2 (high).
+    pub const fn index(self) -> usize {
+        match self {
+            ModeSwitch::Low => 0,
+            ModeSwitch::Middle => 1,
+            ModeSwitch::High => 2,
+        }
+    }
+}
+
 /// The pilot's inputs, mapped.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -169,6 +180,20 @@ pub struct RcInput {
 }
 
 impl RcInput {
+    /// Sticks centred, collective mid, throttle 0, both switches off, mode switch low.
+    pub const NEUTRAL: RcInput = RcInput {
+        sticks: Controls {
+            lat: 0.0,
+            lon: 0.0,
+            ped: 0.0,
+            col: 0.0,
+        },
+        throttle: 0.0,
+        arm: false,
+        test_switch: false,
+        mode: ModeSwitch::Low,
+    };
+
     /// The part of the input the flight logic's sensor frame carries.
     pub const fn pilot_input(&self) -> PilotInput {
         PilotInput {
