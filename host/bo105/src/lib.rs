@@ -9,6 +9,7 @@
 
 #![warn(missing_docs)]
 
+mod integrator;
 mod linear_plant;
 pub mod linearize;
 pub mod model;
