@@ -44,20 +44,9 @@ impl fmt::Display for Vehicle {
 }
 
 /// A vehicle name that is neither `bo105` nor `trex700l`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown vehicle `{0}` (expected bo105 or trex700l)")]
 pub struct UnknownVehicle(pub String);
-
-impl fmt::Display for UnknownVehicle {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "unknown vehicle `{}` (expected bo105 or trex700l)",
-            self.0
-        )
-    }
-}
-
-impl std::error::Error for UnknownVehicle {}
 
 impl FromStr for Vehicle {
     type Err = UnknownVehicle;
@@ -513,6 +502,10 @@ mod tests {
         }
         assert_eq!("bo105".parse::<Vehicle>(), Ok(Vehicle::Bo105));
         assert_eq!("TREX700L".parse::<Vehicle>(), Ok(Vehicle::Trex700l));
-        assert!("ec135".parse::<Vehicle>().is_err());
+        let unknown = "ec135".parse::<Vehicle>().unwrap_err();
+        assert_eq!(
+            unknown.to_string(),
+            "unknown vehicle `ec135` (expected bo105 or trex700l)"
+        );
     }
 }
