@@ -1,0 +1,29 @@
+//! Why the truth of a vehicle or a structure could not be computed.
+
+use bo105::{TrimError, Vehicle};
+use sysid::fit::FitError;
+
+/// What stops the truth mapping or the scoring against it.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The vehicle does not trim in hover, so there is no linearization to map.
+    #[error("cannot trim {vehicle} at hover")]
+    Trim {
+        /// The vehicle.
+        vehicle: Vehicle,
+        /// Why its trim failed.
+        source: TrimError,
+    },
+    /// A hybrid structure's flapping needs the simulator's flapping states.
+    #[error("the linearization has no flapping states")]
+    NoFlappingStates,
+    /// The simulator's flapping block of A has no inverse (no quasi-static flapping).
+    #[error("the flapping block of A is singular")]
+    SingularFlappingBlock,
+    /// The structure's own flap equations at the truth have no quasi-static solution.
+    #[error("the structure's flapping block is singular at the truth")]
+    SingularStructureFlappingBlock,
+    /// The structure's model at the truth values, or the cost between two models, failed.
+    #[error(transparent)]
+    Fit(#[from] FitError),
+}
