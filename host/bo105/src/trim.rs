@@ -22,7 +22,7 @@ use crate::vehicle::{BladePitch, Helicopter};
 
 /// Metres per second in one knot.
 pub const KNOT: f64 = 1852.0 / 3600.0;
-/// The fastest speed [kt] `trim` accepts.
+/// The fastest speed \[kt\] `trim` accepts.
 pub const MAX_TRIM_SPEED_KT: f64 = 120.0;
 
 /// A steady flight condition: velocity over the ground and turn rate, heading north.
@@ -50,29 +50,29 @@ pub const MAX_TURN_RATE: f64 = 0.6;
 /// A trimmed flight condition.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trim {
-    /// Forward speed [kt].
+    /// Forward speed \[kt\].
     pub speed_kt: f64,
     /// Stick fractions [lat, lon, ped, col].
     pub controls: [f64; 4],
-    /// Blade pitches [rad].
+    /// Blade pitches \[rad\].
     pub blade_pitch_rad: BladePitch,
-    /// Roll attitude φ [rad].
+    /// Roll attitude φ \[rad\].
     pub phi: f64,
-    /// Pitch attitude θ [rad].
+    /// Pitch attitude θ \[rad\].
     pub theta: f64,
-    /// Longitudinal tip-path-plane tilt β1c [rad] (forward positive, relative to the shaft).
+    /// Longitudinal tip-path-plane tilt β1c \[rad\] (forward positive, relative to the shaft).
     pub beta1c: f64,
-    /// Lateral tip-path-plane tilt β1s [rad] (left positive).
+    /// Lateral tip-path-plane tilt β1s \[rad\] (left positive).
     pub beta1s: f64,
     /// Main-rotor induced inflow λ_i (divided by ΩR).
     pub inflow: f64,
     /// Tail-rotor induced inflow λ_i.
     pub tail_inflow: f64,
-    /// Main-rotor coning β0 [rad].
+    /// Main-rotor coning β0 \[rad\].
     pub coning: f64,
-    /// Main-rotor thrust [N].
+    /// Main-rotor thrust \[N\].
     pub main_thrust: f64,
-    /// Tail-rotor thrust [N].
+    /// Tail-rotor thrust \[N\].
     pub tail_thrust: f64,
     /// Largest absolute residual acceleration at the solution (m/s², rad/s², rad/s).
     pub residual: f64,

@@ -4,7 +4,7 @@
 //!
 //! - [`VehicleTruth`]: a vehicle of the simulator trimmed in hover and linearized, with its
 //!   servos' equivalent delay.
-//! - [`structure_truth`]: that linearization mapped onto a structure's parameters by name
+//! - [`structure_truth()`]: that linearization mapped onto a structure's parameters by name
 //!   (the rules are in the [`structure_truth`](mod@structure_truth) module), giving a
 //!   [`StructureTruth`].
 //! - [`score_fit`], [`score_fit_with_modes`]: an identified model against the structure's

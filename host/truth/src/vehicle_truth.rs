@@ -18,7 +18,7 @@ pub struct VehicleTruth {
     pub vehicle: Vehicle,
     /// Linearization at hover trim (flapping states included, quasi-static derivatives).
     pub linearization: Linearization,
-    /// Equivalent delay of the default servos: 2ζ/ω_n + transport delay [s].
+    /// Equivalent delay of the default servos: 2ζ/ω_n + transport delay \[s\].
     pub actuator_delay_s: f64,
 }
 

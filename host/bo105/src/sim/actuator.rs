@@ -11,7 +11,7 @@ pub struct ActuatorModel {
     pub damping: f64,
     /// Rate limit [stick fraction per second].
     pub rate_limit_per_s: f64,
-    /// Transport delay [s] (rounded to internal steps).
+    /// Transport delay \[s\] (rounded to internal steps).
     pub transport_delay_s: f64,
 }
 

@@ -344,7 +344,7 @@ impl Sim {
         }
     }
 
-    /// Simulation time [s].
+    /// Simulation time \[s\].
     pub fn time(&self) -> f64 {
         self.time
     }
@@ -377,7 +377,7 @@ impl Sim {
         self.gust
     }
 
-    /// An external force [N] and moment [N·m] about the CG in body axes, held until
+    /// An external force \[N\] and moment [N·m] about the CG in body axes, held until
     /// changed (disturbance hook; the accelerometer feels the force).
     pub fn set_external_load(&mut self, force: [f64; 3], moment: [f64; 3]) {
         if force.iter().chain(moment.iter()).all(|v| v.is_finite()) {

@@ -7,7 +7,7 @@ use super::sensors::SensorNoise;
 /// Simulation options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimOptions {
-    /// Fixed RK4 step [s].
+    /// Fixed RK4 step \[s\].
     pub internal_step_s: f64,
     /// Sensor imperfections.
     pub sensor_noise: SensorNoise,
@@ -15,7 +15,7 @@ pub struct SimOptions {
     pub seed: u64,
     /// Turbulence intensity, 1σ per body axis [m/s] (0 = still air).
     pub gust_level: f64,
-    /// Correlation time of the first-order (Gauss–Markov) gust filter [s].
+    /// Correlation time of the first-order (Gauss–Markov) gust filter \[s\].
     pub gust_time_constant_s: f64,
     /// Probability per `step` that the sensor sample is not updated (dropout).
     pub dropout_probability: f64,

@@ -9,7 +9,7 @@ use crate::model::{self, STATE_LEN};
 pub struct SensorNoise {
     /// Gyro noise, 1σ [rad/s].
     pub gyro_rad_s: f64,
-    /// Attitude noise, 1σ [rad].
+    /// Attitude noise, 1σ \[rad\].
     pub attitude_rad: f64,
     /// Velocity noise, 1σ [m/s].
     pub velocity_m_s: f64,
@@ -17,7 +17,7 @@ pub struct SensorNoise {
     pub accel_m_s2: f64,
     /// Constant bias per channel, order [p q r φ θ ψ u v w ax ay az] (SI units).
     pub bias: [f64; 12],
-    /// Latency [s] (rounded to internal steps): the reading shows the aircraft this long ago.
+    /// Latency \[s\] (rounded to internal steps): the reading shows the aircraft this long ago.
     pub latency_s: f64,
 }
 
@@ -51,13 +51,13 @@ impl Default for SensorNoise {
     }
 }
 
-/// What the flight controller reads: rates [rad/s], Euler angles [rad] (ψ wrapped to
+/// What the flight controller reads: rates [rad/s], Euler angles \[rad\] (ψ wrapped to
 /// (−π, π]), body velocity [m/s] and specific force [m/s²] (≈ (0, 0, −g) in hover).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct SensorReading {
     /// Sequence number: increments on every fresh sample, repeats on a dropout.
     pub seq: u32,
-    /// Time of the sample [s] (the simulation time when it was taken).
+    /// Time of the sample \[s\] (the simulation time when it was taken).
     pub time_s: f64,
     /// Roll rate.
     pub p: f64,
