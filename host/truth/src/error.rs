@@ -27,3 +27,36 @@ pub enum Error {
     #[error(transparent)]
     Fit(#[from] FitError),
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The error and its causes on one line, as the command-line tool prints them.
+    fn chain(error: &dyn std::error::Error) -> String {
+        let mut line = error.to_string();
+        let mut cause = error.source();
+        while let Some(next) = cause {
+            line = format!("{line}: {next}");
+            cause = next.source();
+        }
+        line
+    }
+
+    #[test]
+    fn a_failed_trim_names_the_vehicle_then_the_cause() {
+        let error = Error::Trim {
+            vehicle: Vehicle::Trex700l,
+            source: TrimError::SingularJacobian,
+        };
+        assert_eq!(error.to_string(), "cannot trim trex700l at hover");
+        assert_eq!(
+            chain(&error),
+            "cannot trim trex700l at hover: trim Jacobian is singular"
+        );
+        assert_eq!(
+            chain(&Error::NoFlappingStates),
+            "the linearization has no flapping states"
+        );
+    }
+}
