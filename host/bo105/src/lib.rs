@@ -6,9 +6,14 @@
 //! blade-element thrust with iterated Glauert momentum inflow (optionally Pitt–Peters
 //! dynamic inflow), hub spring and thrust-offset moments, tail rotor, fuselage drag, fin
 //! and tailplane. See `README.md` for the validation against Padfield's Helisim.
+//!
+//! This crate is the aircraft only: it builds on general-purpose crates and never imports
+//! the identification library (`sysid`), the mapping of its linearization onto a model
+//! structure (`truth`) or the command-line tool, which build on it.
 
 #![warn(missing_docs)]
 
+mod integrator;
 mod linear_plant;
 pub mod linearize;
 pub mod model;

@@ -12,8 +12,8 @@
 //! wrong on it is the estimator's (closed loop, windowing, noise), not the aircraft's
 //! nonlinearity. Still air only: wind, gusts and external loads are not part of it.
 
+use crate::integrator::rk4_from;
 use crate::model::{self, Model, ModelFlags, STATE_LEN};
-use crate::sim::rk4_from;
 use crate::trim::Trim;
 
 /// Central-difference step: states and actuator positions are O(0.1–10) in their units,

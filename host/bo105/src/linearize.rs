@@ -54,7 +54,7 @@ const AXIS_NAMES: [&str; 6] = ["X", "Y", "Z", "L", "M", "N"];
 /// A linear model about a trim.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Linearization {
-    /// Trim speed [kt].
+    /// Trim speed \[kt\].
     pub speed_kt: f64,
     /// State names in order.
     pub states: Vec<&'static str>,
@@ -70,7 +70,7 @@ pub struct Linearization {
     pub c: Vec<Vec<f64>>,
     /// Feed-through matrix, row-major.
     pub d: Vec<Vec<f64>>,
-    /// Flap time constant [s] from the flapping block: −1/Re(λ) of A_ff.
+    /// Flap time constant \[s\] from the flapping block: −1/Re(λ) of A_ff.
     pub tau_f_s: f64,
     /// Eigenvalues of A as (re, im), sorted by real part.
     pub eigenvalues: Vec<(f64, f64)>,

@@ -35,23 +35,23 @@ pub const P: usize = 3;
 pub const Q: usize = 4;
 /// Yaw rate r [rad/s].
 pub const R: usize = 5;
-/// Roll angle φ [rad].
+/// Roll angle φ \[rad\].
 pub const PHI: usize = 6;
-/// Pitch angle θ [rad].
+/// Pitch angle θ \[rad\].
 pub const THETA: usize = 7;
-/// Heading ψ [rad] (integrated freely; wrapped only in the sensor reading).
+/// Heading ψ \[rad\] (integrated freely; wrapped only in the sensor reading).
 pub const PSI: usize = 8;
-/// Longitudinal tip-path-plane tilt β1c [rad] (forward positive).
+/// Longitudinal tip-path-plane tilt β1c \[rad\] (forward positive).
 pub const BETA1C: usize = 9;
-/// Lateral tip-path-plane tilt β1s [rad] (left positive).
+/// Lateral tip-path-plane tilt β1s \[rad\] (left positive).
 pub const BETA1S: usize = 10;
 /// Main-rotor uniform induced inflow λ_i (a state only with dynamic inflow).
 pub const LAMBDA: usize = 11;
-/// North position [m].
+/// North position \[m\].
 pub const NORTH: usize = 12;
-/// East position [m].
+/// East position \[m\].
 pub const EAST: usize = 13;
-/// Down position [m].
+/// Down position \[m\].
 pub const DOWN: usize = 14;
 
 /// The full state vector, indexed by the constants of this module.
@@ -67,15 +67,15 @@ impl State {
     pub fn rates(&self) -> [f64; 3] {
         [self.0[P], self.0[Q], self.0[R]]
     }
-    /// Euler angles [φ, θ, ψ] [rad].
+    /// Euler angles [φ, θ, ψ] \[rad\].
     pub fn attitude(&self) -> [f64; 3] {
         [self.0[PHI], self.0[THETA], self.0[PSI]]
     }
-    /// Tip-path-plane tilts [β1c, β1s] [rad].
+    /// Tip-path-plane tilts [β1c, β1s] \[rad\].
     pub fn flapping(&self) -> [f64; 2] {
         [self.0[BETA1C], self.0[BETA1S]]
     }
-    /// Position north, east, down [m].
+    /// Position north, east, down \[m\].
     pub fn position(&self) -> [f64; 3] {
         [self.0[NORTH], self.0[EAST], self.0[DOWN]]
     }

@@ -17,14 +17,12 @@
 //! evaluation (Glauert momentum), so it is trimmed too. Newton: J Δz = −r with a
 //! central-difference Jacobian, steps limited to 0.1 rad per unknown.
 
-use std::fmt;
-
 use crate::model::{self, Model, ModelFlags, State, STATE_LEN};
 use crate::vehicle::{BladePitch, Helicopter};
 
 /// Metres per second in one knot.
 pub const KNOT: f64 = 1852.0 / 3600.0;
-/// The fastest speed [kt] `trim` accepts.
+/// The fastest speed \[kt\] `trim` accepts.
 pub const MAX_TRIM_SPEED_KT: f64 = 120.0;
 
 /// A steady flight condition: velocity over the ground and turn rate, heading north.
@@ -52,29 +50,29 @@ pub const MAX_TURN_RATE: f64 = 0.6;
 /// A trimmed flight condition.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trim {
-    /// Forward speed [kt].
+    /// Forward speed \[kt\].
     pub speed_kt: f64,
     /// Stick fractions [lat, lon, ped, col].
     pub controls: [f64; 4],
-    /// Blade pitches [rad].
+    /// Blade pitches \[rad\].
     pub blade_pitch_rad: BladePitch,
-    /// Roll attitude φ [rad].
+    /// Roll attitude φ \[rad\].
     pub phi: f64,
-    /// Pitch attitude θ [rad].
+    /// Pitch attitude θ \[rad\].
     pub theta: f64,
-    /// Longitudinal tip-path-plane tilt β1c [rad] (forward positive, relative to the shaft).
+    /// Longitudinal tip-path-plane tilt β1c \[rad\] (forward positive, relative to the shaft).
     pub beta1c: f64,
-    /// Lateral tip-path-plane tilt β1s [rad] (left positive).
+    /// Lateral tip-path-plane tilt β1s \[rad\] (left positive).
     pub beta1s: f64,
     /// Main-rotor induced inflow λ_i (divided by ΩR).
     pub inflow: f64,
     /// Tail-rotor induced inflow λ_i.
     pub tail_inflow: f64,
-    /// Main-rotor coning β0 [rad].
+    /// Main-rotor coning β0 \[rad\].
     pub coning: f64,
-    /// Main-rotor thrust [N].
+    /// Main-rotor thrust \[N\].
     pub main_thrust: f64,
-    /// Tail-rotor thrust [N].
+    /// Tail-rotor thrust \[N\].
     pub tail_thrust: f64,
     /// Largest absolute residual acceleration at the solution (m/s², rad/s², rad/s).
     pub residual: f64,
@@ -85,13 +83,19 @@ pub struct Trim {
 }
 
 /// Why a trim failed.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum TrimError {
     /// The speed is negative, not finite or above [`MAX_TRIM_SPEED_KT`].
+    #[error("invalid trim speed {0} kt (expected 0 to {max} kt)", max = MAX_TRIM_SPEED_KT)]
     InvalidSpeed(f64),
     /// The turn rate is not finite or above [`MAX_TURN_RATE`] in magnitude.
+    #[error(
+        "invalid turn rate {0} rad/s (expected at most {max} rad/s either way)",
+        max = MAX_TURN_RATE
+    )]
     InvalidTurnRate(f64),
     /// Newton did not bring the residual below the tolerance.
+    #[error("trim did not converge: residual {residual:.3e} after {iterations} iterations")]
     NotConverged {
         /// Largest residual reached.
         residual: f64,
@@ -99,8 +103,10 @@ pub enum TrimError {
         iterations: usize,
     },
     /// The Jacobian was singular.
+    #[error("trim Jacobian is singular")]
     SingularJacobian,
     /// The solution needs a stick beyond ±1 (the gearing's range).
+    #[error("trim needs {control} stick {value:.3}, beyond the range ±1")]
     ControlOutOfRange {
         /// Control name (lat, lon, ped, col).
         control: &'static str,
@@ -108,39 +114,6 @@ pub enum TrimError {
         value: f64,
     },
 }
-
-impl fmt::Display for TrimError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TrimError::InvalidSpeed(v) => {
-                write!(
-                    f,
-                    "invalid trim speed {v} kt (expected 0 to {MAX_TRIM_SPEED_KT} kt)"
-                )
-            }
-            TrimError::NotConverged {
-                residual,
-                iterations,
-            } => write!(
-                f,
-                "trim did not converge: residual {residual:.3e} after {iterations} iterations"
-            ),
-            TrimError::InvalidTurnRate(v) => write!(
-                f,
-                "invalid turn rate {v} rad/s (expected at most {MAX_TURN_RATE} rad/s either way)"
-            ),
-            TrimError::SingularJacobian => write!(f, "trim Jacobian is singular"),
-            TrimError::ControlOutOfRange { control, value } => {
-                write!(
-                    f,
-                    "trim needs {control} stick {value:.3}, beyond the range ±1"
-                )
-            }
-        }
-    }
-}
-
-impl std::error::Error for TrimError {}
 
 /// Names of the stick channels in control order.
 pub const CONTROL_NAMES: [&str; 4] = ["lat", "lon", "ped", "col"];
@@ -355,6 +328,39 @@ pub fn trim_steady(heli: &Helicopter, flight: &SteadyFlight) -> Result<Trim, Tri
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn error_messages_name_the_limit_or_the_residual() {
+        let messages = [
+            (
+                TrimError::InvalidSpeed(-1.0),
+                "invalid trim speed -1 kt (expected 0 to 120 kt)",
+            ),
+            (
+                TrimError::InvalidTurnRate(0.75),
+                "invalid turn rate 0.75 rad/s (expected at most 0.6 rad/s either way)",
+            ),
+            (
+                TrimError::NotConverged {
+                    residual: 0.00123456,
+                    iterations: 40,
+                },
+                "trim did not converge: residual 1.235e-3 after 40 iterations",
+            ),
+            (TrimError::SingularJacobian, "trim Jacobian is singular"),
+            (
+                TrimError::ControlOutOfRange {
+                    control: "col",
+                    value: 1.23456,
+                },
+                "trim needs col stick 1.235, beyond the range ±1",
+            ),
+        ];
+        for (error, message) in messages {
+            assert_eq!(error.to_string(), message);
+            assert!(std::error::Error::source(&error).is_none());
+        }
+    }
 
     #[test]
     fn bo105_trims_in_hover_and_at_20_and_40_kt() {

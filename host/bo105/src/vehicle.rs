@@ -44,20 +44,9 @@ impl fmt::Display for Vehicle {
 }
 
 /// A vehicle name that is neither `bo105` nor `trex700l`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown vehicle `{0}` (expected bo105 or trex700l)")]
 pub struct UnknownVehicle(pub String);
-
-impl fmt::Display for UnknownVehicle {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "unknown vehicle `{}` (expected bo105 or trex700l)",
-            self.0
-        )
-    }
-}
-
-impl std::error::Error for UnknownVehicle {}
 
 impl FromStr for Vehicle {
     type Err = UnknownVehicle;
@@ -75,15 +64,15 @@ impl FromStr for Vehicle {
 /// number, rotor speed, hub stiffness), never typed in: see [`Rotor::flap_time_constant`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rotor {
-    /// Radius R [m].
+    /// Radius R \[m\].
     pub radius: f64,
     /// Rotor speed Ω [rad/s].
     pub omega: f64,
     /// Number of blades N_b.
     pub blades: f64,
-    /// Blade chord c [m].
+    /// Blade chord c \[m\].
     pub chord: f64,
-    /// Linear twist θ_tw [rad] (root to tip; negative = washout). Blade pitch at radius
+    /// Linear twist θ_tw \[rad\] (root to tip; negative = washout). Blade pitch at radius
     /// fraction x is θ0 + x·θ_tw.
     pub twist: f64,
     /// Blade lift-curve slope a [1/rad].
@@ -94,7 +83,7 @@ pub struct Rotor {
     pub hub_stiffness: f64,
     /// Profile drag δ = δ0 + δ2·C_T².
     pub profile_drag: [f64; 2],
-    /// Hub position from the CG, body axes [m].
+    /// Hub position from the CG, body axes \[m\].
     pub hub: [f64; 3],
 }
 
@@ -104,7 +93,7 @@ impl Rotor {
         self.blades * self.chord / (std::f64::consts::PI * self.radius)
     }
 
-    /// Disc area πR² [m²].
+    /// Disc area πR² \[m²\].
     pub fn disc_area(&self) -> f64 {
         std::f64::consts::PI * self.radius * self.radius
     }
@@ -129,7 +118,7 @@ impl Rotor {
         8.0 * self.stiffness_excess() / self.lock_number(air_density)
     }
 
-    /// Tip-path-plane flap time constant τ_f [s] in hover, from the blade data.
+    /// Tip-path-plane flap time constant τ_f \[s\] in hover, from the blade data.
     ///
     /// The first-order multiblade flap equations (second derivatives dropped, see
     /// `rotor.rs`) in hover are `M·β' = N·β + forcing`, with g = γ/8, s = λ_β² − 1,
@@ -172,16 +161,16 @@ impl Rotor {
 /// A lifting surface (vertical fin or horizontal tailplane).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Surface {
-    /// Area [m²].
+    /// Area \[m²\].
     pub area: f64,
-    /// Incidence [rad] (fin: toward +y side force in forward flight; tailplane: leading
+    /// Incidence \[rad\] (fin: toward +y side force in forward flight; tailplane: leading
     /// edge up).
     pub incidence: f64,
     /// Lift-curve slope [1/rad].
     pub lift_slope: f64,
-    /// Position from the CG, body axes [m].
+    /// Position from the CG, body axes \[m\].
     pub position: [f64; 3],
-    /// Angle of attack where the linear lift stops growing (crude stall) [rad].
+    /// Angle of attack where the linear lift stops growing (crude stall) \[rad\].
     pub stall_angle: f64,
 }
 
@@ -189,9 +178,9 @@ pub struct Surface {
 /// fraction in [−1, 1].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gearing {
-    /// Blade pitch at centred stick [rad].
+    /// Blade pitch at centred stick \[rad\].
     pub centre: f64,
-    /// Blade pitch per unit stick fraction [rad].
+    /// Blade pitch per unit stick fraction \[rad\].
     pub gain: f64,
 }
 
@@ -212,7 +201,7 @@ impl Gearing {
 pub struct Helicopter {
     /// Display name.
     pub name: &'static str,
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass: f64,
     /// Roll inertia I_xx [kg·m²].
     pub ixx: f64,
@@ -228,12 +217,12 @@ pub struct Helicopter {
     pub gravity: f64,
     /// Main rotor (hub position = rotor hub).
     pub main_rotor: Rotor,
-    /// Forward tilt of the main-rotor shaft [rad] (Padfield's γ_s; top of the shaft
+    /// Forward tilt of the main-rotor shaft \[rad\] (Padfield's γ_s; top of the shaft
     /// leans forward).
     pub shaft_tilt: f64,
     /// Tail rotor (thrust along +y for positive pitch; flap data unused).
     pub tail_rotor: Rotor,
-    /// Fuselage equivalent flat-plate drag areas along x, y, z [m²].
+    /// Fuselage equivalent flat-plate drag areas along x, y, z \[m²\].
     pub fuselage_drag_area: [f64; 3],
     /// Vertical fin.
     pub fin: Surface,
@@ -409,7 +398,7 @@ impl Helicopter {
         }
     }
 
-    /// Main-rotor flap time constant τ_f [s] in hover, from blade data.
+    /// Main-rotor flap time constant τ_f \[s\] in hover, from blade data.
     pub fn flap_time_constant(&self) -> f64 {
         self.main_rotor.flap_time_constant(self.air_density)
     }
@@ -441,7 +430,7 @@ impl Helicopter {
     }
 }
 
-/// Blade pitch angles [rad] (Padfield's conventions: θ = θ0 + θ1s sin ψ + θ1c cos ψ,
+/// Blade pitch angles \[rad\] (Padfield's conventions: θ = θ0 + θ1s sin ψ + θ1c cos ψ,
 /// ψ from the tail, anticlockwise; positive θ1s tilts the disc aft → nose up; positive θ1c
 /// tilts it left → roll left).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -513,6 +502,10 @@ mod tests {
         }
         assert_eq!("bo105".parse::<Vehicle>(), Ok(Vehicle::Bo105));
         assert_eq!("TREX700L".parse::<Vehicle>(), Ok(Vehicle::Trex700l));
-        assert!("ec135".parse::<Vehicle>().is_err());
+        let unknown = "ec135".parse::<Vehicle>().unwrap_err();
+        assert_eq!(
+            unknown.to_string(),
+            "unknown vehicle `ec135` (expected bo105 or trex700l)"
+        );
     }
 }

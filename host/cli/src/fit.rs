@@ -215,9 +215,9 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     }
 
     let scored = match args.truth {
-        Some(vehicle) => Some(crate::truth::score_fit_with_modes(
+        Some(vehicle) => Some(truth::score_fit_with_modes(
             &result,
-            &crate::truth::VehicleTruth::at_hover(vehicle)?,
+            &truth::VehicleTruth::at_hover(vehicle)?,
         )?),
         None => None,
     };

@@ -14,8 +14,10 @@ pub mod output;
 pub mod report;
 pub mod sim;
 pub mod table;
-pub mod truth;
 pub mod verify;
+
+/// The truth crate, also reachable as `crate::truth` (the campaign's truth stage names it so).
+pub use ::truth;
 
 /// Identify helicopter dynamics from automated frequency sweeps flown under conditional
 /// attitude hold (Jung, Shim & Kim).

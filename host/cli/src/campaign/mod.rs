@@ -34,6 +34,7 @@ use crate::fly::{self, AmplitudeArg, FcArg, FlyArgs, FlyOutcome, InputArg, ModeA
 use crate::output::{write_atomic, write_json, StagedFolder};
 use error::CampaignError;
 use stage::{Stage, StageProgress};
+use structures::CapturedTrim;
 use summary::{
     CampaignSummary, FitSummary, ModeSummary, Modes, PairSummary, ParameterSummary,
     SpeedDerivativeSummary, StageFailure,

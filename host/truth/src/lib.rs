@@ -1,0 +1,35 @@
+//! Truth scoring: the parameter values a model structure takes when it is fitted to the
+//! simulator's own linearization, the truth `Model` built from them, and the cost of an
+//! identified model against it.
+//!
+//! - [`VehicleTruth`]: a vehicle of the simulator trimmed in hover and linearized, with its
+//!   servos' equivalent delay.
+//! - [`structure_truth()`]: that linearization mapped onto a structure's parameters by name
+//!   (the rules are in the [`structure_truth`](mod@structure_truth) module), giving a
+//!   [`StructureTruth`].
+//! - [`score_fit`], [`score_fit_with_modes`]: an identified model against the structure's
+//!   truth (the `truth` section of `model.json`).
+//! - [`with_vehicle_data`], [`nine_dof_hybrid`]: a shipped structure with the flown
+//!   vehicle's geometry, rotor data and trim attitude ([`TrimAttitude`]) in it.
+//!
+//! It builds on the simulator (`bo105`) and the identification library (`sysid`) and
+//! joins the two; neither of them imports it, nor does it import the command-line tool or
+//! read telemetry.
+
+#![warn(missing_docs)]
+
+mod error;
+mod flap_rows;
+mod folded_flapping;
+pub mod scoring;
+pub mod structure_truth;
+#[cfg(test)]
+mod test_support;
+pub mod vehicle_data;
+pub mod vehicle_truth;
+
+pub use error::Error;
+pub use scoring::{score_fit, score_fit_with_modes, ScoredFit, TRUTH_POINTS_PER_PAIR};
+pub use structure_truth::{structure_truth, StructureTruth};
+pub use vehicle_data::{nine_dof_hybrid, with_vehicle_data, TrimAttitude};
+pub use vehicle_truth::VehicleTruth;
