@@ -7,12 +7,14 @@
 //! modem lines ignored) through the `serialport` crate. One port is one board, so a run
 //! flies its records one after the other on a single link.
 
-use std::io::{ErrorKind, Read, Write};
-use std::os::unix::fs::FileTypeExt;
+use std::io::{ErrorKind, IsTerminal, Read, Write};
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::anyhow;
+use nix::errno::Errno;
+use nix::fcntl::OFlag;
 use sweephold_firmware::Config;
 use sweephold_protocol::{ActuatorOut, SensorIn};
 
@@ -128,12 +130,28 @@ impl SerialWire {
                 port.baud
             ));
         }
+        // Opened here first, without waiting for carrier detect: the open errors read as
+        // for any file, and a file that is no terminal is refused before any terminal
+        // setting. It stays open until serialport has the port, so that closing it is not
+        // the tty's last close (which would drop the modem lines).
+        let probe = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags((OFlag::O_NOCTTY | OFlag::O_NONBLOCK).bits())
+            .open(&port.path)
+            .map_err(|e| anyhow!("cannot open serial port {name}: {e}"))?;
+        if !probe.is_terminal() {
+            let why = std::io::Error::from(Errno::ENOTTY);
+            return Err(anyhow!(
+                "cannot open serial port {name}: not a terminal: {why}"
+            ));
+        }
         let path = port
             .path
             .to_str()
             .ok_or_else(|| anyhow!("cannot open serial port {name}: the path is not UTF-8"))?;
-        // serialport opens without waiting for carrier detect, sets raw mode with the
-        // receiver on and the modem lines ignored, then the frame format and the rate.
+        // serialport sets raw mode with the receiver on and the modem lines ignored, then
+        // the frame format and the rate.
         let opened = serialport::new(path, port.baud)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
@@ -142,28 +160,17 @@ impl SerialWire {
             .exclusive(false)
             .timeout(ANSWER_TIMEOUT)
             .open()
-            .map_err(|e| open_failure(&port.path, &name, &e))?;
+            .map_err(|e| anyhow!("cannot open serial port {name}: termios: {e}"))?;
         opened
             .clear(serialport::ClearBuffer::All)
             .map_err(|e| anyhow!("cannot open serial port {name}: termios: {e}"))?;
+        drop(probe);
         Ok(SerialWire { port: opened, name })
     }
 
     /// The port's path as shown in messages.
     pub fn name(&self) -> &str {
         &self.name
-    }
-}
-
-/// The error of a failed open. serialport does not say which step failed; a path that
-/// exists but is no device failed at the terminal settings: "not a terminal", as the
-/// tty layer puts it.
-fn open_failure(path: &Path, name: &str, error: &serialport::Error) -> anyhow::Error {
-    let no_device = std::fs::metadata(path).is_ok_and(|m| !m.file_type().is_char_device());
-    if no_device {
-        anyhow!("cannot open serial port {name}: not a terminal: {error}")
-    } else {
-        anyhow!("cannot open serial port {name}: {error}")
     }
 }
 
