@@ -46,7 +46,10 @@
 //! measurement is not accumulated (the safety checks abort on such a sample in the same
 //! tick anyway); the scale stays finite and inside its bounds.
 
-use crate::config::MAX_AMPLITUDE;
+/// Largest accepted sweep or pulse amplitude, fraction of stick travel: the bound of
+/// every excitation amplitude, fixed (checked by [`Config::validate`](crate::Config::validate))
+/// or adapted here.
+pub const MAX_AMPLITUDE: f32 = 0.5;
 
 /// The adaptive-amplitude law's settings (firmware presets; not on the wire).
 #[derive(Clone, Copy, Debug, PartialEq)]

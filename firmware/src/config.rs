@@ -21,8 +21,7 @@ pub const MAX_RATE_HZ: u16 = 1000;
 /// ω_max may be at most this fraction of the Nyquist frequency π·rate [rad/s]: above it
 /// a sine has fewer than five samples per period.
 pub const NYQUIST_FRACTION: f32 = 0.4;
-/// Largest accepted sweep or pulse amplitude, fraction of stick travel.
-pub const MAX_AMPLITUDE: f32 = 0.5;
+pub use crate::amplitude::MAX_AMPLITUDE;
 /// Longest accepted fade \[s\].
 pub const MAX_FADE_S: f32 = 60.0;
 /// Longest accepted excitation (lead-in + record + tail) \[s\]: three hours, which also

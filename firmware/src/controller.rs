@@ -251,7 +251,7 @@ impl FlightController {
                     config.safety.rate_limit_rad_s,
                 )
             }),
-            noise_at_start: noise,
+            noise_at_start: noise.clone(),
             noise,
             thresholds: config.hold_thresholds(),
             dt_s,
@@ -457,7 +457,7 @@ impl FlightController {
         if let Some(shaper) = &mut self.shaper {
             shaper.reset();
         }
-        self.noise = self.noise_at_start;
+        self.noise = self.noise_at_start.clone();
         self.axes = [HeldAxis::RELEASED; 3];
     }
 

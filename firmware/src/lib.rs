@@ -30,7 +30,8 @@
 //! Modules, one concept each: [`sweep`] (the sweep, its closed-form phase and its
 //! `f64`-free tick evaluation), [`turns`] (angles as fixed-point fractions of a turn and
 //! their `f32` sine),
-//! [`pulse`] (multisteps), [`excitation`] (both behind one interface), [`amplitude`] (the
+//! [`pulse`] (multisteps), [`excitation`] (both behind one interface; what each yields
+//! per instant is an [`excitation_sample`]), [`amplitude`] (the
 //! adaptive sweep amplitude), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
@@ -67,6 +68,7 @@ pub mod config;
 pub mod controller;
 pub mod estimator;
 pub mod excitation;
+pub mod excitation_sample;
 pub mod filters;
 pub mod hold;
 pub mod imu;

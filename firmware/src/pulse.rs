@@ -9,7 +9,7 @@
 //! so there is no envelope: the fade phases become quiet periods of `T_fade` (zero input,
 //! steady trim before the pulses, free response after them).
 
-use crate::excitation::{ExcitationSample, Segment};
+use crate::excitation_sample::{ExcitationSample, Segment};
 use crate::sweep::first_tick_at_or_after;
 
 /// One step of a multistep: sign and length in base widths.

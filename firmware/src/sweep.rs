@@ -28,7 +28,7 @@
 
 use core::f64::consts::TAU;
 
-use crate::excitation::{ExcitationSample, Segment};
+use crate::excitation_sample::{ExcitationSample, Segment};
 use crate::turns::{sin_turns, Turns};
 
 /// Exponent constant C1 of the sweep.

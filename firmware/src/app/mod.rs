@@ -12,7 +12,8 @@
 //! * [`arming`]: pre-arm and test-entry checks, switch edges;
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
 //! * [`throttle`]: the ESC channel and its soft start;
-//! * [`inputs`]: the input and output types.
+//! * [`inputs`]: the input types;
+//! * [`outputs`]: the output type.
 //!
 //! # The sequencer inside the application
 //!
@@ -53,6 +54,7 @@ pub mod arming;
 pub mod failsafe;
 pub mod inputs;
 pub mod modes;
+pub mod outputs;
 pub mod pilot_mode;
 pub mod throttle;
 
@@ -78,10 +80,9 @@ use throttle::{Throttle, ThrottleSettings};
 
 pub use arming::{CheckFailure, Refusal};
 pub use failsafe::ImuProblem;
-pub use inputs::{
-    ImuFaultKind, ImuInput, ImuStatus, ModeSwitch, RcInput, Receiver, TickInput, TickOutput,
-};
+pub use inputs::{ImuFaultKind, ImuInput, ImuStatus, ModeSwitch, RcInput, Receiver, TickInput};
 pub use modes::Mode;
+pub use outputs::TickOutput;
 pub use pilot_mode::StickMode;
 
 /// The command while disarmed ("servos safe"): cyclic centred, collective at mid

@@ -46,7 +46,7 @@ mod image {
     /// cortex-m-rt requires the `unsafe fn` signature; the body is safe code.
     #[exception]
     unsafe fn DefaultHandler(irqn: i16) {
-        if !board::nvic::dispatch(irqn) {
+        if !board::interrupts::dispatch(irqn) {
             defmt::panic!("unexpected exception or interrupt {=i16}", irqn);
         }
     }

@@ -17,6 +17,7 @@
 pub mod clocks;
 pub mod dividers;
 pub mod gpio;
+pub mod interrupts;
 pub mod link;
 pub mod log;
 pub mod nvic;

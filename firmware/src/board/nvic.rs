@@ -1,7 +1,5 @@
-//! The device interrupts the image uses, and their dispatch.
-//!
-//! Without a PAC the vector table's 82 device entries all point at cortex-m-rt's
-//! `DefaultHandler`, which receives the IRQ number (CMSIS IRQn): [`dispatch`] routes it.
+//! The device interrupts the image uses, and their masks in the NVIC. Which driver
+//! handles each is [`super::interrupts`]'s routing.
 
 use super::regs::nvic::{ICER, ISER};
 
@@ -16,7 +14,8 @@ pub enum Irq {
 }
 
 impl Irq {
-    fn from_number(number: i16) -> Option<Irq> {
+    /// The interrupt of IRQ number `number` (CMSIS IRQn), if the image uses it.
+    pub fn from_number(number: i16) -> Option<Irq> {
         match number {
             28 => Some(Irq::Tim2),
             37 => Some(Irq::Usart1),
@@ -45,15 +44,4 @@ pub fn disable(irq: Irq) {
     if let Some(register) = ICER.get(index) {
         register.write(bit);
     }
-}
-
-/// Route a device interrupt (IRQ number ≥ 0) to its driver. Returns `false` for one the
-/// image never enabled, which the caller treats as a fault.
-pub fn dispatch(number: i16) -> bool {
-    match Irq::from_number(number) {
-        Some(Irq::Tim2) => super::ticker::on_interrupt(),
-        Some(Irq::Usart1) => super::usart::on_interrupt(),
-        None => return false,
-    }
-    true
 }

@@ -131,7 +131,7 @@ pub struct ImuFaultPlan {
 
 impl ImuFaultPlan {
     /// Parse `stuck@T`, `saturate@T`, `missing@T` or `missing`.
-    pub fn parse(text: &str) -> Result<ImuFaultPlan, String> {
+    pub fn parse(text: &str) -> Result<ImuFaultPlan, ImuFaultPlanError> {
         let (kind, at) = match text.split_once('@') {
             Some((kind, at)) => (kind, Some(at)),
             None => (text, None),
@@ -140,33 +140,34 @@ impl ImuFaultPlan {
             "stuck" => ImuFaultKind::Stuck,
             "saturate" => ImuFaultKind::Saturate,
             "missing" => ImuFaultKind::Missing,
-            _ => {
-                return Err(format!(
-                    "unknown IMU fault `{kind}` (expected stuck@AT_S, saturate@AT_S, \
-                     missing@AT_S or missing)"
-                ))
-            }
+            _ => return Err(ImuFaultPlanError::UnknownKind(kind.to_string())),
         };
         let at_s = match at {
             None if kind == ImuFaultKind::Missing => None,
-            None => {
-                return Err(format!(
-                    "`{}` needs a time: {}@AT_S (seconds of record time)",
-                    kind.name(),
-                    kind.name()
-                ))
-            }
+            None => return Err(ImuFaultPlanError::NoTime(kind)),
             Some(at) => match at.trim().parse::<f64>() {
                 Ok(t) if t.is_finite() && t >= 0.0 => Some(t),
-                _ => {
-                    return Err(format!(
-                        "`{at}` is not a time: expected seconds of record time >= 0"
-                    ))
-                }
+                _ => return Err(ImuFaultPlanError::NotATime(at.to_string())),
             },
         };
         Ok(ImuFaultPlan { kind, at_s })
     }
+}
+
+/// Why an `--imu-fault` value names no fault.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ImuFaultPlanError {
+    /// Not one of the faults.
+    #[error(
+        "unknown IMU fault `{0}` (expected stuck@AT_S, saturate@AT_S, missing@AT_S or missing)"
+    )]
+    UnknownKind(String),
+    /// A fault that starts at a time, given none.
+    #[error("`{name}` needs a time: {name}@AT_S (seconds of record time)", name = .0.name())]
+    NoTime(ImuFaultKind),
+    /// The part after `@` is not a time.
+    #[error("`{0}` is not a time: expected seconds of record time >= 0")]
+    NotATime(String),
 }
 
 /// What the board-sim link needs besides the record's configuration.

@@ -4,17 +4,17 @@
 //! over the emulated one (`--fc qemu-usart`): Configure → ConfigureResult (after a
 //! Header), then per tick SensorIn → Events, Sample → ActuatorOut. The exchange itself
 //! is [`FrameChannel`]'s; this module only opens the tty (raw 8N1, no flow control,
-//! modem lines ignored) with termios through `libc`. One port is one board, so a run
+//! modem lines ignored) through the `serialport` crate. One port is one board, so a run
 //! flies its records one after the other on a single link.
 
-use std::fs::File;
-use std::io::{ErrorKind, Read, Write};
-use std::os::fd::AsRawFd;
+use std::io::{ErrorKind, IsTerminal, Read, Write};
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::anyhow;
+use nix::errno::Errno;
+use nix::fcntl::OFlag;
 use sweephold_firmware::Config;
 use sweephold_protocol::{ActuatorOut, SensorIn};
 
@@ -28,6 +28,13 @@ pub const DEFAULT_BAUD: u32 = 460_800;
 /// takes well under a millisecond on the board and ~10 ms of line time at 460 800 Bd.
 pub const ANSWER_TIMEOUT: Duration = Duration::from_secs(2);
 
+/// The line rates a tty driver offers (the termios `B…` speeds from 9600 Bd up): the
+/// rates `serial:PATH@BAUD` accepts.
+const OFFERED_RATES: [u32; 12] = [
+    9_600, 19_200, 38_400, 57_600, 115_200, 230_400, 460_800, 500_000, 921_600, 1_000_000,
+    1_500_000, 2_000_000,
+];
+
 /// A serial port and its line rate, as `--fc serial:PATH[@BAUD]` names them.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SerialPort {
@@ -37,27 +44,60 @@ pub struct SerialPort {
     pub baud: u32,
 }
 
+/// Why `serial:PATH[@BAUD]` names no usable port; `text` is the part after `serial:`.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SerialPortError {
+    /// The part after `@` is not a number.
+    #[error("serial:{text}: baud rate `{baud}` is not a number")]
+    BaudNotANumber {
+        /// The value after `serial:`.
+        text: String,
+        /// The part after `@`.
+        baud: String,
+    },
+    /// Nothing before the `@` (or nothing at all).
+    #[error(
+        "serial:{text}: no port (expected serial:PATH[@BAUD], e.g. serial:/dev/ttyUSB0@460800)"
+    )]
+    NoPort {
+        /// The value after `serial:`.
+        text: String,
+    },
+    /// A rate that is not one of the tty driver's.
+    #[error(
+        "serial:{text}: {baud} Bd is not a rate the tty driver offers (e.g. 115200, 460800, 921600)"
+    )]
+    UnofferedRate {
+        /// The value after `serial:`.
+        text: String,
+        /// The rate asked for [Bd].
+        baud: u32,
+    },
+}
+
 impl SerialPort {
     /// Parse `PATH[@BAUD]` (the part after `serial:`).
-    pub fn parse(text: &str) -> Result<SerialPort, String> {
+    pub fn parse(text: &str) -> Result<SerialPort, SerialPortError> {
         let (path, baud) = match text.rsplit_once('@') {
             Some((path, baud)) => {
-                let baud: u32 = baud
-                    .parse()
-                    .map_err(|_| format!("serial:{text}: baud rate `{baud}` is not a number"))?;
-                (path, baud)
+                let rate: u32 = baud.parse().map_err(|_| SerialPortError::BaudNotANumber {
+                    text: text.to_string(),
+                    baud: baud.to_string(),
+                })?;
+                (path, rate)
             }
             None => (text, DEFAULT_BAUD),
         };
         if path.is_empty() {
-            return Err(format!(
-                "serial:{text}: no port (expected serial:PATH[@BAUD], e.g. serial:/dev/ttyUSB0@460800)"
-            ));
+            return Err(SerialPortError::NoPort {
+                text: text.to_string(),
+            });
         }
-        if termios_speed(baud).is_none() {
-            return Err(format!(
-                "serial:{text}: {baud} Bd is not a rate the tty driver offers (e.g. 115200, 460800, 921600)"
-            ));
+        if !OFFERED_RATES.contains(&baud) {
+            return Err(SerialPortError::UnofferedRate {
+                text: text.to_string(),
+                baud,
+            });
         }
         Ok(SerialPort {
             path: PathBuf::from(path),
@@ -72,73 +112,60 @@ impl std::fmt::Display for SerialPort {
     }
 }
 
-/// The termios speed constant of `baud`, if there is one.
-fn termios_speed(baud: u32) -> Option<libc::speed_t> {
-    Some(match baud {
-        9_600 => libc::B9600,
-        19_200 => libc::B19200,
-        38_400 => libc::B38400,
-        57_600 => libc::B57600,
-        115_200 => libc::B115200,
-        230_400 => libc::B230400,
-        460_800 => libc::B460800,
-        500_000 => libc::B500000,
-        921_600 => libc::B921600,
-        1_000_000 => libc::B1000000,
-        1_500_000 => libc::B1500000,
-        2_000_000 => libc::B2000000,
-        _ => return None,
-    })
-}
-
 /// An open tty in raw mode.
 pub struct SerialWire {
-    file: File,
+    port: Box<dyn serialport::SerialPort>,
     name: String,
 }
 
 impl SerialWire {
     /// Open `port` raw, 8N1, no flow control, modem lines ignored; drop whatever the
-    /// driver had buffered.
+    /// driver had buffered. Not exclusive: like any tty, the port stays open to others
+    /// (a monitor, say).
     pub fn open(port: &SerialPort) -> anyhow::Result<SerialWire> {
         let name = port.path.display().to_string();
-        let fail =
-            |what: &str, e: std::io::Error| anyhow!("cannot open serial port {name}: {what}{e}");
-        // Non-blocking so the open does not wait for carrier detect; cleared below.
-        let file = std::fs::OpenOptions::new()
+        if !OFFERED_RATES.contains(&port.baud) {
+            return Err(anyhow!(
+                "serial port {name}: unsupported rate {} Bd",
+                port.baud
+            ));
+        }
+        // Opened here first, without waiting for carrier detect: the open errors read as
+        // for any file, and a file that is no terminal is refused before any terminal
+        // setting. It stays open until serialport has the port, so that closing it is not
+        // the tty's last close (which would drop the modem lines).
+        let probe = std::fs::OpenOptions::new()
             .read(true)
             .write(true)
-            .custom_flags(libc::O_NOCTTY | libc::O_NONBLOCK)
+            .custom_flags((OFlag::O_NOCTTY | OFlag::O_NONBLOCK).bits())
             .open(&port.path)
-            .map_err(|e| fail("", e))?;
-        let speed = termios_speed(port.baud)
-            .ok_or_else(|| anyhow!("serial port {name}: unsupported rate {} Bd", port.baud))?;
-        let fd = file.as_raw_fd();
-        // SAFETY: `fd` is open for the whole block; `termios` is a plain C struct that
-        // tcgetattr fills before it is read.
-        unsafe {
-            let mut termios: libc::termios = std::mem::zeroed();
-            if libc::tcgetattr(fd, &mut termios) != 0 {
-                return Err(fail("not a terminal: ", std::io::Error::last_os_error()));
-            }
-            libc::cfmakeraw(&mut termios);
-            termios.c_cflag |= libc::CLOCAL | libc::CREAD;
-            termios.c_cflag &= !(libc::CRTSCTS | libc::CSTOPB | libc::PARENB);
-            termios.c_cc[libc::VMIN] = 1;
-            termios.c_cc[libc::VTIME] = 0;
-            if libc::cfsetispeed(&mut termios, speed) != 0
-                || libc::cfsetospeed(&mut termios, speed) != 0
-                || libc::tcsetattr(fd, libc::TCSANOW, &termios) != 0
-            {
-                return Err(fail("termios: ", std::io::Error::last_os_error()));
-            }
-            libc::tcflush(fd, libc::TCIOFLUSH);
-            let flags = libc::fcntl(fd, libc::F_GETFL);
-            if flags < 0 || libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) != 0 {
-                return Err(fail("fcntl: ", std::io::Error::last_os_error()));
-            }
+            .map_err(|e| anyhow!("cannot open serial port {name}: {e}"))?;
+        if !probe.is_terminal() {
+            let why = std::io::Error::from(Errno::ENOTTY);
+            return Err(anyhow!(
+                "cannot open serial port {name}: not a terminal: {why}"
+            ));
         }
-        Ok(SerialWire { file, name })
+        let path = port
+            .path
+            .to_str()
+            .ok_or_else(|| anyhow!("cannot open serial port {name}: the path is not UTF-8"))?;
+        // serialport sets raw mode with the receiver on and the modem lines ignored, then
+        // the frame format and the rate.
+        let opened = serialport::new(path, port.baud)
+            .data_bits(serialport::DataBits::Eight)
+            .parity(serialport::Parity::None)
+            .stop_bits(serialport::StopBits::One)
+            .flow_control(serialport::FlowControl::None)
+            .exclusive(false)
+            .timeout(ANSWER_TIMEOUT)
+            .open()
+            .map_err(|e| anyhow!("cannot open serial port {name}: termios: {e}"))?;
+        opened
+            .clear(serialport::ClearBuffer::All)
+            .map_err(|e| anyhow!("cannot open serial port {name}: termios: {e}"))?;
+        drop(probe);
+        Ok(SerialWire { port: opened, name })
     }
 
     /// The port's path as shown in messages.
@@ -149,22 +176,18 @@ impl SerialWire {
 
 impl ByteWire for SerialWire {
     fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-        self.file.write_all(bytes)
+        // A write waits for room in the driver's buffer at most one answer's time.
+        self.port.set_timeout(ANSWER_TIMEOUT)?;
+        self.port.write_all(bytes)
     }
 
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> std::io::Result<usize> {
-        let mut poll = libc::pollfd {
-            fd: self.file.as_raw_fd(),
-            events: libc::POLLIN,
-            revents: 0,
-        };
-        let millis = libc::c_int::try_from(timeout.as_millis().max(1)).unwrap_or(1000);
-        // SAFETY: one valid pollfd, count 1, for the duration of the call.
-        let ready = unsafe { libc::poll(&mut poll, 1, millis) };
-        match ready {
-            0 => Err(ErrorKind::TimedOut.into()),
-            n if n < 0 => Err(std::io::Error::last_os_error()),
-            _ => self.file.read(buf),
+        self.port
+            .set_timeout(timeout.max(Duration::from_millis(1)))?;
+        match self.port.read(buf) {
+            // serialport reports the other end's hang-up before reading: the stream's end.
+            Err(e) if e.kind() == ErrorKind::BrokenPipe => Ok(0),
+            other => other,
         }
     }
 
@@ -275,7 +298,7 @@ mod tests {
             ("/dev/ttyUSB0@fast", "not a number"),
             ("/dev/ttyUSB0@12345", "not a rate"),
         ] {
-            let error = SerialPort::parse(text).expect_err(text);
+            let error = SerialPort::parse(text).expect_err(text).to_string();
             assert!(error.contains(reason), "{text}: {error}");
         }
     }

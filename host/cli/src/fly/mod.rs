@@ -293,20 +293,31 @@ pub enum FcArg {
 }
 
 /// Parse `--fc`: `in-process`, `qemu`, `qemu-usart`, `serial:PATH[@BAUD]` or `board-sim`.
-pub fn parse_fc(text: &str) -> Result<FcArg, String> {
+pub fn parse_fc(text: &str) -> Result<FcArg, FcArgError> {
     match text {
         "in-process" => Ok(FcArg::InProcess),
         "board-sim" => Ok(FcArg::BoardSim),
         "qemu" => Ok(FcArg::Qemu),
         "qemu-usart" => Ok(FcArg::QemuUsart),
         _ => match text.strip_prefix("serial:") {
-            Some(port) => link_serial::SerialPort::parse(port).map(FcArg::Serial),
-            None => Err(format!(
-                "unknown flight controller `{text}` (expected in-process, qemu, qemu-usart, \
-                 serial:PATH[@BAUD] or board-sim)"
-            )),
+            Some(port) => Ok(FcArg::Serial(link_serial::SerialPort::parse(port)?)),
+            None => Err(FcArgError::Unknown(text.to_string())),
         },
     }
+}
+
+/// Why an `--fc` value names no flight controller.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum FcArgError {
+    /// None of the kinds.
+    #[error(
+        "unknown flight controller `{0}` (expected in-process, qemu, qemu-usart, \
+         serial:PATH[@BAUD] or board-sim)"
+    )]
+    Unknown(String),
+    /// `serial:` with a value that names no port.
+    #[error(transparent)]
+    Serial(#[from] link_serial::SerialPortError),
 }
 
 /// Shortest `--t-rec` [s]: the upper-band record must hold two windows of ten periods

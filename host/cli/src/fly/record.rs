@@ -197,9 +197,7 @@ pub fn fly_record(
     options.spike_probability = disturbances.sensor_spike;
     let mut sim = Sim::at_trim(aircraft.heli.clone(), trim, options);
     let trim_sticks = trim.controls.map(|c| c as f32);
-    let mut pilot_rng = SplitMix(SplitMix64::new(
-        u64::from(config.test.seed) ^ 0x9170_7D15_7A2B,
-    ));
+    let mut pilot_rng = SplitMix64::new(u64::from(config.test.seed) ^ 0x9170_7D15_7A2B);
 
     link.begin_record(config)?;
     let mut dump = Vec::with_capacity((max_s * rate) as usize * 140);
@@ -220,7 +218,8 @@ pub fn fly_record(
             // Flying on: the pilot's hands at trim.
         } else if disturbances.pilot_stick_noise > 0.0 {
             for s in &mut sticks {
-                *s += (disturbances.pilot_stick_noise * pilot_rng.gaussian()) as f32;
+                // One deviate per stick: the first of each Box–Muller pair.
+                *s += (disturbances.pilot_stick_noise * pilot_rng.normal_pair().0) as f32;
             }
         }
         if let (Some(at), None) = (disturbances.pilot_override_at_s, ended) {
@@ -315,16 +314,5 @@ pub fn measurements(r: &bo105::SensorReading) -> Measurements {
         ax: r.ax as f32,
         ay: r.ay as f32,
         az: r.az as f32,
-    }
-}
-
-/// SplitMix64 with a Box–Muller Gaussian (the cosine branch only), for the simulated
-/// pilot's hands.
-struct SplitMix(SplitMix64);
-
-impl SplitMix {
-    fn gaussian(&mut self) -> f64 {
-        let (a, b) = (self.0.unit_open(), self.0.unit_open());
-        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
     }
 }

@@ -42,7 +42,8 @@ impl Sweep {
     }
 }
 
-/// SplitMix64 with Box–Muller: reproducible Gaussian noise without a dependency.
+/// SplitMix64 with Box–Muller ([`SplitMix64::normal_pair`]): reproducible Gaussian noise,
+/// one deviate per call.
 pub struct Noise {
     random: SplitMix64,
     spare: Option<f64>,
@@ -56,20 +57,14 @@ impl Noise {
         }
     }
 
-    fn uniform(&mut self) -> f64 {
-        self.random.unit_open()
-    }
-
     /// A standard normal deviate.
     pub fn gaussian(&mut self) -> f64 {
         if let Some(v) = self.spare.take() {
             return v;
         }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let radius = (-2.0 * u1.ln()).sqrt();
-        let angle = std::f64::consts::TAU * u2;
-        self.spare = Some(radius * angle.sin());
-        radius * angle.cos()
+        let (first, second) = self.random.normal_pair();
+        self.spare = Some(second);
+        first
     }
 }
 
