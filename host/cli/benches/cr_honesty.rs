@@ -3,7 +3,7 @@
 //! fit, 9-DOF hybrid fit started from it with `--reduce`), and compare, per key parameter,
 //! the spread of the 20 estimates (sample standard deviation σ) with the mean Cramér–Rao
 //! bound the fits reported for it (CR_abs = CR % · |value| / 100). A bound is honest when
-//! σ / mean(CR_abs) lies within [1/3, 3] (issue 7). Prints the table; exits non-zero when a
+//! σ / mean(CR_abs) lies within [1/3, 3]. Prints the table; exits non-zero when a
 //! ratio is outside.
 //!
 //! Beside the ratio it prints each parameter's truth (the simulator's linearization, from
@@ -91,8 +91,8 @@ fn flagged_free_parameters(document: &serde_json::Value) -> Vec<String> {
 }
 
 /// The angular-rate pair (output p, q or r) whose identified response is farthest from
-/// the truth's: its name and the cost J between the two over the pair's range (issue 7
-/// asks J ≤ 20 for every such pair).
+/// the truth's: its name and the cost J between the two over the pair's range (the bar is
+/// J ≤ 20 for every such pair).
 fn worst_rate_pair_truth_cost(document: &serde_json::Value) -> Option<(String, f64)> {
     document["truth"]["pairs"]
         .as_array()?

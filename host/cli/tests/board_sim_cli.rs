@@ -1,6 +1,6 @@
 //! `fly --fc board-sim`: the board's sensor-to-servo stack (firmware `board_stack`) flown
-//! against the emulated IMU and an SBUS stream. The figures checked here are the issue's
-//! (estimator error, attitude after the test, abort reasons and latency); the values
+//! against the emulated IMU and an SBUS stream. The figures checked here are the board
+//! application's bars (estimator error, attitude after the test, abort reasons and latency); the values
 //! measured are in docs/board-application.md.
 
 use std::path::{Path, PathBuf};

@@ -1,4 +1,4 @@
-//! Issue 19 as a user meets it: dumps whose ticks step back, structure files with numbers
+//! Malformed inputs as a user meets them: dumps whose ticks step back, structure files with numbers
 //! that are not finite or parameters nothing uses, shipped structures by name, and a
 //! board image that is not one. Each ends in the right result or a one-line error, never
 //! a panic, and no input file is modified.

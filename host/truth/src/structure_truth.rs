@@ -310,7 +310,7 @@ mod tests {
         }
     }
 
-    /// The key parameters of the bar: rotor, heave and yaw control, flap controls.
+    /// The nine key parameters scored against the truth: rotor, heave and yaw control, flap controls.
     const KEY_PARAMETERS: [&str; 9] = [
         "tau_f", "Lb1s", "Mb1c", "Zcol", "Nped", "Mf_lat", "Mf_lon", "Lf_lat", "Lf_lon",
     ];
