@@ -73,7 +73,7 @@ pub struct AdaptiveSettings {
 impl AdaptiveSettings {
     /// The presets' law: the sweep's share of each attitude at half the release angle
     /// (2° of 4°: the other half is left to the drift of the released hover), of each rate
-    /// at a fifth of its abort limit, ×1.5 / ×0.5 per half cycle, 0.2–4 times the
+    /// at a quarter of its abort limit, ×1.25 / ×0.7 per half cycle, 0.2–2 times the
     /// configured amplitude, slope at most 2 per second (half the simulator's servo rate
     /// limit of 4 per second).
     pub const PRESET: AdaptiveSettings = AdaptiveSettings {
