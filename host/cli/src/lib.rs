@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod arg_values;
+pub mod artifacts;
 pub mod campaign;
 pub mod decode;
 pub mod fit;

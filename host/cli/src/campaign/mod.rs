@@ -5,10 +5,8 @@
 //! `report.html`.
 
 pub mod error;
-pub mod stage;
+pub mod progress;
 pub mod structures;
-pub mod summary;
-pub mod truth_model;
 pub mod verification;
 
 use std::collections::BTreeMap;
@@ -28,18 +26,22 @@ use sysid::fit::{
 };
 use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions};
 
+use crate::artifacts::files;
+use crate::artifacts::stage::Stage;
+use crate::artifacts::summary::{
+    CampaignSummary, FitSummary, ModeSummary, Modes, PairSummary, ParameterSummary,
+    PeakAttitudeDeg, SpeedDerivativeSummary, StageFailure,
+};
+use crate::artifacts::truth_model::TruthModelDocument;
+use crate::artifacts::verification::VerifyDocument;
 use crate::fly::link::InProcessLink;
 use crate::fly::plan::PAPER_T_REC_S;
+use crate::fly::summary::FlySummary;
 use crate::fly::{self, AmplitudeArg, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
 use crate::output::{write_atomic, write_json, StagedFolder};
 use error::CampaignError;
-use stage::{Stage, StageProgress};
-use summary::{
-    CampaignSummary, FitSummary, ModeSummary, Modes, PairSummary, ParameterSummary,
-    SpeedDerivativeSummary, StageFailure,
-};
-use truth_model::TruthModelDocument;
-use verification::{verify_dump, VerifyDocument};
+use progress::StageProgress;
+use verification::verify_dump;
 
 /// Sweep record length of `--quick` [s]: long enough for the frequency responses above
 /// ~0.6 rad/s, short enough for a test.
@@ -52,33 +54,6 @@ pub const VERIFY_SEGMENT_S: Option<f64> = None;
 /// Each output's bias is its mean over the trim capture before the doublet (and each
 /// input's trim likewise), not fitted to the prediction.
 pub const VERIFY_BIAS: BiasMode = BiasMode::Trim;
-
-/// Files of the campaign folder.
-pub mod files {
-    /// The campaign's summary.
-    pub const SUMMARY: &str = "summary.json";
-    /// The report.
-    pub const REPORT: &str = "report.html";
-    /// Frequency responses of the `cah` records.
-    pub const FRF: &str = "frf.json";
-    /// The trim points the fits derive `trim_derived` parameters from.
-    pub const TRIM_POINTS: &str = "trim-points.csv";
-    /// The 6-DOF fit.
-    pub const MODEL_6DOF: &str = "model6.json";
-    /// The 9-DOF hybrid fit (with its truth section).
-    pub const MODEL_9DOF: &str = "model9.json";
-    /// The 9-DOF structure at the truth values.
-    pub const TRUTH_MODEL_9DOF: &str = "truth-model9.json";
-    /// Verification time histories and scores.
-    pub const VERIFY: &str = "verify.json";
-    /// Folder of the held-out doublets.
-    pub const VERIFICATION_FOLDER: &str = "verify-doublet";
-
-    /// Folder of the sweeps flown in `mode` (`cah`, `standard`, `noise`).
-    pub fn fly_folder(mode: &str) -> String {
-        format!("fly-{mode}")
-    }
-}
 
 /// Arguments of `sweephold campaign`.
 #[derive(Args, Debug, Clone)]
@@ -307,6 +282,27 @@ fn fly_in_process(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
     fly::fly(args, &|| Box::new(InProcessLink::new()))
 }
 
+/// The mode's figures from `fly`'s summary of its records written into `folder`.
+pub fn mode_summary(summary: &FlySummary, folder: &str) -> ModeSummary {
+    let peak = |value: fn(&crate::fly::summary::MaxAbsDeg) -> f64| {
+        summary
+            .runs
+            .iter()
+            .map(|run| value(&run.max_abs_deg))
+            .fold(0.0, f64::max)
+    };
+    ModeSummary {
+        cross_coherence_lat_lon: summary.mean_cross_coherence("lat", "lon"),
+        max_abs_deg: PeakAttitudeDeg {
+            phi: peak(|m| m.phi),
+            theta: peak(|m| m.theta),
+        },
+        aborts: summary.runs.iter().filter(|run| run.aborted).count(),
+        records: summary.runs.len(),
+        folder: folder.to_string(),
+    }
+}
+
 /// The `fit` section of the summary from the final fit (truth filled in later).
 fn fit_summary(result: &FitResult, start_cost_ave: f64) -> FitSummary {
     let identified_modes = mode_records(&result.model);
@@ -439,7 +435,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
             let folder = files::fly_folder(mode.name());
             let fly_args = run.fly_args(mode, InputArg::Sweep, run.args.seed, &folder);
             let outcome = fly_in_process(&fly_args)?;
-            let summary = ModeSummary::from_fly(&outcome.summary, &folder);
+            let summary = mode_summary(&outcome.summary, &folder);
             let line = format!(
                 "{} records, {} abort(s), lat–lon coherence {}",
                 summary.records,
@@ -698,6 +694,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fly::summary::{HoldFraction, MaxAbsDeg, RunSummary};
 
     #[test]
     fn a_failed_stage_keeps_the_previous_campaign_and_its_own_files() {
@@ -751,5 +748,51 @@ mod tests {
         assert_eq!(summary["seed"], 7);
         assert!(!dir.join("campaign.partial").exists());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn run(axis: &str, phi: f64, aborted: bool, lon: Option<f64>) -> RunSummary {
+        RunSummary {
+            axis: axis.into(),
+            index: 1,
+            file: format!("{axis}-1.bin"),
+            omega_min: 0.2,
+            omega_max: 31.4,
+            duration_s: 90.0,
+            frames: 1,
+            aborted,
+            abort_reason: aborted.then(|| "attitude_limit".into()),
+            max_abs_deg: MaxAbsDeg {
+                phi,
+                theta: phi / 2.0,
+                psi: 0.0,
+            },
+            hold_fraction: HoldFraction::default(),
+            cross_coherence: lon.map(|c| ("lon".to_string(), c)).into_iter().collect(),
+            estimator: None,
+            after: None,
+        }
+    }
+
+    #[test]
+    fn mode_summary_takes_peaks_aborts_and_lateral_coherence() {
+        let fly = FlySummary {
+            vehicle: "bo105".into(),
+            mode: "cah".into(),
+            rate_hz: 200,
+            seed: 1,
+            link: "in-process".into(),
+            plant: "nonlinear".into(),
+            runs: vec![
+                run("lat", 3.0, false, Some(0.1)),
+                run("lat", 5.0, false, Some(0.3)),
+                run("lon", 9.0, true, Some(0.9)),
+            ],
+        };
+        let mode = mode_summary(&fly, "fly-cah");
+        assert!((mode.cross_coherence_lat_lon.unwrap() - 0.2).abs() < 1e-12);
+        assert_eq!(mode.max_abs_deg.phi, 9.0);
+        assert_eq!(mode.max_abs_deg.theta, 4.5);
+        assert_eq!(mode.aborts, 1);
+        assert_eq!(mode.records, 3);
     }
 }

@@ -12,10 +12,10 @@ use sysid::fit::{Model, PairFit};
 use sysid::frf::analysis::CoherenceCurve;
 use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions, Record};
 
-use crate::campaign::files;
-use crate::campaign::summary::CampaignSummary;
-use crate::campaign::truth_model::TruthModelDocument;
-use crate::campaign::verification::VerifyDocument;
+use crate::artifacts::files;
+use crate::artifacts::summary::CampaignSummary;
+use crate::artifacts::truth_model::TruthModelDocument;
+use crate::artifacts::verification::VerifyDocument;
 
 /// Why the report cannot be made.
 #[derive(Debug)]

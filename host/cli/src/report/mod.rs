@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use crate::campaign::files;
+use crate::artifacts::files;
 pub use inputs::{ReportError, ReportInputs};
 
 /// Arguments of `sweephold report`.

@@ -17,8 +17,8 @@ use sysid::fit::Model;
 use super::html::{figure, note, section, table, Cell, Mark};
 use super::inputs::ReportInputs;
 use super::svg::{colors, min_max_decimate, BarChart, Figure, Panel, Scale, Series};
-use crate::campaign::stage::Stage;
-use crate::campaign::summary::{FitSummary, ModeSummary, ParameterSummary};
+use crate::artifacts::stage::Stage;
+use crate::artifacts::summary::{FitSummary, ModeSummary, ParameterSummary};
 
 /// Section ids of the plot sections, in page order (each holds at least one `<svg>`).
 pub const PLOT_SECTIONS: [&str; 4] = ["sweep-input", "cross-coherence", "bode", "verification"];
@@ -1111,7 +1111,7 @@ mod tests {
 
     /// A report's inputs holding only a summary with `fit`.
     fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
-        use crate::campaign::summary::{CampaignSummary, Modes};
+        use crate::artifacts::summary::{CampaignSummary, Modes};
         ReportInputs {
             dir: std::path::PathBuf::from("campaign"),
             summary: CampaignSummary {
@@ -1215,13 +1215,13 @@ mod tests {
             parameter("Xr", &["insensitive"]),
         ];
         fit.speed_derivatives = vec![
-            crate::campaign::summary::SpeedDerivativeSummary {
+            crate::artifacts::summary::SpeedDerivativeSummary {
                 name: "Mu".into(),
                 value: Some(0.11),
                 truth: Some(0.10),
                 error_percent: Some(10.0),
             },
-            crate::campaign::summary::SpeedDerivativeSummary {
+            crate::artifacts::summary::SpeedDerivativeSummary {
                 name: "Nv".into(),
                 value: Some(0.07),
                 truth: Some(0.05),
