@@ -12,6 +12,7 @@ pub mod fly;
 pub mod frf;
 pub mod interrupt;
 pub mod output;
+pub mod plot;
 pub mod report;
 pub mod sim;
 pub mod table;
