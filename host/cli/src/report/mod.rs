@@ -2,10 +2,10 @@
 //! (inline SVG, no script, nothing fetched) drawn only from the files in the folder, so
 //! that it can be regenerated at any time.
 
+pub mod curves;
 pub mod html;
 pub mod inputs;
 pub mod sections;
-pub mod svg;
 
 use std::path::{Path, PathBuf};
 
@@ -52,20 +52,20 @@ pub fn render(inputs: &ReportInputs) -> String {
         "sweephold campaign: {} seed {}",
         summary.vehicle, summary.seed
     );
-    let mut body = format!("<h1>{}</h1>\n", svg::escape(&title));
+    let mut body = format!("<h1>{}</h1>\n", html::escape(&title));
     body += &html::note(
         "Frequency-sweep system identification under conditional attitude hold (Jung, Shim & \
 Kim): the firmware flown in the loop with the nonlinear simulator, frequency responses, \
 6-DOF then 9-DOF hybrid state-space fit, verification on held-out doublets, and comparison \
 with the simulator's truth.",
     );
-    body += &sections::summary_section(inputs);
-    body += &sections::sweep_input_section(inputs);
-    body += &sections::coherence_section(inputs);
-    body += &sections::bode_section(inputs);
-    body += &sections::parameter_section(inputs);
-    body += &sections::modes_section(inputs);
-    body += &sections::cost_section(inputs);
-    body += &sections::verification_section(inputs);
+    body += &sections::summary::summary_section(inputs);
+    body += &sections::sweep::sweep_input_section(inputs);
+    body += &sections::coherence::coherence_section(inputs);
+    body += &sections::bode::bode_section(inputs);
+    body += &sections::parameters::parameter_section(inputs);
+    body += &sections::modes::modes_section(inputs);
+    body += &sections::costs::cost_section(inputs);
+    body += &sections::verification::verification_section(inputs);
     html::page(&title, &body)
 }
