@@ -226,7 +226,8 @@ fn parse_columns(list: &str, option: &str) -> anyhow::Result<Vec<(String, String
 }
 
 impl FrfArgs {
-    fn options(&self) -> FrfOptions {
+    /// The analysis options these arguments give.
+    pub fn options(&self) -> FrfOptions {
         FrfOptions {
             band: self.band.map(|b| b.0),
             points: self.points,

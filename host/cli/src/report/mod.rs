@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 
 use crate::artifacts::files;
+use crate::artifacts::flown::FlownRecords;
 pub use inputs::{ReportError, ReportInputs};
 
 /// Arguments of `sweephold report`.
@@ -33,10 +34,21 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Read the campaign folder `dir`, write `dir/report.html`, return its path.
+/// Read the campaign folder `dir` (decoding its dumps), write `dir/report.html`, return its
+/// path.
 pub fn write_report(dir: &Path) -> Result<PathBuf, ReportError> {
-    let inputs = ReportInputs::load(dir)?;
-    let html = render(&inputs);
+    write(&ReportInputs::load(dir)?)
+}
+
+/// Read the documents of the campaign folder `dir`, write `dir/report.html` with `flown`
+/// for what the report draws from the dumps, return its path.
+pub fn write_report_with(dir: &Path, flown: FlownRecords) -> Result<PathBuf, ReportError> {
+    write(&ReportInputs::read(dir, Some(flown))?)
+}
+
+fn write(inputs: &ReportInputs) -> Result<PathBuf, ReportError> {
+    let dir = &inputs.dir;
+    let html = render(inputs);
     let path = dir.join(files::REPORT);
     crate::output::write_atomic(&path, html.as_bytes()).map_err(|e| ReportError::Write {
         path: path.clone(),

@@ -50,7 +50,7 @@ pub fn coherence_section(inputs: &ReportInputs) -> String {
     );
     let mut series = Vec::new();
     let mut band: Option<[f64; 2]> = None;
-    for coherence in &inputs.coherence {
+    for coherence in &inputs.flown.coherence {
         let color = mode_colors
             .iter()
             .find(|(m, _)| *m == coherence.mode)

@@ -10,7 +10,7 @@ use crate::report::inputs::ReportInputs;
 
 /// The lateral `cah` sweep: the stick inputs and the attitudes (paper Fig. 1/6).
 pub fn sweep_input_section(inputs: &ReportInputs) -> String {
-    let Some(record) = &inputs.sweep else {
+    let Some(record) = &inputs.flown.sweep else {
         return section(
             "sweep-input",
             "Sweep input time history",

@@ -26,8 +26,7 @@ pub fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
         model: None,
         truth_model: None,
         verify: None,
-        sweep: None,
-        coherence: Vec::new(),
+        flown: Default::default(),
     }
 }
 
