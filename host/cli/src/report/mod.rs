@@ -1,6 +1,9 @@
 //! `sweephold report DIR`: `report.html` of a campaign folder — one self-contained page
 //! (inline SVG, no script, nothing fetched) drawn only from the files in the folder, so
-//! that it can be regenerated at any time.
+//! that it can be regenerated at any time. It reads the documents the campaign wrote
+//! ([`crate::artifacts`]) and computes nothing the campaign has: within a campaign, what
+//! it draws from the dumps is handed over as the campaign decoded it; on its own, it
+//! decodes the dumps.
 
 pub mod curves;
 pub mod html;

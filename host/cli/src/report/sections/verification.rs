@@ -1,9 +1,12 @@
 //! Verification on the held-out doublets: the TIC table, and measured vs predicted time
 //! histories per record.
 
+use std::collections::BTreeMap;
+
 use sysid::fit::verify::BiasMode;
 
-use crate::artifacts::summary::ANGULAR_RATES;
+use super::fmt;
+use crate::artifacts::summary::{mean_tic, ANGULAR_RATES};
 use crate::plot::{colors, Figure, Panel, Scale, Series};
 use crate::report::html::{figure, note, section, table, Cell};
 use crate::report::inputs::ReportInputs;
@@ -46,17 +49,12 @@ pub fn verification_section(inputs: &ReportInputs) -> String {
                     None => Cell::plain("-"),
                 });
             }
-            let rates: Vec<f64> = record
+            let tic: BTreeMap<String, f64> = record
                 .outputs
                 .iter()
-                .filter(|o| ANGULAR_RATES.contains(&o.name.as_str()))
-                .map(|o| o.tic)
+                .map(|o| (o.name.clone(), o.tic))
                 .collect();
-            row.push(Cell::plain(if rates.is_empty() {
-                "-".to_string()
-            } else {
-                format!("{:.3}", rates.iter().sum::<f64>() / rates.len() as f64)
-            }));
+            row.push(Cell::plain(fmt(mean_tic(&tic, Some(&ANGULAR_RATES)), 3)));
             row.push(Cell::plain(format!("{:.3}", record.tic_mean)));
             row
         })
