@@ -6,7 +6,9 @@
 //!
 //! [`campaign`] runs one function per stage, each as the verb it stands for would do it
 //! (`fly`, `frf`, `fit`, `verify`: their own arguments, parsed with their defaults), handing
-//! over in memory what the next stages need; each dump is decoded once, as it is flown.
+//! over in memory what the next stages need. Each sweep is decoded once, as it is flown,
+//! and its record passed on (the 9-DOF stage still reads the trim the flight controller
+//! captured from the events of the `cah` dumps).
 
 pub mod error;
 pub mod fits;
