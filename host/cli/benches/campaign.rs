@@ -9,7 +9,7 @@
 use std::collections::BTreeMap;
 
 use clap::Parser;
-use sweephold::campaign::stage::Stage;
+use sweephold::artifacts::stage::Stage;
 use sweephold::{Cli, Command};
 
 const TARGET_S: f64 = 30.0;
@@ -80,7 +80,7 @@ fn main() {
         total / TARGET_S
     );
     if let Some(summary) = last {
-        let coherence = |m: &Option<sweephold::campaign::summary::ModeSummary>| {
+        let coherence = |m: &Option<sweephold::artifacts::summary::ModeSummary>| {
             m.as_ref()
                 .and_then(|m| m.cross_coherence_lat_lon)
                 .map_or("-".to_string(), |c| format!("{c:.3}"))

@@ -21,6 +21,7 @@ use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
 };
+use sysid::fit::trim::TrimPoints;
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
 };
@@ -79,6 +80,21 @@ pub struct FitArgs {
     pub trim_points: Option<PathBuf>,
 }
 
+impl FitArgs {
+    /// The fit's options these arguments give, with the trim points of `--trim-points`
+    /// (read by the caller).
+    pub fn options(&self, trim_points: Option<TrimPoints>) -> FitOptions {
+        FitOptions {
+            points_per_pair: self.points,
+            max_starts: self.max_starts.max(1),
+            seed: self.seed,
+            reduce: self.reduce,
+            trim_points,
+            ..FitOptions::default()
+        }
+    }
+}
+
 /// `NAME=VALUE` of `--constant`.
 fn parse_constant(text: &str) -> Result<(String, f64), String> {
     let (name, value) = text
@@ -109,7 +125,7 @@ fn model_structure(
         return Ok(ModelStructure::from_path_with_constants(model, constants)?);
     }
     let name = model.to_string_lossy();
-    crate::campaign::structures::shipped(&name, constants).unwrap_or_else(|| {
+    crate::structures::shipped(&name, constants).unwrap_or_else(|| {
         bail!(
             "--model {}: no such file, and no shipped structure of that name ({})",
             model.display(),
@@ -140,7 +156,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             let text = fs::read_to_string(path)
                 .with_context(|| format!("cannot read {}", path.display()))?;
             Some(
-                sysid::fit::trim::TrimPoints::parse_csv(&text)
+                TrimPoints::parse_csv(&text)
                     .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
             )
         }
@@ -189,14 +205,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         structure,
     ));
 
-    let options = FitOptions {
-        points_per_pair: args.points,
-        max_starts: args.max_starts.max(1),
-        seed: args.seed,
-        reduce: args.reduce,
-        trim_points,
-        ..FitOptions::default()
-    };
+    let options = args.options(trim_points);
     // With --start-from, the file's own starts are the fallback: the lower J_ave wins.
     let (result, outcomes) = fit_from_alternative_starts(&starts, &data, &options)?;
     if outcomes.len() > 1 {

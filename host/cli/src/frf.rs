@@ -9,8 +9,8 @@ use crate::output::{
 use anyhow::bail;
 use clap::Args;
 use sysid::frf::{
-    analyse, group_by_primary, load_csv, load_dump, render_plots, CsvColumns, FrfAnalysis,
-    FrfOptions, Record, ResponseEstimator, ResponseInputs,
+    analyse, group_by_primary, load_csv, load_dump, CsvColumns, FrfAnalysis, FrfOptions, Record,
+    ResponseEstimator, ResponseInputs,
 };
 
 /// Arguments of `sweephold frf`.
@@ -226,7 +226,8 @@ fn parse_columns(list: &str, option: &str) -> anyhow::Result<Vec<(String, String
 }
 
 impl FrfArgs {
-    fn options(&self) -> FrfOptions {
+    /// The analysis options these arguments give.
+    pub fn options(&self) -> FrfOptions {
         FrfOptions {
             band: self.band.map(|b| b.0),
             points: self.points,
@@ -297,7 +298,7 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
 
     // Plots first: the document is the result, written last and whole.
     let plots = match &args.plots {
-        Some(dir) => write_files_into("--plots", dir, &render_plots(&analysis)?)?,
+        Some(dir) => write_files_into("--plots", dir, &crate::plot::frf::frf_plots(&analysis)?)?,
         None => 0,
     };
     write_json(&args.out, &analysis.document)?;

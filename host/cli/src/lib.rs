@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod arg_values;
+pub mod artifacts;
 pub mod campaign;
 pub mod decode;
 pub mod fit;
@@ -11,13 +12,12 @@ pub mod fly;
 pub mod frf;
 pub mod interrupt;
 pub mod output;
+pub mod plot;
 pub mod report;
 pub mod sim;
+pub mod structures;
 pub mod table;
 pub mod verify;
-
-/// The truth crate, also reachable as `crate::truth` (the campaign's truth stage names it so).
-pub use ::truth;
 
 /// Identify helicopter dynamics from automated frequency sweeps flown under conditional
 /// attitude hold (Jung, Shim & Kim).

@@ -10,9 +10,7 @@ use std::path::PathBuf;
 use crate::output::{check_input_file, check_output_folder, write_files_into};
 use anyhow::{anyhow, Context};
 use clap::Args;
-use sysid::fit::verify::{
-    render_verification_plots, verify_record_in_segments, BiasMode, Verification, VerifyError,
-};
+use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification, VerifyError};
 use sysid::fit::ModelDocument;
 use sysid::frf::load_test_dump;
 
@@ -147,8 +145,11 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
         write_verification(&mut report, &verification);
         all_theil.extend(verification.outputs.iter().map(|o| o.theil));
         if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {
-            let written =
-                write_files_into("--plots", dir, &render_verification_plots(&verification)?)?;
+            let written = write_files_into(
+                "--plots",
+                dir,
+                &crate::plot::verification::verification_plots(&verification)?,
+            )?;
             let _ = writeln!(report, "wrote {written} plots to {}", dir.display());
         }
     }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
-use sweephold::campaign::stage::Stage;
+use sweephold::artifacts::stage::Stage;
 
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use super::stage::Stage;
+use crate::artifacts::stage::Stage;
 
 /// A campaign stopped at `stage`. The output folder keeps the previous complete
 /// campaign; what this one wrote is kept in `DIR.failed`, whose `summary.json` records

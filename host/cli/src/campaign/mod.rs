@@ -3,83 +3,46 @@
 //! the 6-DOF then the 9-DOF hybrid model (with reduction), score it against the
 //! simulator's truth, verify it on held-out doublets, and write `summary.json` and
 //! `report.html`.
+//!
+//! [`campaign`] runs one function per stage, each as the verb it stands for would do it
+//! (`fly`, `frf`, `fit`, `verify`: their own arguments, parsed with their defaults), handing
+//! over in memory what the next stages need. Each sweep is decoded once, as it is flown,
+//! and its record passed on (the 9-DOF stage still reads the trim the flight controller
+//! captured from the events of the `cah` dumps).
 
 pub mod error;
-pub mod stage;
-pub mod structures;
-pub mod summary;
-pub mod truth_model;
+pub mod fits;
+pub mod flights;
+pub mod progress;
+pub mod responses;
+pub mod scoring;
 pub mod verification;
 
 use std::collections::BTreeMap;
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::anyhow;
 use clap::Args;
-use sweephold_protocol::Axis;
-use sysid::document::FrfDocument;
-use sysid::fit::modes::{hover_summary, mode_records, poles_at_origin, HOVER_MODE_LIMIT_RAD_S};
-use sysid::fit::report::ScoredModelDocument;
-use sysid::fit::trim::TrimPoints;
-use sysid::fit::verify::BiasMode;
-use sysid::fit::{
-    fit, fit_from_alternative_starts, start_from_quasi_steady, FitOptions, FitResult,
-};
-use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions};
+use sysid::fit::modes::{hover_summary, HOVER_MODE_LIMIT_RAD_S};
+use sysid::frf::analysis::CoherenceCurve;
+use sysid::frf::Record;
 
-use crate::fly::link::InProcessLink;
+use crate::artifacts::files;
+use crate::artifacts::flown::{lateral_coherence, FlownRecords, ModeCoherence};
+use crate::artifacts::stage::Stage;
+use crate::artifacts::summary::{CampaignSummary, Modes, StageFailure};
 use crate::fly::plan::PAPER_T_REC_S;
-use crate::fly::{self, AmplitudeArg, FcArg, FlyArgs, FlyOutcome, InputArg, ModeArg, VehicleArg};
-use crate::output::{write_atomic, write_json, StagedFolder};
+use crate::fly::{AmplitudeArg, ModeArg, VehicleArg};
+use crate::output::{write_json, StagedFolder};
 use error::CampaignError;
-use stage::{Stage, StageProgress};
-use structures::CapturedTrim;
-use summary::{
-    CampaignSummary, FitSummary, ModeSummary, Modes, PairSummary, ParameterSummary,
-    SpeedDerivativeSummary, StageFailure,
-};
-use truth_model::TruthModelDocument;
-use verification::{verify_dump, VerifyDocument};
+use flights::FlownMode;
+use progress::StageProgress;
 
 /// Sweep record length of `--quick` [s]: long enough for the frequency responses above
 /// ~0.6 rad/s, short enough for a test.
 pub const QUICK_T_REC_S: f64 = 20.0;
-
-/// The held-out doublets are simulated open loop over their whole record (a few seconds:
-/// the hover instabilities do not run away in that time), as VERIFID does.
-pub const VERIFY_SEGMENT_S: Option<f64> = None;
-
-/// Each output's bias is its mean over the trim capture before the doublet (and each
-/// input's trim likewise), not fitted to the prediction.
-pub const VERIFY_BIAS: BiasMode = BiasMode::Trim;
-
-/// Files of the campaign folder.
-pub mod files {
-    /// The campaign's summary.
-    pub const SUMMARY: &str = "summary.json";
-    /// The report.
-    pub const REPORT: &str = "report.html";
-    /// Frequency responses of the `cah` records.
-    pub const FRF: &str = "frf.json";
-    /// The trim points the fits derive `trim_derived` parameters from.
-    pub const TRIM_POINTS: &str = "trim-points.csv";
-    /// The 6-DOF fit.
-    pub const MODEL_6DOF: &str = "model6.json";
-    /// The 9-DOF hybrid fit (with its truth section).
-    pub const MODEL_9DOF: &str = "model9.json";
-    /// The 9-DOF structure at the truth values.
-    pub const TRUTH_MODEL_9DOF: &str = "truth-model9.json";
-    /// Verification time histories and scores.
-    pub const VERIFY: &str = "verify.json";
-    /// Folder of the held-out doublets.
-    pub const VERIFICATION_FOLDER: &str = "verify-doublet";
-
-    /// Folder of the sweeps flown in `mode` (`cah`, `standard`, `noise`).
-    pub fn fly_folder(mode: &str) -> String {
-        format!("fly-{mode}")
-    }
-}
 
 /// Arguments of `sweephold campaign`.
 #[derive(Args, Debug, Clone)]
@@ -204,6 +167,17 @@ fn headline(summary: &CampaignSummary) -> String {
     text
 }
 
+/// `campaign --trim-points`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TrimPointsArg {
+    /// On for the Bo-105, off for the TREX 700L.
+    Default,
+    /// Derive from trim points.
+    On,
+    /// Fit like the other parameters.
+    Off,
+}
+
 /// Everything a campaign holds between stages.
 struct Campaign<'a> {
     args: &'a CampaignArgs,
@@ -214,6 +188,7 @@ struct Campaign<'a> {
 }
 
 impl Campaign<'_> {
+    /// Where the stages write: `DIR.partial` until the campaign completes.
     fn dir(&self) -> &Path {
         self.staged
             .as_ref()
@@ -264,143 +239,13 @@ impl Campaign<'_> {
         Ok(((), self.dir().display().to_string()))
     }
 
+    /// Write `summary.json` as it stands, with the total time so far.
     fn write_summary(&mut self) -> anyhow::Result<()> {
         self.summary
             .timings_s
             .insert("total".to_string(), self.started.elapsed().as_secs_f64());
         write_json(&self.dir().join(files::SUMMARY), &self.summary)
     }
-
-    fn fly_args(&self, mode: ModeArg, input: InputArg, seed: u64, folder: &str) -> FlyArgs {
-        FlyArgs {
-            vehicle: self.args.vehicle,
-            mode,
-            axes: Axis::ALL.to_vec(),
-            input,
-            amplitude: if input == InputArg::Sweep {
-                self.args.amplitude
-            } else {
-                AmplitudeArg::Fixed
-            },
-            seed,
-            t_rec_s: self.args.t_rec_s(),
-            rate_hz: 200,
-            out: self.dir().join(folder),
-            gust: 0.0,
-            sensor_dropout: 0.0,
-            sensor_spike: 0.0,
-            pilot_override_at_s: None,
-            pilot_noise: 0.0,
-            perfect_sensors: false,
-            linearized_plant: false,
-            quiet: true,
-            fc: FcArg::InProcess,
-            elf: None,
-            vibration: None,
-            rc_loss_at_s: None,
-            imu_fault: None,
-            fly_on_s: None,
-        }
-    }
-}
-
-fn fly_in_process(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
-    fly::fly(args, &|| Box::new(InProcessLink::new()))
-}
-
-/// The `fit` section of the summary from the final fit (truth filled in later).
-fn fit_summary(result: &FitResult, start_cost_ave: f64) -> FitSummary {
-    let identified_modes = mode_records(&result.model);
-    FitSummary {
-        structure: result.structure.name.clone(),
-        cost_ave: result.average_cost,
-        truth_cost_ave: None,
-        start_cost_ave,
-        pairs: result
-            .pairs
-            .iter()
-            .map(|p| PairSummary {
-                output: p.output.clone(),
-                input: p.input.clone(),
-                cost: p.cost,
-                range: p.range,
-                truth_cost: None,
-            })
-            .collect(),
-        params: result
-            .to_document()
-            .parameters
-            .iter()
-            .map(|p| ParameterSummary {
-                name: p.name.clone(),
-                value: p.value,
-                status: serde_json::to_value(p.status)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default(),
-                cr_percent: p.cramer_rao_percent,
-                insensitivity_percent: p.insensitivity_percent,
-                truth: None,
-                error_percent: None,
-                flags: p.flags.iter().map(flag_name).collect(),
-            })
-            .collect(),
-        model_file: files::MODEL_9DOF.to_string(),
-        // Without the truth yet; the truth stage pairs them. An error (a model without
-        // eigenvalues) leaves them empty here and is reported by the truth stage.
-        modes: identified_modes.clone().unwrap_or_default(),
-        truth_modes: Vec::new(),
-        hover_modes_matched: None,
-        poles_at_origin: identified_modes.as_deref().ok().map(poles_at_origin),
-        speed_derivatives: speed_derivatives(&result.model, None),
-        trim: result.trim.clone(),
-    }
-}
-
-/// The quasi-static M_u, L_v, N_v of `model`, beside `truth`'s when given.
-pub fn speed_derivatives(
-    model: &sysid::fit::Model,
-    truth: Option<&sysid::fit::Model>,
-) -> Vec<SpeedDerivativeSummary> {
-    use sysid::fit::trim::{quasi_static_derivative, SPEED_DERIVATIVES};
-    SPEED_DERIVATIVES
-        .iter()
-        .map(|&(name, row, column)| {
-            let value = quasi_static_derivative(model, row, column);
-            let truth = truth.and_then(|t| quasi_static_derivative(t, row, column));
-            let error_percent = match (value, truth) {
-                (Some(v), Some(t)) if t != 0.0 => Some(100.0 * (v - t) / t.abs()),
-                _ => None,
-            };
-            SpeedDerivativeSummary {
-                name: name.to_string(),
-                value,
-                truth,
-                error_percent,
-            }
-        })
-        .collect()
-}
-
-/// `cr`, `insensitive` or `correlated:OTHER`.
-pub fn flag_name(flag: &sysid::fit::AccuracyFlag) -> String {
-    match flag {
-        sysid::fit::AccuracyFlag::CramerRao => "cr".to_string(),
-        sysid::fit::AccuracyFlag::Insensitive => "insensitive".to_string(),
-        sysid::fit::AccuracyFlag::Correlated { with, .. } => format!("correlated:{with}"),
-        sysid::fit::AccuracyFlag::Needed { .. } => "needed".to_string(),
-    }
-}
-
-/// `campaign --trim-points`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum TrimPointsArg {
-    /// On for the Bo-105, off for the TREX 700L.
-    Default,
-    /// Derive from trim points.
-    On,
-    /// Fit like the other parameters.
-    Off,
 }
 
 impl<'a> Campaign<'a> {
@@ -425,275 +270,92 @@ impl<'a> Campaign<'a> {
     }
 }
 
+/// The arguments of the verb `verb` from the command line `argv` (without the verb): its
+/// own parser, so its own defaults and checks.
+pub fn verb_args<T: clap::Args + clap::FromArgMatches>(
+    verb: &'static str,
+    argv: impl IntoIterator<Item = OsString>,
+) -> anyhow::Result<T> {
+    let matches = T::augment_args(clap::Command::new(verb).no_binary_name(true))
+        .try_get_matches_from(argv)
+        .map_err(|e| anyhow!("`{verb}` arguments: {}", e.render().to_string().trim()))?;
+    Ok(T::from_arg_matches(&matches)?)
+}
+
 /// Run the whole campaign of `args` (see the module documentation).
 pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
     let mut run = Campaign::new(args);
     run.stage(Stage::Setup, Campaign::set_up)?;
+    let mut cah = run.stage(Stage::FlyCah, |run| run.fly_sweeps(ModeArg::Cah))?;
+    // Of the other modes, the report draws the lateral sweeps alone.
+    let standard = run
+        .stage(Stage::FlyStandard, |run| run.fly_sweeps(ModeArg::Standard))?
+        .lateral_only();
+    let noise = run
+        .stage(Stage::FlyNoise, |run| run.fly_sweeps(ModeArg::Noise))?
+        .lateral_only();
+    let doublets = run.stage(Stage::FlyVerification, Campaign::fly_doublets)?;
+    // The report's sweep time history, before the frequency responses take the records.
+    let sweep = cah.lateral().next().cloned();
+    let frf = run.stage(Stage::Frf, |run| {
+        run.frequency_responses(cah.take_records())
+    })?;
+    let trim_points = run.trim_points()?;
+    let six = run.stage(Stage::Fit6Dof, |run| run.fit_6dof(&frf.document))?;
+    let nine = run.stage(Stage::Fit9Dof, |run| {
+        run.fit_9dof(&cah.dumps, &frf.document, &six, &trim_points)
+    })?;
+    run.stage(Stage::Truth, |run| run.score(&nine))?;
+    run.stage(Stage::Verify, |run| run.verify(&nine.model, &doublets))?;
+    run.report(sweep, frf.lateral_coherence, [standard, noise])
+}
 
-    let mut cah_dumps = Vec::new();
-    for (stage, mode) in [
-        (Stage::FlyCah, ModeArg::Cah),
-        (Stage::FlyStandard, ModeArg::Standard),
-        (Stage::FlyNoise, ModeArg::Noise),
-    ] {
-        let dumps = run.stage(stage, |run| {
-            let folder = files::fly_folder(mode.name());
-            let fly_args = run.fly_args(mode, InputArg::Sweep, run.args.seed, &folder);
-            let outcome = fly_in_process(&fly_args)?;
-            let summary = ModeSummary::from_fly(&outcome.summary, &folder);
-            let line = format!(
-                "{} records, {} abort(s), lat–lon coherence {}",
-                summary.records,
-                summary.aborts,
-                summary
-                    .cross_coherence_lat_lon
-                    .map_or("-".to_string(), |c| format!("{c:.3}"))
-            );
-            let slot = match mode {
-                ModeArg::Cah => &mut run.summary.modes.cah,
-                ModeArg::Standard => &mut run.summary.modes.standard,
-                ModeArg::Noise => &mut run.summary.modes.noise,
-            };
-            *slot = Some(summary);
-            Ok((outcome, line))
+impl Campaign<'_> {
+    /// The report stage: the report from the folder's documents and the records flown —
+    /// the first lateral `cah` sweep, the `cah` coherence curves of the frequency-response
+    /// stage, those of the `others` modes' lateral sweeps computed here — then the folder
+    /// completed.
+    fn report(
+        mut self,
+        sweep: Option<Record>,
+        cah_coherence: Vec<CoherenceCurve>,
+        others: [FlownMode; 2],
+    ) -> Result<CampaignOutcome, CampaignError> {
+        self.write_summary()
+            .map_err(|e| CampaignError::new(Stage::Report, &e))?;
+        self.stage(Stage::Report, |run| {
+            let mut coherence = Vec::new();
+            // Without a lateral cah sweep there is no lateral group, nor curves.
+            if sweep.is_some() {
+                coherence.push(ModeCoherence {
+                    mode: ModeArg::Cah.name().to_string(),
+                    curves: cah_coherence,
+                });
+            }
+            for flown in others.into_iter().filter(|f| !f.records.is_empty()) {
+                coherence.push(ModeCoherence {
+                    mode: flown.mode.name().to_string(),
+                    curves: lateral_coherence(flown.records)?,
+                });
+            }
+            crate::report::write_report_with(run.dir(), FlownRecords { sweep, coherence })?;
+            run.write_summary()?;
+            let staged = run
+                .staged
+                .take()
+                .ok_or_else(|| anyhow!("the campaign folder was not set up"))?;
+            staged.complete()?;
+            let line = run.args.out.join(files::REPORT).display().to_string();
+            Ok(((), line))
         })?;
-        if mode == ModeArg::Cah {
-            cah_dumps = dumps
-                .summary
-                .runs
-                .iter()
-                .zip(&dumps.dumps)
-                .filter(|(run, _)| !run.aborted)
-                .map(|(_, path)| path.clone())
-                .collect();
-        }
+        // Again in the completed folder, with the report stage's time and the total.
+        self.write_summary()
+            .map_err(|e| CampaignError::new(Stage::Report, &e))?;
+        Ok(CampaignOutcome {
+            summary: self.summary,
+            report: self.args.out.join(files::REPORT),
+        })
     }
-
-    let doublets: Vec<String> = run.stage(Stage::FlyVerification, |run| {
-        let fly_args = run.fly_args(
-            ModeArg::Cah,
-            InputArg::Doublet,
-            run.args.verification_seed(),
-            files::VERIFICATION_FOLDER,
-        );
-        let outcome = fly_in_process(&fly_args)?;
-        let files: Vec<String> = outcome
-            .summary
-            .runs
-            .iter()
-            .filter(|r| !r.aborted)
-            .map(|r| format!("{}/{}", files::VERIFICATION_FOLDER, r.file))
-            .collect();
-        let line = format!(
-            "{} doublets, seed {}",
-            files.len(),
-            run.args.verification_seed()
-        );
-        Ok((files, line))
-    })?;
-
-    let frf: FrfDocument = run.stage(Stage::Frf, |run| {
-        if cah_dumps.is_empty() {
-            return Err(anyhow!("every cah record aborted: nothing to identify"));
-        }
-        let records = cah_dumps
-            .iter()
-            .map(load_dump)
-            .collect::<Result<Vec<_>, _>>()?;
-        let analysis = analyse(&group_by_primary(records)?, &FrfOptions::default())?;
-        write_json(&run.dir().join(files::FRF), &analysis.document)?;
-        let valid = analysis
-            .document
-            .pairs
-            .iter()
-            .filter(|p| p.valid_range.is_some())
-            .count();
-        let line = format!(
-            "{} pairs, {} with a coherent range",
-            analysis.document.pairs.len(),
-            valid
-        );
-        Ok((analysis.document, line))
-    })?;
-
-    let use_trim_points = match args.trim_points {
-        TrimPointsArg::On => true,
-        TrimPointsArg::Off => false,
-        TrimPointsArg::Default => args.vehicle == VehicleArg::Bo105,
-    };
-    let trim_points: Option<TrimPoints> = if !use_trim_points {
-        None
-    } else {
-        Some(run.stage(Stage::TrimPoints, |run| {
-            let points = crate::sim::simulator_trim_points(run.args.vehicle.sim())?;
-            write_atomic(
-                &run.dir().join(files::TRIM_POINTS),
-                points.to_csv().as_bytes(),
-            )?;
-            let line = format!("{} steady flights", points.points.len());
-            Ok((points, line))
-        })?)
-    };
-    let fit_options = |reduce: bool| FitOptions {
-        seed: args.seed,
-        reduce,
-        trim_points: trim_points.clone(),
-        ..FitOptions::default()
-    };
-    let six: FitResult = run.stage(Stage::Fit6Dof, |run| {
-        let structure = structures::six_dof()?;
-        // The 6-DOF fit only supplies start values (paper Eq. 26–27): it is not reduced.
-        // Reducing it cost 3.9 s instead of 1.3 s on the default campaign for the same
-        // 9-DOF J_ave (113.1 vs 113.3).
-        // Nor does it take the trim points: its derivatives only start the hybrid, and on
-        // most seeds it lands in a degenerate minimum (X_ped, Z_ped of 10⁶–10⁸ with long
-        // delays) whose steady balance gives no usable Z_w.
-        let options = FitOptions {
-            trim_points: None,
-            ..fit_options(false)
-        };
-        let result = fit(&structure, &frf, &options)?;
-        write_json(&run.dir().join(files::MODEL_6DOF), &result.to_document())?;
-        let line = format!(
-            "{}: J_ave {:.1}, {} pairs",
-            result.structure.name,
-            result.average_cost,
-            result.pairs.len()
-        );
-        Ok((result, line))
-    })?;
-
-    let nine: FitResult = run.stage(Stage::Fit9Dof, |run| {
-        // As `sweephold fit --start-from`: the 6-DOF's Eq. 26–27 starts and the file's
-        // own, the lower J_ave kept and then reduced.
-        // Kinematics and gravity about the trim the flight controller captured.
-        let trim = structures::TrimAttitude::captured(&cah_dumps)?;
-        let hybrid = structures::nine_dof_hybrid(run.args.vehicle.sim(), trim)?;
-        let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
-        let starts = [
-            (files::MODEL_6DOF.to_string(), started),
-            ("bo105-9dof-hybrid.toml".to_string(), hybrid),
-        ];
-        let (result, _outcomes) = fit_from_alternative_starts(&starts, &frf, &fit_options(true))?;
-        write_json(&run.dir().join(files::MODEL_9DOF), &result.to_document())?;
-        run.summary.fit = Some(fit_summary(&result, six.average_cost));
-        let line = format!(
-            "{}: J_ave {:.1}, {} reduction step(s)",
-            result.structure.name,
-            result.average_cost,
-            result.reduction.len()
-        );
-        Ok((result, line))
-    })?;
-
-    run.stage(Stage::Truth, |run| {
-        let vehicle = run.args.vehicle.sim();
-        let truth = crate::truth::VehicleTruth::at_hover(vehicle)?;
-        let scored = crate::truth::score_fit_with_modes(&nine, &truth)?;
-        let (section, mapped) = (scored.section, scored.mapped);
-        write_json(
-            &run.dir().join(files::TRUTH_MODEL_9DOF),
-            &TruthModelDocument::new(vehicle.name(), &nine.structure.name, &mapped.model),
-        )?;
-        let modes_line = match &scored.modes {
-            Ok(compared) => hover_summary(&compared.hover, compared.poles_at_origin),
-            // Reported, not fatal: the model and its scoring are still worth the report.
-            Err(error) => format!("modes not computed: {error}"),
-        };
-        let line = format!(
-            "J_ave against the truth {:.1}; {modes_line}",
-            section.average_cost
-        );
-        if let Some(fit) = run.summary.fit.as_mut() {
-            match &scored.modes {
-                Ok(compared) => {
-                    fit.modes = compared.identified.clone();
-                    fit.truth_modes = compared.truth.clone();
-                    fit.hover_modes_matched = Some(compared.hover);
-                    fit.poles_at_origin = Some(compared.poles_at_origin);
-                }
-                Err(_) => {
-                    fit.modes.clear();
-                    fit.truth_modes.clear();
-                    fit.hover_modes_matched = None;
-                    fit.poles_at_origin = None;
-                }
-            }
-            fit.truth_cost_ave = Some(section.average_cost);
-            fit.speed_derivatives = speed_derivatives(&nine.model, Some(&mapped.model));
-            for pair in &mut fit.pairs {
-                pair.truth_cost = section
-                    .pairs
-                    .iter()
-                    .find(|t| t.input == pair.input && t.output == pair.output)
-                    .map(|t| t.cost);
-            }
-            for param in &mut fit.params {
-                if let Some(t) = section.parameters.iter().find(|t| t.name == param.name) {
-                    param.truth = t.truth;
-                    param.error_percent = t.error_percent;
-                }
-            }
-        }
-        let document = ScoredModelDocument {
-            model: nine.to_document(),
-            truth: Some(section),
-            modes: scored
-                .modes
-                .map(|compared| compared.identified)
-                .unwrap_or_default(),
-        };
-        write_json(&run.dir().join(files::MODEL_9DOF), &document)?;
-        Ok(((), line))
-    })?;
-
-    run.stage(Stage::Verify, |run| {
-        let records = doublets
-            .iter()
-            .map(|file| verify_dump(&nine.model, run.dir(), file, VERIFY_SEGMENT_S, VERIFY_BIAS))
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let document = VerifyDocument {
-            model_file: files::MODEL_9DOF.to_string(),
-            segment_s: VERIFY_SEGMENT_S,
-            bias: VERIFY_BIAS,
-            records,
-        };
-        write_json(&run.dir().join(files::VERIFY), &document)?;
-        let summary = document.summary();
-        let line = format!(
-            "{} records, mean TIC p q r {}, all {} outputs {:.3} ({} bias)",
-            document.records.len(),
-            summary
-                .mean_pqr()
-                .map_or("-".to_string(), |m| format!("{m:.3}")),
-            summary.tic.len(),
-            summary.mean_all(),
-            summary.bias
-        );
-        run.summary.verify = Some(summary);
-        Ok(((), line))
-    })?;
-
-    run.write_summary()
-        .map_err(|e| CampaignError::new(Stage::Report, &e))?;
-    run.stage(Stage::Report, |run| {
-        crate::report::write_report(run.dir())?;
-        run.write_summary()?;
-        let staged = run
-            .staged
-            .take()
-            .ok_or_else(|| anyhow!("the campaign folder was not set up"))?;
-        staged.complete()?;
-        let line = run.args.out.join(files::REPORT).display().to_string();
-        Ok(((), line))
-    })?;
-    // Again in the completed folder, with the report stage's time and the total.
-    run.write_summary()
-        .map_err(|e| CampaignError::new(Stage::Report, &e))?;
-    Ok(CampaignOutcome {
-        summary: run.summary,
-        report: args.out.join(files::REPORT),
-    })
 }
 
 #[cfg(test)]
@@ -752,5 +414,35 @@ mod tests {
         assert_eq!(summary["seed"], 7);
         assert!(!dir.join("campaign.partial").exists());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The stages run the verbs on their defaults: these are what the campaign's files
+    /// were made with (a default that changes changes the campaign's output).
+    #[test]
+    fn the_verbs_defaults_are_the_campaigns_settings() {
+        let frf: crate::frf::FrfArgs = verb_args("frf", ["lat-1.bin".into()]).unwrap();
+        assert_eq!(frf.options(), sysid::frf::FrfOptions::default());
+        let fit: crate::fit::FitArgs = verb_args(
+            "fit",
+            ["--frf", "frf.json", "--model", "bo105-6dof", "--seed", "7"].map(OsString::from),
+        )
+        .unwrap();
+        let expected = sysid::fit::FitOptions {
+            seed: 7,
+            ..sysid::fit::FitOptions::default()
+        };
+        assert_eq!(fit.options(None), expected);
+        let verify: crate::verify::VerifyArgs = verb_args(
+            "verify",
+            ["--model", "model9.json", "lat-1.bin"].map(OsString::from),
+        )
+        .unwrap();
+        assert_eq!(verify.segment, None);
+        assert_eq!(verify.bias.mode(), sysid::fit::verify::BiasMode::Trim);
+        let error = verb_args::<crate::frf::FrfArgs>("frf", Vec::new()).unwrap_err();
+        assert!(
+            error.to_string().starts_with("`frf` arguments: "),
+            "{error}"
+        );
     }
 }

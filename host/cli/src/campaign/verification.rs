@@ -1,109 +1,67 @@
-//! The verification stage: the identified model simulated on held-out doublet records
-//! (CIFER's VERIFID; method in `sysid::fit::verify`), and `verify.json`, which keeps the
-//! measured and predicted time histories for the report.
+//! The verification stage: the identified model simulated on the held-out doublet records
+//! as `sweephold verify` simulates it (its arguments; CIFER's VERIFID, method in
+//! `sysid::fit::verify`), each record kept decimated in `verify.json`, and the summary's
+//! `verify` section.
 
-use std::collections::BTreeMap;
+use std::ffi::OsString;
 use std::path::Path;
 
 use anyhow::anyhow;
-use serde::{Deserialize, Serialize};
 use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification};
 use sysid::fit::Model;
 use sysid::frf::load_test_dump;
 
-use super::summary::{
-    bias_of_older_files, mean_tic, VerifyRecordSummary, VerifySummary, ANGULAR_RATES,
-};
+use super::{verb_args, Campaign};
+use crate::artifacts::files;
+use crate::artifacts::verification::{VerifiedOutput, VerifiedRecord, VerifyDocument};
+use crate::output::write_json;
+use crate::verify::VerifyArgs;
 
 /// Every `DECIMATION`-th sample is kept in `verify.json` (200 Hz → 50 Hz): the doublets'
 /// content is below 10 rad/s, and the file stays small.
 pub const DECIMATION: usize = 4;
 
-/// One output of one record: scores and the decimated time histories.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VerifiedOutput {
-    /// Output name.
-    pub name: String,
-    /// Theil's inequality coefficient.
-    pub tic: f64,
-    /// Bias b (trim value plus sensor bias) removed from `measured`: the output's mean over
-    /// the trim samples before the doublet, or the least-squares mean(y − ŷ), as the
-    /// document's `bias` says.
-    pub bias: f64,
-    /// Measured perturbation y − b, decimated.
-    pub measured: Vec<f64>,
-    /// Predicted ŷ, decimated.
-    pub predicted: Vec<f64>,
-}
-
-/// One held-out record.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VerifiedRecord {
-    /// Dump file, relative to the campaign folder.
-    pub file: String,
-    /// Time step of the stored series [s].
-    pub step_s: f64,
-    /// Mean TIC over the outputs.
-    pub tic_mean: f64,
-    /// When the simulated model overflowed [s]; null otherwise.
-    pub diverged_at_s: Option<f64>,
-    /// The compared outputs, model order.
-    pub outputs: Vec<VerifiedOutput>,
-}
-
-/// `verify.json`: the verification of the campaign's final model.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VerifyDocument {
-    /// Model file verified, relative to the campaign folder.
-    pub model_file: String,
-    /// Simulation restarted from the measured state every this many seconds (null: open
-    /// loop over the whole record).
-    pub segment_s: Option<f64>,
-    /// Where the output biases came from: `trim` or `fitted` (files written before it:
-    /// `fitted`).
-    #[serde(default = "bias_of_older_files")]
-    pub bias: BiasMode,
-    /// One entry per held-out record.
-    pub records: Vec<VerifiedRecord>,
-}
-
-impl VerifyDocument {
-    /// The `verify` section of `summary.json`: TIC per output averaged over the records.
-    pub fn summary(&self) -> VerifySummary {
-        let mut sums: BTreeMap<String, (f64, usize)> = BTreeMap::new();
-        for record in &self.records {
-            for output in &record.outputs {
-                let entry = sums.entry(output.name.clone()).or_insert((0.0, 0));
-                entry.0 += output.tic;
-                entry.1 += 1;
-            }
-        }
-        let tic: BTreeMap<String, f64> = sums
-            .into_iter()
-            .map(|(name, (sum, n))| (name, sum / n as f64))
-            .collect();
-        let tic_mean_all = mean_tic(&tic, None);
-        VerifySummary {
-            bias: self.bias,
-            tic_mean_pqr: mean_tic(&tic, Some(&ANGULAR_RATES)),
-            tic_mean_all,
-            tic_mean: tic_mean_all.unwrap_or(1.0),
-            tic,
-            records: self
-                .records
-                .iter()
-                .map(|record| VerifyRecordSummary {
-                    file: record.file.clone(),
-                    tic: record
-                        .outputs
-                        .iter()
-                        .map(|o| (o.name.clone(), o.tic))
-                        .collect(),
-                    tic_mean: record.tic_mean,
-                    diverged_at_s: record.diverged_at_s,
-                })
-                .collect(),
-        }
+impl Campaign<'_> {
+    /// The verify stage: `model` (the final fit) on the `doublets` (files relative to the
+    /// campaign folder).
+    pub(super) fn verify(
+        &mut self,
+        model: &Model,
+        doublets: &[String],
+    ) -> anyhow::Result<((), String)> {
+        let mut argv: Vec<OsString> =
+            vec!["--model".into(), self.dir().join(files::MODEL_9DOF).into()];
+        argv.extend(doublets.iter().map(|file| self.dir().join(file).into()));
+        // The verb's defaults: each doublet simulated open loop over its whole record (a
+        // few seconds: the hover instabilities do not run away in that time), as VERIFID
+        // does; each output's bias its mean over the trim capture before the doublet (and
+        // each input's trim likewise), not fitted to the prediction.
+        let args: VerifyArgs = verb_args("verify", argv)?;
+        let (segment_s, bias) = (args.segment, args.bias.mode());
+        let records = doublets
+            .iter()
+            .map(|file| verify_dump(model, self.dir(), file, segment_s, bias))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let document = VerifyDocument {
+            model_file: files::MODEL_9DOF.to_string(),
+            segment_s,
+            bias,
+            records,
+        };
+        write_json(&self.dir().join(files::VERIFY), &document)?;
+        let summary = document.summary();
+        let line = format!(
+            "{} records, mean TIC p q r {}, all {} outputs {:.3} ({} bias)",
+            document.records.len(),
+            summary
+                .mean_pqr()
+                .map_or("-".to_string(), |m| format!("{m:.3}")),
+            summary.tic.len(),
+            summary.mean_all(),
+            summary.bias
+        );
+        self.summary.verify = Some(summary);
+        Ok(((), line))
     }
 }
 
@@ -163,78 +121,5 @@ fn verified_record(file: &str, verification: &Verification) -> VerifiedRecord {
                     .map_or_else(Vec::new, |s| decimate(s)),
             })
             .collect(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn output(name: &str, tic: f64) -> VerifiedOutput {
-        VerifiedOutput {
-            name: name.into(),
-            tic,
-            bias: 0.0,
-            measured: vec![],
-            predicted: vec![],
-        }
-    }
-
-    #[test]
-    fn summary_averages_each_output_over_the_records() {
-        let document = VerifyDocument {
-            model_file: "model9.json".into(),
-            segment_s: None,
-            bias: BiasMode::Trim,
-            records: vec![
-                VerifiedRecord {
-                    file: "a.bin".into(),
-                    step_s: 0.02,
-                    tic_mean: 0.2,
-                    diverged_at_s: None,
-                    outputs: vec![output("p", 0.1), output("q", 0.3)],
-                },
-                VerifiedRecord {
-                    file: "b.bin".into(),
-                    step_s: 0.02,
-                    tic_mean: 0.5,
-                    diverged_at_s: None,
-                    outputs: vec![output("p", 0.3), output("w", 0.7)],
-                },
-            ],
-        };
-        let summary = document.summary();
-        assert!((summary.tic["p"] - 0.2).abs() < 1e-12);
-        assert!((summary.tic["q"] - 0.3).abs() < 1e-12);
-        assert!((summary.tic["w"] - 0.7).abs() < 1e-12);
-        assert!((summary.tic_mean - 0.4).abs() < 1e-12);
-        assert_eq!(summary.tic_mean_all, Some(summary.tic_mean));
-        assert!((summary.tic_mean_pqr.unwrap() - 0.25).abs() < 1e-12);
-        assert_eq!(summary.bias, BiasMode::Trim);
-        assert_eq!(summary.records.len(), 2);
-        let json = serde_json::to_value(&summary).unwrap();
-        assert_eq!(json["bias"], "trim");
-        assert_eq!(serde_json::to_value(&document).unwrap()["bias"], "trim");
-        assert!(
-            summary
-                .headline()
-                .ends_with("; mean p q r 0.250, all 3 outputs 0.400 (trim bias)"),
-            "{}",
-            summary.headline()
-        );
-    }
-
-    #[test]
-    fn files_written_before_the_bias_was_recorded_read_as_fitted() {
-        let old_document = r#"{"model_file": "model9.json", "segment_s": null, "records": []}"#;
-        let document: VerifyDocument = serde_json::from_str(old_document).unwrap();
-        assert_eq!(document.bias, BiasMode::Fitted);
-        let old_summary = r#"{"tic": {"p": 0.1, "q": 0.2, "r": 0.3, "w": 0.8},
-            "tic_mean": 0.35, "records": []}"#;
-        let summary: VerifySummary = serde_json::from_str(old_summary).unwrap();
-        assert_eq!(summary.bias, BiasMode::Fitted);
-        assert_eq!(summary.tic_mean_pqr, None);
-        assert!((summary.mean_pqr().unwrap() - 0.2).abs() < 1e-12);
-        assert_eq!(summary.mean_all(), 0.35);
     }
 }

@@ -20,6 +20,7 @@ use clap::{Args, ValueEnum};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sweephold_firmware::Config;
 use sweephold_protocol::{Axis, ExcitationMode, InputKind};
+use sysid::frf::Record;
 
 use crate::arg_values;
 use crate::output::{write_atomic, write_json, StagedFolder};
@@ -462,6 +463,10 @@ pub struct FlyOutcome {
     pub summary: FlySummary,
     /// Dump paths, in flying order.
     pub dumps: Vec<PathBuf>,
+    /// The sweep record of each dump as decoded for its cross-control coherence, in
+    /// flying order (`None` for an aborted record or another input than a sweep), so that
+    /// a caller needs not decode the dumps again. Its `source` is the dump's file name.
+    pub records: Vec<Option<Record>>,
 }
 
 /// Run `sweephold fly`: the records are flown into `OUT.partial`, which replaces OUT
@@ -664,7 +669,7 @@ pub fn fly_with_workers(
         .progress_chars("=> ");
 
     let next = Mutex::new(0usize);
-    let results: Mutex<Vec<Option<anyhow::Result<RunSummary>>>> =
+    let results: Mutex<Vec<Option<anyhow::Result<FinishedRecord>>>> =
         Mutex::new(plans.iter().map(|_| None).collect());
     let workers = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
@@ -716,12 +721,15 @@ pub fn fly_with_workers(
     });
 
     let mut runs = Vec::new();
+    let mut records = Vec::new();
     for (plan, result) in plans
         .iter()
         .zip(results.into_inner().unwrap_or_else(|e| e.into_inner()))
     {
         let run = result.unwrap_or_else(|| Err(anyhow::anyhow!("not flown")));
-        runs.push(run.with_context(|| format!("record {}", plan.file_name()))?);
+        let (run, record) = run.with_context(|| format!("record {}", plan.file_name()))?;
+        runs.push(run);
+        records.push(record);
     }
     let link = make_link().describe();
     let summary = FlySummary {
@@ -741,7 +749,11 @@ pub fn fly_with_workers(
     let path = args.out.join("summary.json");
     write_json(&path, &summary)?;
     let dumps = plans.iter().map(|p| args.out.join(p.file_name())).collect();
-    Ok(FlyOutcome { summary, dumps })
+    Ok(FlyOutcome {
+        summary,
+        dumps,
+        records,
+    })
 }
 
 /// Seconds from arming to the end of the excitation for `config` (trim capture, fades,
@@ -751,19 +763,27 @@ pub fn expected_duration_s(config: &Config) -> f64 {
     f64::from(config.trim_capture_s) + excitation.duration_s()
 }
 
+/// A record written: its summary, and its sweep as decoded for the summary (if a sweep
+/// that did not abort).
+type FinishedRecord = (RunSummary, Option<Record>);
+
 fn finish_record(
     args: &FlyArgs,
     plan: &RecordPlan,
     config: &Config,
     flown: record::FlownRecord,
-) -> anyhow::Result<RunSummary> {
+) -> anyhow::Result<FinishedRecord> {
     write_atomic(&args.out.join(plan.file_name()), &flown.dump)?;
-    let cross_coherence = if plan.input.is_sweep() && flown.abort.is_none() {
-        record_cross_coherence(&flown.dump, &plan.file_name())?
+    let record = if plan.input.is_sweep() && flown.abort.is_none() {
+        Some(sysid::frf::load_dump_bytes(&flown.dump, &plan.file_name())?)
     } else {
-        BTreeMap::new()
+        None
     };
-    Ok(RunSummary {
+    let cross_coherence = match &record {
+        Some(record) => record_cross_coherence(record)?,
+        None => BTreeMap::new(),
+    };
+    let run = RunSummary {
         axis: plan.axis.name().to_string(),
         index: plan.index,
         file: plan.file_name(),
@@ -780,15 +800,15 @@ fn finish_record(
             max_error_deg: flown.attitude_error_deg,
         }),
         after: flown.after,
-    })
+    };
+    Ok((run, record))
 }
 
 /// Mean coherence between the primary control and each other excited control over the
 /// sweep band of one record (sysid's cross-control coherence).
-pub fn record_cross_coherence(dump: &[u8], name: &str) -> anyhow::Result<BTreeMap<String, f64>> {
-    let record = sysid::frf::load_dump_bytes(dump, name)?;
+pub fn record_cross_coherence(record: &Record) -> anyhow::Result<BTreeMap<String, f64>> {
     let primary = record.primary.clone();
-    let pairs = sysid::frf::cross_control_coherence(&record, &sysid::frf::FrfOptions::default())?;
+    let pairs = sysid::frf::cross_control_coherence(record, &sysid::frf::FrfOptions::default())?;
     Ok(pairs
         .into_iter()
         .map(|c| (if c.a == primary { c.b } else { c.a }, c.mean))

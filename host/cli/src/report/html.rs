@@ -3,7 +3,8 @@
 
 use std::fmt::Write as _;
 
-use super::svg::escape;
+pub use crate::plot::draw::escape;
+use crate::plot::PlotError;
 
 /// The page's style: a centred column at most 1280 px wide (no sideways scroll at that
 /// width), figures scaled to the column, wide tables scrolling inside their own box.
@@ -42,12 +43,15 @@ pub fn section(id: &str, heading: &str, content: &str) -> String {
     )
 }
 
-/// A figure with a caption.
-pub fn figure(svg: &str, caption: &str) -> String {
-    format!(
-        "<figure>{svg}<figcaption>{}</figcaption></figure>\n",
-        escape(caption)
-    )
+/// A figure (an inline `<svg>`) with a caption; a drawing that failed is said in its place.
+pub fn figure(svg: Result<String, PlotError>, caption: &str) -> String {
+    match svg {
+        Ok(svg) => format!(
+            "<figure>{svg}<figcaption>{}</figcaption></figure>\n",
+            escape(caption)
+        ),
+        Err(error) => note(&format!("{caption}: {error}")),
+    }
 }
 
 /// A paragraph of explanatory text.

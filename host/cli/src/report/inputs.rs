@@ -1,6 +1,7 @@
 //! Everything the report draws, read from the campaign folder: `summary.json`, `frf.json`,
-//! `model9.json`, `truth-model9.json`, `verify.json` and the dumps (the sweep time history
-//! and the cross-control coherence curves are recomputed from the dumps).
+//! `model9.json`, `truth-model9.json`, `verify.json`, and what it draws from the dumps (the
+//! sweep time history and the cross-control coherence curves): handed over by the
+//! campaign, or decoded from the dumps when the report is made from the folder alone.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -9,13 +10,13 @@ use serde::de::DeserializeOwned;
 use sysid::document::FrfDocument;
 use sysid::fit::report::ModelMatrices;
 use sysid::fit::{Model, PairFit};
-use sysid::frf::analysis::CoherenceCurve;
-use sysid::frf::{analyse, group_by_primary, load_dump, FrfOptions, Record};
+use sysid::frf::{load_dump, Record};
 
-use crate::campaign::files;
-use crate::campaign::summary::CampaignSummary;
-use crate::campaign::truth_model::TruthModelDocument;
-use crate::campaign::verification::VerifyDocument;
+use crate::artifacts::files;
+use crate::artifacts::flown::{lateral_coherence, FlownRecords, ModeCoherence, LATERAL};
+use crate::artifacts::summary::CampaignSummary;
+use crate::artifacts::truth_model::TruthModelDocument;
+use crate::artifacts::verification::VerifyDocument;
 
 /// Why the report cannot be made.
 #[derive(Debug)]
@@ -92,15 +93,6 @@ impl FittedModel {
     }
 }
 
-/// The lateral cross-control coherence of one mode versus frequency.
-#[derive(Clone, Debug)]
-pub struct ModeCoherence {
-    /// Mode name.
-    pub mode: String,
-    /// The lat–lon (and other lat–x) curves of the joined lateral records.
-    pub curves: Vec<CoherenceCurve>,
-}
-
 /// The report's inputs. Files of stages that did not complete are `None` (the sections
 /// say so); files that exist but do not parse are an error.
 #[derive(Clone, Debug)]
@@ -117,10 +109,8 @@ pub struct ReportInputs {
     pub truth_model: Option<TruthModelDocument>,
     /// `verify.json`.
     pub verify: Option<VerifyDocument>,
-    /// The first lateral `cah` sweep (paper Fig. 1/6).
-    pub sweep: Option<Record>,
-    /// Lateral cross-control coherence per flown mode (paper Fig. 3/7).
-    pub coherence: Vec<ModeCoherence>,
+    /// The sweep time history and the cross-control coherence curves.
+    pub flown: FlownRecords,
 }
 
 fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, ReportError> {
@@ -152,6 +142,7 @@ fn corrupt(path: &Path, error: impl fmt::Display) -> ReportError {
 
 /// The lateral sweep dumps of a mode folder, in file-name order.
 fn lateral_dumps(folder: &Path) -> Vec<PathBuf> {
+    let prefix = format!("{LATERAL}-");
     let mut dumps: Vec<PathBuf> = std::fs::read_dir(folder)
         .map(|entries| {
             entries
@@ -159,7 +150,7 @@ fn lateral_dumps(folder: &Path) -> Vec<PathBuf> {
                 .filter(|p| {
                     p.file_name()
                         .and_then(|n| n.to_str())
-                        .is_some_and(|n| n.starts_with("lat-") && n.ends_with(".bin"))
+                        .is_some_and(|n| n.starts_with(&prefix) && n.ends_with(".bin"))
                 })
                 .collect()
         })
@@ -169,8 +160,14 @@ fn lateral_dumps(folder: &Path) -> Vec<PathBuf> {
 }
 
 impl ReportInputs {
-    /// Read the campaign folder `dir`.
+    /// Read the campaign folder `dir`, decoding its dumps.
     pub fn load(dir: &Path) -> Result<ReportInputs, ReportError> {
+        ReportInputs::read(dir, None)
+    }
+
+    /// Read the documents of the campaign folder `dir`; the dump-derived inputs are
+    /// `flown` when given, else decoded from its dumps.
+    pub fn read(dir: &Path, flown: Option<FlownRecords>) -> Result<ReportInputs, ReportError> {
         let summary: CampaignSummary = read_json(&dir.join(files::SUMMARY))?;
         let frf = read_optional(&dir.join(files::FRF))?;
         let model: Option<FittedModel> = read_optional(&dir.join(files::MODEL_9DOF))?;
@@ -193,36 +190,10 @@ impl ReportInputs {
             }
         }
         let verify = read_optional(&dir.join(files::VERIFY))?;
-
-        let mut sweep = None;
-        let mut coherence = Vec::new();
-        let modes = [
-            ("cah", summary.modes.cah.as_ref()),
-            ("standard", summary.modes.standard.as_ref()),
-            ("noise", summary.modes.noise.as_ref()),
-        ];
-        for (mode, flown) in modes {
-            let Some(flown) = flown else { continue };
-            let dumps = lateral_dumps(&dir.join(&flown.folder));
-            if dumps.is_empty() {
-                continue;
-            }
-            let records = dumps
-                .iter()
-                .map(|path| load_dump(path).map_err(|e| corrupt(path, e)))
-                .collect::<Result<Vec<Record>, _>>()?;
-            if mode == "cah" {
-                sweep = records.first().cloned();
-            }
-            let folder = dir.join(&flown.folder);
-            let groups = group_by_primary(records).map_err(|e| corrupt(&folder, e))?;
-            let analysis =
-                analyse(&groups, &FrfOptions::default()).map_err(|e| corrupt(&folder, e))?;
-            coherence.push(ModeCoherence {
-                mode: mode.to_string(),
-                curves: analysis.cross_coherence_curves,
-            });
-        }
+        let flown = match flown {
+            Some(flown) => flown,
+            None => decode_flown(dir, &summary)?,
+        };
         Ok(ReportInputs {
             dir: dir.to_path_buf(),
             summary,
@@ -230,8 +201,38 @@ impl ReportInputs {
             model,
             truth_model,
             verify,
-            sweep,
-            coherence,
+            flown,
         })
     }
+}
+
+/// The dump-derived inputs of the campaign folder `dir`: its lateral sweeps decoded, the
+/// first `cah` one kept, each mode's joined into coherence curves.
+fn decode_flown(dir: &Path, summary: &CampaignSummary) -> Result<FlownRecords, ReportError> {
+    let mut flown = FlownRecords::default();
+    let modes = [
+        ("cah", summary.modes.cah.as_ref()),
+        ("standard", summary.modes.standard.as_ref()),
+        ("noise", summary.modes.noise.as_ref()),
+    ];
+    for (mode, done) in modes {
+        let Some(done) = done else { continue };
+        let dumps = lateral_dumps(&dir.join(&done.folder));
+        if dumps.is_empty() {
+            continue;
+        }
+        let records = dumps
+            .iter()
+            .map(|path| load_dump(path).map_err(|e| corrupt(path, e)))
+            .collect::<Result<Vec<Record>, _>>()?;
+        if mode == "cah" {
+            flown.sweep = records.first().cloned();
+        }
+        let folder = dir.join(&done.folder);
+        flown.coherence.push(ModeCoherence {
+            mode: mode.to_string(),
+            curves: lateral_coherence(records).map_err(|e| corrupt(&folder, e))?,
+        });
+    }
+    Ok(flown)
 }

@@ -1,17 +1,21 @@
 //! `sweephold report DIR`: `report.html` of a campaign folder — one self-contained page
 //! (inline SVG, no script, nothing fetched) drawn only from the files in the folder, so
-//! that it can be regenerated at any time.
+//! that it can be regenerated at any time. It reads the documents the campaign wrote
+//! ([`crate::artifacts`]) and computes nothing the campaign has: within a campaign, what
+//! it draws from the dumps is handed over as the campaign decoded it; on its own, it
+//! decodes the dumps.
 
+pub mod curves;
 pub mod html;
 pub mod inputs;
 pub mod sections;
-pub mod svg;
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use crate::campaign::files;
+use crate::artifacts::files;
+use crate::artifacts::flown::FlownRecords;
 pub use inputs::{ReportError, ReportInputs};
 
 /// Arguments of `sweephold report`.
@@ -33,10 +37,21 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Read the campaign folder `dir`, write `dir/report.html`, return its path.
+/// Read the campaign folder `dir` (decoding its dumps), write `dir/report.html`, return its
+/// path.
 pub fn write_report(dir: &Path) -> Result<PathBuf, ReportError> {
-    let inputs = ReportInputs::load(dir)?;
-    let html = render(&inputs);
+    write(&ReportInputs::load(dir)?)
+}
+
+/// Read the documents of the campaign folder `dir`, write `dir/report.html` with `flown`
+/// for what the report draws from the dumps, return its path.
+pub fn write_report_with(dir: &Path, flown: FlownRecords) -> Result<PathBuf, ReportError> {
+    write(&ReportInputs::read(dir, Some(flown))?)
+}
+
+fn write(inputs: &ReportInputs) -> Result<PathBuf, ReportError> {
+    let dir = &inputs.dir;
+    let html = render(inputs);
     let path = dir.join(files::REPORT);
     crate::output::write_atomic(&path, html.as_bytes()).map_err(|e| ReportError::Write {
         path: path.clone(),
@@ -52,20 +67,20 @@ pub fn render(inputs: &ReportInputs) -> String {
         "sweephold campaign: {} seed {}",
         summary.vehicle, summary.seed
     );
-    let mut body = format!("<h1>{}</h1>\n", svg::escape(&title));
+    let mut body = format!("<h1>{}</h1>\n", html::escape(&title));
     body += &html::note(
         "Frequency-sweep system identification under conditional attitude hold (Jung, Shim & \
 Kim): the firmware flown in the loop with the nonlinear simulator, frequency responses, \
 6-DOF then 9-DOF hybrid state-space fit, verification on held-out doublets, and comparison \
 with the simulator's truth.",
     );
-    body += &sections::summary_section(inputs);
-    body += &sections::sweep_input_section(inputs);
-    body += &sections::coherence_section(inputs);
-    body += &sections::bode_section(inputs);
-    body += &sections::parameter_section(inputs);
-    body += &sections::modes_section(inputs);
-    body += &sections::cost_section(inputs);
-    body += &sections::verification_section(inputs);
+    body += &sections::summary::summary_section(inputs);
+    body += &sections::sweep::sweep_input_section(inputs);
+    body += &sections::coherence::coherence_section(inputs);
+    body += &sections::bode::bode_section(inputs);
+    body += &sections::parameters::parameter_section(inputs);
+    body += &sections::modes::modes_section(inputs);
+    body += &sections::costs::cost_section(inputs);
+    body += &sections::verification::verification_section(inputs);
     html::page(&title, &body)
 }

@@ -18,7 +18,7 @@
 //! 4. [`composite`] — per frequency, the window-length estimates are blended with
 //!    weights 1/εr².
 //! 5. [`coherence`] — random error, valid ranges, cross-control coherence.
-//! 6. [`analysis`] — the whole computation into an [`FrfDocument`]; [`plots`] draws it.
+//! 6. [`analysis`] — the whole computation into an [`FrfDocument`].
 //!
 //! ```no_run
 //! use sysid::frf::{compute_frequency_responses, group_by_primary, load_dump, FrfOptions};
@@ -44,7 +44,6 @@ pub mod csv;
 pub mod dump;
 pub mod miso;
 pub mod options;
-pub mod plots;
 pub mod records;
 pub mod reference;
 pub mod spectra;
@@ -66,7 +65,6 @@ pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };
 pub use options::{FrfOptions, ResponseEstimator, ResponseInputs};
-pub use plots::render_plots;
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
 
 use std::path::PathBuf;
@@ -141,8 +139,6 @@ pub enum FrfError {
     },
     /// An option is out of range.
     InvalidOption(String),
-    /// Writing a plot failed.
-    Plot(String),
 }
 
 impl std::fmt::Display for FrfError {
@@ -196,7 +192,6 @@ impl std::fmt::Display for FrfError {
                 )
             }
             FrfError::InvalidOption(message) => write!(f, "invalid option: {message}"),
-            FrfError::Plot(message) => write!(f, "plot failed: {message}"),
         }
     }
 }

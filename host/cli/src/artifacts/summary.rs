@@ -8,8 +8,6 @@ use serde::{Deserialize, Serialize};
 use sysid::fit::modes::{HoverModeScore, ModeRecord, TruthModeRecord};
 use sysid::fit::verify::BiasMode;
 
-use crate::fly::summary::FlySummary;
-
 /// Peak |φ| and |θ| over all the records of one mode [deg].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PeakAttitudeDeg {
@@ -33,29 +31,6 @@ pub struct ModeSummary {
     pub records: usize,
     /// Folder of the dumps and of `fly`'s own summary.json, relative to the campaign's.
     pub folder: String,
-}
-
-impl ModeSummary {
-    /// The mode's figures from `fly`'s summary of its records written into `folder`.
-    pub fn from_fly(summary: &FlySummary, folder: &str) -> Self {
-        let peak = |value: fn(&crate::fly::summary::MaxAbsDeg) -> f64| {
-            summary
-                .runs
-                .iter()
-                .map(|run| value(&run.max_abs_deg))
-                .fold(0.0, f64::max)
-        };
-        ModeSummary {
-            cross_coherence_lat_lon: summary.mean_cross_coherence("lat", "lon"),
-            max_abs_deg: PeakAttitudeDeg {
-                phi: peak(|m| m.phi),
-                theta: peak(|m| m.theta),
-            },
-            aborts: summary.runs.iter().filter(|run| run.aborted).count(),
-            records: summary.runs.len(),
-            folder: folder.to_string(),
-        }
-    }
 }
 
 /// The three modes, each null until flown.
@@ -281,56 +256,4 @@ pub struct CampaignSummary {
     pub timings_s: BTreeMap<String, f64>,
     /// Null when every stage completed.
     pub error: Option<StageFailure>,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::fly::summary::{HoldFraction, MaxAbsDeg, RunSummary};
-
-    fn run(axis: &str, phi: f64, aborted: bool, lon: Option<f64>) -> RunSummary {
-        RunSummary {
-            axis: axis.into(),
-            index: 1,
-            file: format!("{axis}-1.bin"),
-            omega_min: 0.2,
-            omega_max: 31.4,
-            duration_s: 90.0,
-            frames: 1,
-            aborted,
-            abort_reason: aborted.then(|| "attitude_limit".into()),
-            max_abs_deg: MaxAbsDeg {
-                phi,
-                theta: phi / 2.0,
-                psi: 0.0,
-            },
-            hold_fraction: HoldFraction::default(),
-            cross_coherence: lon.map(|c| ("lon".to_string(), c)).into_iter().collect(),
-            estimator: None,
-            after: None,
-        }
-    }
-
-    #[test]
-    fn mode_summary_takes_peaks_aborts_and_lateral_coherence() {
-        let fly = FlySummary {
-            vehicle: "bo105".into(),
-            mode: "cah".into(),
-            rate_hz: 200,
-            seed: 1,
-            link: "in-process".into(),
-            plant: "nonlinear".into(),
-            runs: vec![
-                run("lat", 3.0, false, Some(0.1)),
-                run("lat", 5.0, false, Some(0.3)),
-                run("lon", 9.0, true, Some(0.9)),
-            ],
-        };
-        let mode = ModeSummary::from_fly(&fly, "fly-cah");
-        assert!((mode.cross_coherence_lat_lon.unwrap() - 0.2).abs() < 1e-12);
-        assert_eq!(mode.max_abs_deg.phi, 9.0);
-        assert_eq!(mode.max_abs_deg.theta, 4.5);
-        assert_eq!(mode.aborts, 1);
-        assert_eq!(mode.records, 3);
-    }
 }

@@ -1,10 +1,7 @@
-//! The stages of a campaign, their names (the keys of `timings_s` and of errors) and the
-//! per-stage progress line on stderr.
+//! The stages of a campaign in the order they run, and their names: the keys of
+//! `summary.json`'s `timings_s` and its `error.stage`.
 
 use std::fmt;
-use std::time::{Duration, Instant};
-
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// One step of `sweephold campaign`, in the order they run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -92,50 +89,6 @@ impl Stage {
 impl fmt::Display for Stage {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-/// The progress display of one stage: a spinner while it runs when stderr is a terminal
-/// (indicatif hides itself otherwise), then one line with its wall time unless quiet.
-pub struct StageProgress {
-    stage: Stage,
-    spinner: ProgressBar,
-    started: Instant,
-    quiet: bool,
-}
-
-impl StageProgress {
-    /// Start showing `stage`.
-    pub fn start(stage: Stage, quiet: bool) -> Self {
-        let target = if quiet {
-            ProgressDrawTarget::hidden()
-        } else {
-            ProgressDrawTarget::stderr()
-        };
-        let spinner = ProgressBar::with_draw_target(None, target);
-        spinner.set_style(
-            ProgressStyle::with_template("{spinner} {prefix:<16} {msg} {elapsed}")
-                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-        );
-        spinner.set_prefix(stage.name());
-        spinner.set_message(stage.description());
-        spinner.enable_steady_tick(Duration::from_millis(120));
-        StageProgress {
-            stage,
-            spinner,
-            started: Instant::now(),
-            quiet,
-        }
-    }
-
-    /// Stop the spinner and print the stage's outcome; returns its wall time [s].
-    pub fn finish(self, outcome: &str) -> f64 {
-        let seconds = self.started.elapsed().as_secs_f64();
-        self.spinner.finish_and_clear();
-        if !self.quiet {
-            eprintln!("{:<16} {:>6.2} s  {}", self.stage.name(), seconds, outcome);
-        }
-        seconds
     }
 }
 

@@ -1,0 +1,13 @@
+//! The campaign folder: its layout and the documents in it. The campaign writes them, the
+//! report reads them (`sweephold report DIR` from the folder alone): `summary.json`
+//! ([`summary`]), `truth-model9.json` ([`truth_model`]), `verify.json` ([`verification`]),
+//! the stage names `summary.json` keys its timings by ([`stage`]), where each file lies
+//! ([`files`]), and what the report draws from the dumps ([`flown`]), which a campaign
+//! hands over as it decoded it.
+
+pub mod files;
+pub mod flown;
+pub mod stage;
+pub mod summary;
+pub mod truth_model;
+pub mod verification;

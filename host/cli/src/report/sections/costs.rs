@@ -1,0 +1,43 @@
+//! The cost table: J per fitted pair, of the fit and against the truth.
+
+use super::fmt;
+use crate::artifacts::summary::ANGULAR_RATES;
+use crate::report::html::{note, section, table, Cell};
+use crate::report::inputs::ReportInputs;
+
+/// J per pair, fit and against the truth.
+pub fn cost_section(inputs: &ReportInputs) -> String {
+    let Some(fit) = &inputs.summary.fit else {
+        return section("costs", "Cost per pair", &note("No fit in this campaign."));
+    };
+    let mut rows: Vec<Vec<Cell>> = fit
+        .pairs
+        .iter()
+        .map(|p| {
+            let rate = ANGULAR_RATES.contains(&p.output.as_str());
+            vec![
+                Cell::name(format!("{}/{}", p.output, p.input)),
+                Cell::plain(format!("{:.2}–{:.2}", p.range[0], p.range[1])),
+                Cell::judged(format!("{:.1}", p.cost), p.cost <= 100.0),
+                match p.truth_cost {
+                    Some(c) if rate => Cell::judged(format!("{c:.1}"), c <= 20.0),
+                    other => Cell::plain(fmt(other, 1)),
+                },
+            ]
+        })
+        .collect();
+    rows.push(vec![
+        Cell::name("J_ave"),
+        Cell::plain(""),
+        Cell::judged(format!("{:.1}", fit.cost_ave), fit.cost_ave <= 50.0),
+        Cell::plain(fmt(fit.truth_cost_ave, 1)),
+    ]);
+    let content = note(&format!(
+        "J = 20/n_ω Σ W_γ[W_g(Δ|T| dB)² + W_p(Δ∠T deg)²] on 20 points per pair: ≤ 100 \
+acceptable per pair (green), J_ave ≤ 50 the bar. J truth: the identified model against the \
+truth model over the same range (bar ≤ 20 for the angular rates). The 6-DOF start had \
+J_ave {:.1}.",
+        fit.start_cost_ave
+    )) + &table(&["pair", "range [rad/s]", "J", "J truth"], &rows);
+    section("costs", "Cost per pair (J table)", &content)
+}
