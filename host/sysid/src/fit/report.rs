@@ -220,6 +220,13 @@ fn finite(value: Option<f64>) -> Option<f64> {
     value.filter(|v| v.is_finite())
 }
 
+impl FitResult {
+    /// The `model.json` form.
+    pub fn to_document(&self) -> ModelDocument {
+        ModelDocument::from_result(self)
+    }
+}
+
 impl ModelDocument {
     /// The document of a fit result.
     pub fn from_result(result: &FitResult) -> Self {
