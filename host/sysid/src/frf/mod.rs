@@ -17,8 +17,9 @@
 //!    with the recorded sweep as instrument z instead (an option).
 //! 4. [`composite`] — per frequency, the window-length estimates are blended with
 //!    weights 1/εr².
-//! 5. [`coherence`] — random error, valid ranges, cross-control coherence.
-//! 6. [`analysis`] — the whole computation into an [`FrfDocument`]; [`plots`] draws it.
+//! 5. [`coherence`] — random error, valid ranges, coherence bias.
+//! 6. [`analysis`] — the whole computation into an [`FrfDocument`], and the
+//!    cross-control coherence; [`plots`] draws it.
 //!
 //! ```no_run
 //! use sysid::frf::{compute_frequency_responses, group_by_primary, load_dump, FrfOptions};
@@ -53,14 +54,11 @@ pub mod spectra;
 pub(crate) mod testing;
 
 pub use analysis::{
-    analyse, compute_frequency_responses, CoherenceCurve, FrfAnalysis, GroupSummary,
-    MultipleCoherence,
+    analyse, compute_frequency_responses, cross_control_coherence, CoherenceCurve, FrfAnalysis,
+    GroupSummary, MultipleCoherence,
 };
 pub use chirp_z::{chirp_z, ChirpZ};
-pub use coherence::{
-    cross_control_coherence, debiased_coherence, random_error, valid_range,
-    welch_independent_averages,
-};
+pub use coherence::{debiased_coherence, random_error, valid_range};
 pub use csv::{load_csv, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
@@ -68,6 +66,7 @@ pub use dump::{
 pub use options::{FrfOptions, ResponseEstimator, ResponseInputs};
 pub use plots::render_plots;
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
+pub use spectra::welch_independent_averages;
 
 use std::path::PathBuf;
 
