@@ -135,16 +135,9 @@ impl TryFrom<UncheckedFrfDocument> for FrfDocument {
 
 /// Why a frequency-response document was refused: one line, starting `frf.json:` and
 /// naming the pair and field, e.g. `frf.json: pair lat→p: mag_db has 199 values, omega 200`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("frf.json: {0}")]
 pub struct InvalidFrfDocument(pub String);
-
-impl std::fmt::Display for InvalidFrfDocument {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "frf.json: {}", self.0)
-    }
-}
-
-impl std::error::Error for InvalidFrfDocument {}
 
 impl FrfDocument {
     /// The conditioned response of one pair, if present.

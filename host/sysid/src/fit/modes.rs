@@ -113,29 +113,18 @@ pub const SPIRAL_SHARE: f64 = 0.25;
 const MAX_ITERATIONS: usize = 10_000;
 
 /// Why the modes of a model cannot be computed.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModeError {
     /// `M` cannot be inverted: `A = M⁻¹F` does not exist.
+    #[error("the mass matrix M is singular: A = M⁻¹F does not exist")]
     SingularMassMatrix,
     /// `M` or `F` has a NaN or an infinite entry, or `M⁻¹F` does (a nearly singular `M`).
+    #[error("M, F or M⁻¹F has a NaN or infinite entry")]
     NotFinite,
     /// The eigenvalue or eigenvector decomposition did not converge.
+    #[error("the eigenvalue decomposition did not converge")]
     NoConvergence,
 }
-
-impl fmt::Display for ModeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ModeError::SingularMassMatrix => {
-                write!(f, "the mass matrix M is singular: A = M⁻¹F does not exist")
-            }
-            ModeError::NotFinite => write!(f, "M, F or M⁻¹F has a NaN or infinite entry"),
-            ModeError::NoConvergence => write!(f, "the eigenvalue decomposition did not converge"),
-        }
-    }
-}
-
-impl std::error::Error for ModeError {}
 
 /// The name of a mode (rules in the module documentation). In JSON and tables: the
 /// strings of [`ModeName::as_str`].

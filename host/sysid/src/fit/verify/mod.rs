@@ -73,48 +73,58 @@ pub use score::{score_output, score_output_with_bias, OutputScore};
 pub use simulate::{delayed, simulate, simulate_with_resets, DiscreteModel};
 
 /// Why a model cannot be verified against a record.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum VerifyError {
     /// A control of the model is not among the record's inputs.
+    #[error("model control `{control}` is not an input of {record} (inputs: {})", .available.join(" "))]
     MissingInput {
         /// The control.
         control: String,
         /// The record.
-        source: String,
+        record: String,
         /// The record's inputs.
         available: Vec<String>,
     },
     /// No output of the model is among the record's outputs.
+    #[error("no output of the model ({}) is recorded in {record}", .model_outputs.join(" "))]
     NoCommonOutput {
         /// The record.
-        source: String,
+        record: String,
         /// The model's outputs.
         model_outputs: Vec<String>,
     },
     /// The model's matrices do not fit its names, or M is singular.
+    #[error("unusable model: {reason}")]
     BadModel {
         /// What is wrong.
         reason: String,
     },
     /// The record is too short or its rate is not positive.
+    #[error("{record}: {reason}")]
     BadRecord {
         /// The record.
-        source: String,
+        record: String,
         /// What is wrong.
         reason: String,
     },
     /// The simulation left the finite numbers (an unstable model ran away).
+    #[error("the simulated model diverged (non-finite at sample {sample})")]
     Diverged {
         /// Sample index where the first non-finite value appeared.
         sample: usize,
     },
     /// The trim bias was asked for, but the record has no trim samples before its
     /// excitation.
+    #[error(
+        "{record}: no trim samples before the excitation to take the output bias from \
+         (the fitted bias needs none)"
+    )]
     NoTrim {
         /// The record.
-        source: String,
+        record: String,
     },
     /// A plot could not be written.
+    #[error("cannot draw plot {}: {message}", .path.display())]
     Plot {
         /// The file.
         path: PathBuf,
@@ -122,46 +132,6 @@ pub enum VerifyError {
         message: String,
     },
 }
-
-impl fmt::Display for VerifyError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            VerifyError::MissingInput {
-                control,
-                source,
-                available,
-            } => write!(
-                f,
-                "model control `{control}` is not an input of {source} (inputs: {})",
-                available.join(" ")
-            ),
-            VerifyError::NoCommonOutput {
-                source,
-                model_outputs,
-            } => write!(
-                f,
-                "no output of the model ({}) is recorded in {source}",
-                model_outputs.join(" ")
-            ),
-            VerifyError::BadModel { reason } => write!(f, "unusable model: {reason}"),
-            VerifyError::BadRecord { source, reason } => write!(f, "{source}: {reason}"),
-            VerifyError::Diverged { sample } => write!(
-                f,
-                "the simulated model diverged (non-finite at sample {sample})"
-            ),
-            VerifyError::NoTrim { source } => write!(
-                f,
-                "{source}: no trim samples before the excitation to take the output bias from \
-                 (the fitted bias needs none)"
-            ),
-            VerifyError::Plot { path, message } => {
-                write!(f, "cannot draw plot {}: {message}", path.display())
-            }
-        }
-    }
-}
-
-impl std::error::Error for VerifyError {}
 
 /// Where the constant b removed from each measured output (its trim value plus any sensor
 /// bias) comes from; see the module documentation.
@@ -256,20 +226,20 @@ pub fn verify_record_in_segments(
     if let Some(segment) = segment_s {
         if !(segment.is_finite() && segment * record.sample_rate_hz >= 2.0) {
             return Err(VerifyError::BadRecord {
-                source: record.source.clone(),
+                record: record.source.clone(),
                 reason: format!("segment of {segment} s is shorter than 2 samples"),
             });
         }
     }
     if !(record.sample_rate_hz.is_finite() && record.sample_rate_hz > 0.0) {
         return Err(VerifyError::BadRecord {
-            source: record.source.clone(),
+            record: record.source.clone(),
             reason: format!("sample rate {} Hz", record.sample_rate_hz),
         });
     }
     if record.len() < 2 {
         return Err(VerifyError::BadRecord {
-            source: record.source.clone(),
+            record: record.source.clone(),
             reason: format!("{} samples, need at least 2", record.len()),
         });
     }
@@ -279,7 +249,7 @@ pub fn verify_record_in_segments(
             .input(control)
             .ok_or_else(|| VerifyError::MissingInput {
                 control: control.clone(),
-                source: record.source.clone(),
+                record: record.source.clone(),
                 available: record.inputs.iter().map(|c| c.name.clone()).collect(),
             })?;
         recorded_inputs.push(series);
@@ -292,7 +262,7 @@ pub fn verify_record_in_segments(
         .collect();
     if compared.is_empty() {
         return Err(VerifyError::NoCommonOutput {
-            source: record.source.clone(),
+            record: record.source.clone(),
             model_outputs: model.outputs.clone(),
         });
     }
@@ -307,12 +277,12 @@ pub fn verify_record_in_segments(
         BiasMode::Fitted => None,
         BiasMode::Trim if record.trim_samples == 0 => {
             return Err(VerifyError::NoTrim {
-                source: record.source.clone(),
+                record: record.source.clone(),
             })
         }
         BiasMode::Trim if record.trim_samples > record.len() => {
             return Err(VerifyError::BadRecord {
-                source: record.source.clone(),
+                record: record.source.clone(),
                 reason: format!(
                     "{} trim samples in a record of {}",
                     record.trim_samples,

@@ -159,7 +159,7 @@ pub fn simulate_with_resets(
 ) -> Result<Vec<Vec<f64>>, VerifyError> {
     if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
         return Err(VerifyError::BadRecord {
-            source: "inputs".into(),
+            record: "inputs".into(),
             reason: format!("sample rate {sample_rate_hz} Hz"),
         });
     }
@@ -176,7 +176,7 @@ pub fn simulate_with_resets(
     let length = inputs.first().map_or(0, Vec::len);
     if inputs.iter().any(|series| series.len() != length) {
         return Err(VerifyError::BadRecord {
-            source: "inputs".into(),
+            record: "inputs".into(),
             reason: "input series differ in length".into(),
         });
     }

@@ -1,3 +1,6 @@
+//! Tests of the time-domain verification: the exact discretisation, fractional delays,
+//! scores on self-generated and noisy data, segments, mismatches and the trim bias.
+
 use nalgebra::DMatrix;
 
 use super::score::rms;
@@ -407,7 +410,7 @@ fn the_trim_bias_needs_trim_samples() {
     assert_eq!(
         error,
         VerifyError::NoTrim {
-            source: "synthetic".into()
+            record: "synthetic".into()
         }
     );
     assert!(
