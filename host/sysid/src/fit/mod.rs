@@ -39,11 +39,10 @@ pub use driver::{fit, fit_from_alternative_starts, usable_pairs};
 pub use error::{FitError, StructureError, StructureProblem};
 pub use model::Model;
 pub use optimizer::StopReason;
-pub use reduce::ReductionStep;
 pub use report::ModelDocument;
 pub use result::{
-    AccuracyFlag, FitResult, FlagRecord, PairFit, ParameterReport, ParameterStatus, SkippedPair,
-    StartOutcome, StartSetOutcome,
+    AccuracyFlag, FitResult, FlagRecord, PairFit, ParameterReport, ParameterStatus, ReductionStep,
+    SkippedPair, StartOutcome, StartSetOutcome,
 };
 pub use start::{start_from_quasi_steady, StartValueNote};
 pub use structure::{ModelStructure, ParameterKind};

@@ -102,7 +102,7 @@ pub struct ModelDocument {
     pub outputs: Vec<String>,
     /// M F G H0 H1, row-major.
     pub matrices: ModelMatrices,
-    /// Delay per control [s], in `controls` order.
+    /// Delay per control \[s\], in `controls` order.
     pub delays: Vec<f64>,
     /// Base parameters in structure order, then constrained ones.
     pub parameters: Vec<ParameterReport>,

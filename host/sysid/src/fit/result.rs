@@ -1,6 +1,7 @@
 //! What a fit produces: the fitted model with a report per parameter (value, status,
 //! Cramér–Rao bound, insensitivity, guideline flags), the cost per pair, every start of
-//! the optimizer and the pairs left out.
+//! the optimizer, the steps of the reduction and the pairs left out. Its `model.json`
+//! form is [`super::report`]'s.
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -159,6 +160,8 @@ pub struct StartOutcome {
     /// Iterations used.
     pub iterations: usize,
     /// Why it stopped (debug form of [`StopReason`]), or the error.
+    ///
+    /// [`StopReason`]: super::StopReason
     pub stop: String,
 }
 
@@ -207,6 +210,8 @@ impl FitResult {
 
     /// The pairs and ranges fitted, e.g. to score the model against a truth model with
     /// [`cost_between_models`].
+    ///
+    /// [`cost_between_models`]: super::cost_between_models
     pub fn bands(&self) -> Vec<PairBand> {
         self.pairs
             .iter()
@@ -299,6 +304,8 @@ pub struct SkippedPair {
 }
 
 /// The cost a start set reached in [`fit_from_alternative_starts`], before reduction.
+///
+/// [`fit_from_alternative_starts`]: super::fit_from_alternative_starts
 #[derive(Clone, Debug, PartialEq)]
 pub struct StartSetOutcome {
     /// What the caller called this start set (e.g. "6-DOF model", "structure file").

@@ -1,3 +1,6 @@
+//! Tests of the fit as a whole: recovery of known models from perturbed starts, start
+//! sets, determinism, and the errors and skipped pairs of unusable data.
+
 use super::*;
 use crate::document::FrfDocument;
 use crate::fit::test_support::*;

@@ -32,6 +32,8 @@
 //! The steps are submodules: `prepare` (join a group, choose its band, grid, windows
 //! and channels), `responses` (spectra, MISO solves and composites of one group) and
 //! `cross_coherence` (coherence between the controls of a group).
+//!
+//! [`ResponseInputs`]: super::ResponseInputs
 
 use crate::document::{FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
 
@@ -99,6 +101,8 @@ pub struct FrfAnalysis {
 /// Composite MISO-conditioned and SISO frequency responses of every (responding input,
 /// output) pair (the swept input of each group, or every excited one: [`ResponseInputs`]),
 /// and the cross-control coherences, of the given record groups (one per swept axis).
+///
+/// [`ResponseInputs`]: super::ResponseInputs
 pub fn compute_frequency_responses(
     groups: &[RecordGroup],
     opts: &FrfOptions,

@@ -172,7 +172,7 @@ pub struct ModelStructure {
     /// Matrix entries that differ from the defaults (M = I, H0 selects states that are
     /// also outputs, everything else zero).
     pub entries: Vec<MatrixEntry>,
-    /// Delay τ per control [s], as expressions (constant 0 when not given).
+    /// Delay τ per control \[s\], as expressions (constant 0 when not given).
     pub delays: Vec<ParameterExpression>,
     /// Pairs to fit.
     pub pairs: Vec<PairSpec>,

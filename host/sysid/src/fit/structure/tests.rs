@@ -1,3 +1,5 @@
+//! Tests of structure files: parsing, constants, and the line every error names.
+
 use std::collections::BTreeMap;
 
 use super::*;

@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 use super::structure::ModelStructure;
 
 /// The state columns of a trim-point file, in their order in [`TrimPoint::states`]:
-/// body velocities [m/s], body rates [rad/s], attitude [rad].
+/// body velocities [m/s], body rates [rad/s], attitude \[rad\].
 pub const STATE_COLUMNS: [&str; 8] = ["u", "v", "w", "p", "q", "r", "phi", "theta"];
 /// The stick columns, in their order in [`TrimPoint::controls`] (fractions of travel).
 pub const CONTROL_COLUMNS: [&str; 4] = ["lat", "lon", "ped", "col"];
@@ -61,7 +61,7 @@ pub const MAX_ROUNDS: usize = 6;
 pub struct TrimPoint {
     /// Free text (`hover`, `forward`, …); may be empty.
     pub label: String,
-    /// u v w [m/s], p q r [rad/s], φ θ [rad] ([`STATE_COLUMNS`]).
+    /// u v w [m/s], p q r [rad/s], φ θ \[rad\] ([`STATE_COLUMNS`]).
     pub states: [f64; 8],
     /// lat lon ped col stick fractions ([`CONTROL_COLUMNS`]).
     pub controls: [f64; 4],

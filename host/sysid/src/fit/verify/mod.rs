@@ -168,7 +168,7 @@ impl fmt::Display for BiasMode {
 pub struct Verification {
     /// The record's source.
     pub source: String,
-    /// Sample rate [Hz].
+    /// Sample rate \[Hz\].
     pub sample_rate_hz: f64,
     /// Samples compared.
     pub samples: usize,
@@ -183,7 +183,7 @@ pub struct Verification {
     pub not_recorded: Vec<String>,
     /// Mean of the per-output TICs.
     pub theil_mean: f64,
-    /// Time [s] at which the simulated model overflowed (an unstable model running away):
+    /// Time \[s\] at which the simulated model overflowed (an unstable model running away):
     /// every output then scores TIC = 1, the worst value (the limit as ŷ → ∞).
     pub diverged_at_s: Option<f64>,
     /// Measured series (with the bias removed), per compared output.

@@ -9,6 +9,9 @@ pub struct OutputScore {
     pub output: String,
     /// The constant b removed from the measurement: the output's trim mean
     /// ([`BiasMode::Trim`]) or the least-squares mean(y − ŷ) ([`BiasMode::Fitted`]).
+    ///
+    /// [`BiasMode::Trim`]: super::BiasMode::Trim
+    /// [`BiasMode::Fitted`]: super::BiasMode::Fitted
     pub bias: f64,
     /// RMS of the residual y − b − ŷ.
     pub rms_error: f64,
@@ -26,6 +29,8 @@ pub(super) fn rms(values: impl Iterator<Item = f64>, n: usize) -> f64 {
 
 /// Score a prediction against a measurement of one output with the bias fitted by least
 /// squares, `b = mean(y − ŷ)` ([`BiasMode::Fitted`]), then the TIC.
+///
+/// [`BiasMode::Fitted`]: super::BiasMode::Fitted
 pub fn score_output(name: &str, measured: &[f64], predicted: &[f64]) -> OutputScore {
     let n = measured.len().min(predicted.len()).max(1);
     let bias = measured

@@ -20,7 +20,7 @@ pub struct DiscreteModel {
     pub c: DMatrix<f64>,
     /// D = H1·B.
     pub d: DMatrix<f64>,
-    /// Sample interval h [s].
+    /// Sample interval h \[s\].
     pub step_s: f64,
 }
 

@@ -52,6 +52,8 @@ impl CoherenceCurve {
 /// in windows only two periods long (see `a_control_driven_through_dynamics_reads_coherent`). Controls with no excitation
 /// (RMS below `excitation_ratio` of the swept control's) have no defined coherence and
 /// are left out of the result.
+///
+/// [`welch_independent_averages`]: crate::frf::spectra::welch_independent_averages
 pub fn cross_control_coherence(
     record: &Record,
     opts: &FrfOptions,
@@ -141,8 +143,7 @@ pub(super) fn curves_from_spectra(
 
 /// Periods of ω a window must span to count towards the cross-control coherence at ω.
 ///
-/// Two periods (the responses' resolution limit,
-/// [`lowest_resolved`](crate::frf::spectra::lowest_resolved)) are too few here.
+/// Two periods (the responses' resolution limit, [`lowest_resolved`]) are too few here.
 /// A control that follows the swept one through dynamics with a delay or a lightly
 /// damped mode is exactly coherent with it, but in a window only a couple of periods
 /// long the chirp's frequency moves on within the window and the answer arrives late,
@@ -151,6 +152,8 @@ pub(super) fn curves_from_spectra(
 /// noise-free second-order response (1 rad/s, ζ 0.3) of a 0.2–31.4 rad/s sweep read 0.77
 /// from two periods on and 0.90 from four (`a_control_driven_through_dynamics_reads_coherent`),
 /// while unrelated noise stays near zero either way.
+///
+/// [`lowest_resolved`]: crate::frf::spectra::lowest_resolved
 const CROSS_COHERENCE_MIN_PERIODS: f64 = 4.0;
 
 /// The windows that estimate the cross-control coherence at grid point `k` (frequency
