@@ -10,6 +10,7 @@ use super::ParameterExpression;
 use crate::fit::error::{StructureError, StructureProblem};
 use crate::fit::expression::LinearForm;
 
+/// A `[lo, hi]` band in rad/s: two finite numbers with 0 < lo < hi.
 pub(super) fn check_band(band: &[f64]) -> Result<[f64; 2], String> {
     match band {
         [lo, hi] if lo.is_finite() && hi.is_finite() && *lo > 0.0 && lo < hi => Ok([*lo, *hi]),
