@@ -131,7 +131,7 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
             verify_record_in_segments(&model, &record, args.segment, bias).map_err(|e| {
                 // Record errors name the dump already; model errors get it in front.
                 let message = e.to_string();
-                if let VerifyError::NoTrim { source } = &e {
+                if let VerifyError::NoTrim { record: source } = &e {
                     anyhow!(
                         "{source}: no trim samples before the excitation to take the output \
                          bias from; --bias fitted fits it instead"

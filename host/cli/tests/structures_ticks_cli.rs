@@ -335,10 +335,9 @@ fn fit_model_takes_a_shipped_name_a_file_wins_and_an_unknown_name_lists_them() {
     let dir = TempDir::new("names");
     // The TREX hybrid's exact responses at its start values: a fit of that name is
     // already at its minimum.
-    let trex =
-        sweephold::campaign::structures::shipped("trex700l-9dof-hybrid", &Default::default())
-            .unwrap()
-            .unwrap();
+    let trex = sweephold::structures::shipped("trex700l-9dof-hybrid", &Default::default())
+        .unwrap()
+        .unwrap();
     let model = trex.model(&trex.values()).unwrap();
     let bands: Vec<PairBand> = trex
         .pairs

@@ -16,13 +16,13 @@ use serde::{Deserialize, Serialize};
 /// Version of the `frf.json` layout.
 pub const FRF_DOCUMENT_VERSION: u32 = 1;
 
-/// Largest |magnitude| a response may have [dB]. 400 dB is a gain of 10²⁰: no
+/// Largest |magnitude| a response may have \[dB\]. 400 dB is a gain of 10²⁰: no
 /// helicopter response (output units per stick fraction) comes near it, and a document
 /// holding more was damaged or computed from a degenerate record. The bound also keeps
 /// the fit's cost finite: its magnitude residuals are differences of dB values, squared.
 pub const MAX_PLAUSIBLE_MAG_DB: f64 = 400.0;
 
-/// Largest |phase| a response may have [deg], about 2800 turns. The unwrapped phase of a
+/// Largest |phase| a response may have \[deg\], about 2800 turns. The unwrapped phase of a
 /// 200-point response moves by at most 180° per point (36 000° in all); past this bound
 /// the value is damage, and squared in the fit's cost it would no longer be finite
 /// arithmetic worth trusting.
@@ -37,9 +37,9 @@ pub struct PairResponse {
     pub output: String,
     /// Frequencies [rad/s], ascending.
     pub omega: Vec<f64>,
-    /// Magnitude [dB] (20·log10|H|; output units per unit of stick fraction).
+    /// Magnitude \[dB\] (20·log10|H|; output units per unit of stick fraction).
     pub mag_db: Vec<f64>,
-    /// Phase [deg], unwrapped along frequency.
+    /// Phase \[deg\], unwrapped along frequency.
     pub phase_deg: Vec<f64>,
     /// Coherence γ² in [0, 1] (partial coherence for MISO-conditioned responses: the
     /// share of the output, left after the other conditioning inputs, that this input
@@ -135,16 +135,9 @@ impl TryFrom<UncheckedFrfDocument> for FrfDocument {
 
 /// Why a frequency-response document was refused: one line, starting `frf.json:` and
 /// naming the pair and field, e.g. `frf.json: pair lat→p: mag_db has 199 values, omega 200`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("frf.json: {0}")]
 pub struct InvalidFrfDocument(pub String);
-
-impl std::fmt::Display for InvalidFrfDocument {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "frf.json: {}", self.0)
-    }
-}
-
-impl std::error::Error for InvalidFrfDocument {}
 
 impl FrfDocument {
     /// The conditioned response of one pair, if present.

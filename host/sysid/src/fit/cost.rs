@@ -116,9 +116,9 @@ pub struct PairGrid {
     pub range: [f64; 2],
     /// Fit frequencies [rad/s].
     pub omega: Vec<f64>,
-    /// Data magnitude [dB] at `omega`.
+    /// Data magnitude \[dB\] at `omega`.
     pub mag_db: Vec<f64>,
-    /// Data phase [deg] at `omega`.
+    /// Data phase \[deg\] at `omega`.
     pub phase_deg: Vec<f64>,
     /// W_γ at `omega`.
     pub coherence_weight: Vec<f64>,

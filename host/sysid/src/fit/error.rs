@@ -1,15 +1,15 @@
 //! Typed errors of the fit: structure-file problems (always with the line they are on)
 //! and data / numerical problems met while fitting.
 
-use std::fmt;
-
 /// What is wrong in a model structure file.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum StructureProblem {
     /// The file is not valid TOML, or a value has the wrong type / an unknown key
     /// (the `toml` crate's message).
+    #[error("{0}")]
     Syntax(String),
     /// A state, control or output name that the structure does not declare.
+    #[error("unknown {kind} `{name}`")]
     UnknownName {
         /// `state`, `control`, `output`, `matrix row` or `constant`.
         kind: &'static str,
@@ -17,10 +17,13 @@ pub enum StructureProblem {
         name: String,
     },
     /// A name declared twice (states, controls, outputs or parameters).
+    #[error("`{0}` is declared twice")]
     DuplicateName(String),
     /// An expression uses a parameter that `[parameters]` does not define.
+    #[error("undefined parameter `{0}` (declare it under [parameters])")]
     UndefinedParameter(String),
     /// An expression that is not a linear combination of parameters.
+    #[error("bad expression `{expression}`: {reason}")]
     BadExpression {
         /// The expression text.
         expression: String,
@@ -28,9 +31,11 @@ pub enum StructureProblem {
         reason: String,
     },
     /// Constrained parameters that refer to each other in a loop.
+    #[error("constrained parameter `{0}` depends on itself")]
     CyclicConstraint(String),
     /// A parameter table that is neither free (`start`), fixed (`fixed`) nor
     /// constrained (`expr`), or has several of them, or bad bounds.
+    #[error("parameter `{name}`: {reason}")]
     BadParameter {
         /// Parameter name.
         name: String,
@@ -39,6 +44,7 @@ pub enum StructureProblem {
     },
     /// A number that must be finite is NaN or infinite: a parameter's start, fixed value
     /// or bound, a matrix entry or a delay.
+    #[error("{what} = {value} is not a finite number")]
     NotFinite {
         /// What the number is, e.g. ``parameter `Xu` `` or ``parameter `Xu`: min``.
         what: String,
@@ -48,57 +54,20 @@ pub enum StructureProblem {
     /// Parameters declared under `[parameters]` that no matrix entry or delay uses (or
     /// only with a coefficient of 0): the fit cannot move them, and their Cramér–Rao
     /// bounds would make every bound infinite.
+    #[error("{}", unused_parameters(.0))]
     UnusedParameters(Vec<String>),
     /// A pair range that is neither `"auto"` nor `[lo, hi]` with 0 < lo < hi.
+    #[error("bad range: {0}")]
     BadRange(String),
     /// The file could not be read.
+    #[error("cannot read: {0}")]
     Io(String),
 }
 
-impl fmt::Display for StructureProblem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Syntax(message) => write!(f, "{message}"),
-            Self::UnknownName { kind, name } => write!(f, "unknown {kind} `{name}`"),
-            Self::DuplicateName(name) => write!(f, "`{name}` is declared twice"),
-            Self::UndefinedParameter(name) => write!(
-                f,
-                "undefined parameter `{name}` (declare it under [parameters])"
-            ),
-            Self::BadExpression { expression, reason } => {
-                write!(f, "bad expression `{expression}`: {reason}")
-            }
-            Self::CyclicConstraint(name) => {
-                write!(f, "constrained parameter `{name}` depends on itself")
-            }
-            Self::BadParameter { name, reason } => write!(f, "parameter `{name}`: {reason}"),
-            Self::NotFinite { what, value } => write!(f, "{what} = {value} is not a finite number"),
-            Self::UnusedParameters(names) => {
-                let listed = names
-                    .iter()
-                    .map(|name| format!("`{name}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                if names.len() == 1 {
-                    write!(
-                        f,
-                        "parameter {listed} is declared but used in no matrix entry or delay"
-                    )
-                } else {
-                    write!(
-                        f,
-                        "parameters {listed} are declared but used in no matrix entry or delay"
-                    )
-                }
-            }
-            Self::BadRange(reason) => write!(f, "bad range: {reason}"),
-            Self::Io(message) => write!(f, "cannot read: {message}"),
-        }
-    }
-}
-
-/// A problem in a structure file, located by file name and 1-based line.
-#[derive(Clone, Debug, PartialEq)]
+/// A problem in a structure file, located by file name and 1-based line. The problem is
+/// part of the message, not a `source()`: a chain printed with `{:#}` would say it twice.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{source_name}{}: {problem}", at_line(.line))]
 pub struct StructureError {
     /// File name (or `<string>` when parsed from text).
     pub source_name: String,
@@ -108,23 +77,15 @@ pub struct StructureError {
     pub problem: StructureProblem,
 }
 
-impl fmt::Display for StructureError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(line) => write!(f, "{}, line {}: {}", self.source_name, line, self.problem),
-            None => write!(f, "{}: {}", self.source_name, self.problem),
-        }
-    }
-}
-
-impl std::error::Error for StructureError {}
-
 /// Everything that can stop a fit.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FitError {
-    /// The structure file is malformed.
-    Structure(StructureError),
+    /// The structure file is malformed (the structure error itself: its message, and no
+    /// further source).
+    #[error(transparent)]
+    Structure(#[from] StructureError),
     /// The structure asks for a pair that the frequency-response document lacks.
+    #[error("line {line}: pair {output}/{input} is not in the frequency-response data")]
     MissingPair {
         /// Control name.
         input: String,
@@ -134,6 +95,10 @@ pub enum FitError {
         line: usize,
     },
     /// A pair with `range = "auto"` whose data has no valid (coherent) range.
+    #[error(
+        "line {line}: pair {output}/{input} has range \"auto\" but its data have no \
+         valid (coherent) range; give an explicit [lo, hi] or drop the pair"
+    )]
     NoValidRange {
         /// Control name.
         input: String,
@@ -143,12 +108,16 @@ pub enum FitError {
         line: usize,
     },
     /// Every pair of the structure was skipped for lack of a usable coherent range.
+    #[error(
+        "none of the {skipped} pairs has a usable coherent range in the data (see the skipped pairs; lower the coherence threshold of `sweephold frf` or give explicit ranges)"
+    )]
     NoUsablePairs {
         /// How many pairs were skipped.
         skipped: usize,
     },
     /// The pair's range does not overlap the frequencies of its data, or the data are
     /// malformed (lengths differ, frequencies not ascending or not positive, NaN).
+    #[error("pair {output}/{input}: {reason}")]
     BadPairData {
         /// Control name.
         input: String,
@@ -158,8 +127,10 @@ pub enum FitError {
         reason: String,
     },
     /// The structure has no pair to fit.
+    #[error("the structure lists no pair to fit")]
     NoPairs,
     /// Parameter vector of the wrong length for the structure.
+    #[error("expected {expected} parameter values, got {got}")]
     ParameterCount {
         /// Expected length.
         expected: usize,
@@ -168,11 +139,13 @@ pub enum FitError {
     },
     /// `sM − F` is singular at a fit frequency (a pole on the jω axis, or M singular):
     /// the model cannot be evaluated there.
+    #[error("sM − F is singular at ω = {omega} rad/s (pole on the jω axis or singular M)")]
     SingularSystem {
         /// Frequency [rad/s].
         omega: f64,
     },
     /// A name used to compare two models does not exist in one of them.
+    #[error("pair {output}/{input} is not in both models")]
     UnknownPairName {
         /// Control name.
         input: String,
@@ -180,62 +153,29 @@ pub enum FitError {
         output: String,
     },
     /// A start-value source (a previous model) does not provide what is needed.
+    #[error("start values: {0}")]
     StartValues(String),
     /// The trim points cannot give the structure's `trim_derived` parameters.
+    #[error("trim points: {0}")]
     TrimPoints(String),
 }
 
-impl fmt::Display for FitError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Structure(error) => write!(f, "{error}"),
-            Self::MissingPair {
-                input,
-                output,
-                line,
-            } => write!(
-                f,
-                "line {line}: pair {output}/{input} is not in the frequency-response data"
-            ),
-            Self::NoUsablePairs { skipped } => write!(
-                f,
-                "none of the {skipped} pairs has a usable coherent range in the data (see the skipped pairs; lower the coherence threshold of `sweephold frf` or give explicit ranges)"
-            ),
-            Self::NoValidRange {
-                input,
-                output,
-                line,
-            } => write!(
-                f,
-                "line {line}: pair {output}/{input} has range \"auto\" but its data have no \
-                 valid (coherent) range; give an explicit [lo, hi] or drop the pair"
-            ),
-            Self::BadPairData {
-                input,
-                output,
-                reason,
-            } => write!(f, "pair {output}/{input}: {reason}"),
-            Self::NoPairs => write!(f, "the structure lists no pair to fit"),
-            Self::ParameterCount { expected, got } => {
-                write!(f, "expected {expected} parameter values, got {got}")
-            }
-            Self::SingularSystem { omega } => write!(
-                f,
-                "sM − F is singular at ω = {omega} rad/s (pole on the jω axis or singular M)"
-            ),
-            Self::UnknownPairName { input, output } => {
-                write!(f, "pair {output}/{input} is not in both models")
-            }
-            Self::StartValues(message) => write!(f, "start values: {message}"),
-            Self::TrimPoints(message) => write!(f, "trim points: {message}"),
-        }
-    }
+/// `, line N` after the file name when the line is known.
+fn at_line(line: &Option<usize>) -> String {
+    line.map(|line| format!(", line {line}"))
+        .unwrap_or_default()
 }
 
-impl std::error::Error for FitError {}
-
-impl From<StructureError> for FitError {
-    fn from(error: StructureError) -> Self {
-        Self::Structure(error)
+/// The message of [`StructureProblem::UnusedParameters`]: the names, in backticks.
+fn unused_parameters(names: &[String]) -> String {
+    let listed = names
+        .iter()
+        .map(|name| format!("`{name}`"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if names.len() == 1 {
+        format!("parameter {listed} is declared but used in no matrix entry or delay")
+    } else {
+        format!("parameters {listed} are declared but used in no matrix entry or delay")
     }
 }

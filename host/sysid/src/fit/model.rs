@@ -31,7 +31,7 @@ pub struct Model {
     pub h0: DMatrix<f64>,
     /// Output matrix on state derivatives, outputs × states.
     pub h1: DMatrix<f64>,
-    /// Delay per control [s].
+    /// Delay per control \[s\].
     pub delays: Vec<f64>,
 }
 

@@ -22,7 +22,7 @@
 //!
 //! The eigenvector `x` (of `(A − λI) x = 0`, the right singular vector of the smallest
 //! singular value of `A − λI`) has components in the states' own units: m/s, rad/s, rad.
-//! They are made comparable by expressing each as the attitude [rad] it amounts to in this
+//! They are made comparable by expressing each as the attitude \[rad\] it amounts to in this
 //! mode, `ω_s = max(|λ|, 0.1 rad/s)` being the mode's rate of change:
 //!
 //! ```text
@@ -113,29 +113,18 @@ pub const SPIRAL_SHARE: f64 = 0.25;
 const MAX_ITERATIONS: usize = 10_000;
 
 /// Why the modes of a model cannot be computed.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModeError {
     /// `M` cannot be inverted: `A = M⁻¹F` does not exist.
+    #[error("the mass matrix M is singular: A = M⁻¹F does not exist")]
     SingularMassMatrix,
     /// `M` or `F` has a NaN or an infinite entry, or `M⁻¹F` does (a nearly singular `M`).
+    #[error("M, F or M⁻¹F has a NaN or infinite entry")]
     NotFinite,
     /// The eigenvalue or eigenvector decomposition did not converge.
+    #[error("the eigenvalue decomposition did not converge")]
     NoConvergence,
 }
-
-impl fmt::Display for ModeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ModeError::SingularMassMatrix => {
-                write!(f, "the mass matrix M is singular: A = M⁻¹F does not exist")
-            }
-            ModeError::NotFinite => write!(f, "M, F or M⁻¹F has a NaN or infinite entry"),
-            ModeError::NoConvergence => write!(f, "the eigenvalue decomposition did not converge"),
-        }
-    }
-}
-
-impl std::error::Error for ModeError {}
 
 /// The name of a mode (rules in the module documentation). In JSON and tables: the
 /// strings of [`ModeName::as_str`].
@@ -340,14 +329,14 @@ impl Mode {
             .then(|| -self.eigenvalue.re / self.eigenvalue.norm())
     }
 
-    /// t_2 = ln 2 / Re λ [s] when Re λ > 0 (the envelope's, for a complex pair); None
+    /// t_2 = ln 2 / Re λ \[s\] when Re λ > 0 (the envelope's, for a complex pair); None
     /// otherwise and at the origin.
     pub fn time_to_double_s(&self) -> Option<f64> {
         (self.name != ModeName::Origin && self.eigenvalue.re > 0.0)
             .then(|| LN_2 / self.eigenvalue.re)
     }
 
-    /// t_½ = ln 2 / (−Re λ) [s] when Re λ < 0 (the envelope's, for a complex pair); None
+    /// t_½ = ln 2 / (−Re λ) \[s\] when Re λ < 0 (the envelope's, for a complex pair); None
     /// otherwise and at the origin.
     pub fn time_to_half_s(&self) -> Option<f64> {
         (self.name != ModeName::Origin && self.eigenvalue.re < 0.0)
@@ -576,9 +565,9 @@ pub struct ModeRecord {
     pub omega_n: Option<f64>,
     /// ζ = −Re λ/|λ| of a complex pair; null for a real pole.
     pub zeta: Option<f64>,
-    /// ln 2 / Re λ [s] when unstable; else null.
+    /// ln 2 / Re λ \[s\] when unstable; else null.
     pub time_to_double_s: Option<f64>,
-    /// ln 2 / (−Re λ) [s] when stable; else null.
+    /// ln 2 / (−Re λ) \[s\] when stable; else null.
     pub time_to_half_s: Option<f64>,
     /// Poles the mode stands for: 1 (real) or 2 (complex pair).
     #[serde(default = "one_pole")]

@@ -23,62 +23,14 @@
 //! origin. A parameter kept by any of these rules while it breaks the Cramér–Rao or
 //! insensitivity guideline is flagged [`AccuracyFlag::Needed`] with the reason.
 
-use serde::{Deserialize, Serialize};
-
 use super::cost::PairGrid;
 use super::error::FitError;
 use super::model::Model;
 use super::modes::{eigenvalue_text, modes, pair_modes, relative_error_percent, ModeName};
+pub use super::result::ReductionStep;
+use super::search::fit_on_grids;
 use super::structure::ParameterKind;
-use super::{fit_on_grids, AccuracyFlag, FitOptions, FitResult, ParameterReport, ParameterStatus};
-
-/// One reduction step.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ReductionStep {
-    /// The parameter fixed at zero.
-    pub dropped: String,
-    /// Why it was chosen, e.g. `insensitivity 35.2 %`.
-    pub reason: String,
-    /// J_ave before the step.
-    pub average_cost_before: f64,
-    /// J_ave after refitting without the parameter; infinite (`null` in JSON) when the
-    /// model without it cannot be evaluated or is no state-space model (M singular).
-    #[serde(with = "infinite_as_null")]
-    pub average_cost_after: f64,
-    /// Whether the smaller model was kept.
-    pub accepted: bool,
-    /// The refit moved another parameter by more than
-    /// [`FitOptions::reduce_max_shift_cramer_rao`] of its Cramér–Rao bounds (so the step
-    /// was undone whatever its cost; the reason names the parameter).
-    #[serde(default)]
-    pub left_the_minimum: bool,
-    /// The refit moved a hover mode beyond
-    /// [`FitOptions::reduce_max_hover_mode_shift_percent`] or added a pole at the origin
-    /// (so the step was undone whatever its cost): which mode, from where to where.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub moved_hover_mode: Option<String>,
-}
-
-impl ReductionStep {
-    /// Why an undone step's parameter is needed, in words (None for an accepted step).
-    pub fn needed_because(&self) -> Option<String> {
-        if self.accepted {
-            return None;
-        }
-        Some(if let Some(mode) = &self.moved_hover_mode {
-            format!("without it the refit {mode}")
-        } else if self.left_the_minimum {
-            "without it the refit leaves the minimum".to_string()
-        } else if self.average_cost_after.is_finite() {
-            format!(
-                "without it J_ave rises {:.2} -> {:.2}",
-                self.average_cost_before, self.average_cost_after
-            )
-        } else {
-            "without it the model is unusable".to_string()
-        })
-    }
-}
+use super::{AccuracyFlag, FitOptions, FitResult, ParameterReport, ParameterStatus};
 
 /// How the refit `after` changed the hover modes of `before` (module documentation), in
 /// words, when it moved one by more than `limit_percent` or added a pole at the origin;
@@ -158,24 +110,6 @@ pub(crate) fn flag_needed(result: &mut FitResult) {
         if let Some(reason) = reason {
             report.flags.push(AccuracyFlag::Needed { reason });
         }
-    }
-}
-
-/// JSON has no infinity: a non-finite J is written as `null` and read back as +∞
-/// (serde_json would write `null` and then refuse to read it back into an f64).
-mod infinite_as_null {
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(value: &f64, serializer: S) -> Result<S::Ok, S::Error> {
-        if value.is_finite() {
-            serializer.serialize_f64(*value)
-        } else {
-            serializer.serialize_none()
-        }
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
-        Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::INFINITY))
     }
 }
 

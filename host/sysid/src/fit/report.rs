@@ -102,7 +102,7 @@ pub struct ModelDocument {
     pub outputs: Vec<String>,
     /// M F G H0 H1, row-major.
     pub matrices: ModelMatrices,
-    /// Delay per control [s], in `controls` order.
+    /// Delay per control \[s\], in `controls` order.
     pub delays: Vec<f64>,
     /// Base parameters in structure order, then constrained ones.
     pub parameters: Vec<ParameterReport>,
@@ -218,6 +218,13 @@ impl TruthSection {
 
 fn finite(value: Option<f64>) -> Option<f64> {
     value.filter(|v| v.is_finite())
+}
+
+impl FitResult {
+    /// The `model.json` form.
+    pub fn to_document(&self) -> ModelDocument {
+        ModelDocument::from_result(self)
+    }
 }
 
 impl ModelDocument {

@@ -1,12 +1,6 @@
 //! Coherence-derived quantities: random error, the valid frequency range of a pair, and
-//! the cross-control coherence between controls during a sweep.
-
-use crate::document::CrossCoherence;
-
-use super::analysis::{cross_control_curves, prepare_group};
-use super::options::FrfOptions;
-use super::records::{Record, RecordGroup};
-use super::FrfError;
+//! the estimation bias of a coherence. The cross-control coherence of a sweep, which
+//! uses them, is computed in [`analysis`](super::analysis).
 
 /// Smallest coherence used in [`random_error`], so that the error stays finite.
 const MIN_COHERENCE: f64 = 1e-12;
@@ -26,38 +20,6 @@ pub fn random_error(coherence: f64, independent_windows: f64) -> f64 {
         MIN_COHERENCE
     };
     ((1.0 - g2) / g2).sqrt() / (2.0 * independent_windows.max(1e-12)).sqrt()
-}
-
-/// Equivalent number of independent averages of a Welch estimate: `segments` windows
-/// `window` long, each moved by `hop` samples (Welch 1967, Eq. 17):
-///
-/// ```text
-/// n_eq = K / (1 + 2 Σ_{j=1}^{K−1} (1 − j/K) ρ(j)²),   ρ(j) = Σ_i w_i w_{i+jH} / Σ_i w_i²
-/// ```
-///
-/// For a Hann window at 50 % overlap ρ(1) = 1/6 (so n_eq ≈ 0.95·K); at 80 % overlap
-/// neighbouring windows share most of their data and n_eq ≈ 0.42·K.
-pub fn welch_independent_averages(window: &[f64], hop: usize, segments: usize) -> f64 {
-    let energy: f64 = window.iter().map(|w| w * w).sum();
-    if segments == 0 || energy <= 0.0 || hop == 0 {
-        return segments as f64;
-    }
-    let k = segments as f64;
-    let mut correlation = 0.0;
-    for j in 1..segments {
-        let shift = j * hop;
-        if shift >= window.len() {
-            break;
-        }
-        let overlap: f64 = window
-            .iter()
-            .zip(&window[shift..])
-            .map(|(a, b)| a * b)
-            .sum();
-        let rho = overlap / energy;
-        correlation += (1.0 - j as f64 / k) * rho * rho;
-    }
-    k / (1.0 + 2.0 * correlation)
 }
 
 /// Magnitude-squared coherence corrected for its estimation bias. An estimate from n_d
@@ -146,52 +108,10 @@ fn widest_run(omega: &[f64], flags: impl Iterator<Item = bool>) -> Option<[f64; 
     best.map(|(_, band)| band)
 }
 
-/// Mean cross-control coherence, over the sweep band, between the swept control of
-/// `record` and each other control that is excited in it (the guideline is ≤ 0.5; the
-/// paper's conditional attitude hold reaches 0.17).
-///
-/// The coherence of each control pair is computed with the same windows as the
-/// responses ([`FrfOptions`]: band, windows, overlap, points); at each frequency the
-/// bias-corrected estimates ([`debiased_coherence`]) of the windows spanning at least four
-/// periods of it (at the bottom of the band, where none does, the longest window) are
-/// averaged with weights equal to their equivalent numbers of independent averages
-/// ([`welch_independent_averages`]), and the result is averaged over the log-spaced grid
-/// points, i.e. evenly in log frequency. Four periods rather than the responses' two:
-/// a control driven through delayed or lightly damped dynamics reads as partly unrelated
-/// in windows only two periods long (see `a_control_driven_through_dynamics_reads_coherent`). Controls with no excitation
-/// (RMS below `excitation_ratio` of the swept control's) have no defined coherence and
-/// are left out of the result.
-pub fn cross_control_coherence(
-    record: &Record,
-    opts: &FrfOptions,
-) -> Result<Vec<CrossCoherence>, FrfError> {
-    opts.validate()?;
-    let group = RecordGroup::new(vec![record.clone()])?;
-    let prepared = prepare_group(&group, opts, false)?;
-    let primary = prepared.primary.clone();
-    Ok(cross_control_curves(&prepared, opts)
-        .into_iter()
-        .filter(|curve| curve.a == primary || curve.b == primary)
-        .map(|curve| {
-            let other = if curve.a == primary {
-                curve.b.clone()
-            } else {
-                curve.a.clone()
-            };
-            CrossCoherence {
-                axis: primary.clone(),
-                a: primary.clone(),
-                b: other,
-                mean: curve.mean(),
-            }
-        })
-        .collect())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frf::testing::{record, Block, Noise, Sweep};
+    use crate::frf::spectra::welch_independent_averages;
 
     #[test]
     fn random_error_follows_the_formula() {
@@ -261,98 +181,6 @@ mod tests {
                     .all(|w| w[0] < threshold || w[1] < threshold));
             }
         }
-    }
-
-    #[test]
-    fn independent_and_dependent_controls() {
-        let fs = 50.0;
-        let sweep = Sweep {
-            omega_min: 0.5,
-            omega_max: 20.0,
-            duration: 60.0,
-            amplitude: 0.05,
-        };
-        let len = (60.0 * fs) as usize;
-        let lat: Vec<f64> = (0..len).map(|k| sweep.value(k as f64 / fs)).collect();
-        let mut noise = Noise::new(11);
-        // lon: independent noise; ped: half the sweep plus a little noise; col: constant.
-        let lon: Vec<f64> = (0..len).map(|_| 0.02 * noise.gaussian()).collect();
-        let ped: Vec<f64> = lat
-            .iter()
-            .map(|v| 0.5 * v + 0.002 * noise.gaussian())
-            .collect();
-        let col = vec![0.3; len];
-        let p: Vec<f64> = lat.iter().map(|v| 2.0 * v).collect();
-        let rec = record(
-            fs,
-            [0.5, 20.0],
-            vec![("lat", lat), ("lon", lon), ("ped", ped), ("col", col)],
-            vec![("p", p)],
-        );
-        let result = cross_control_coherence(&rec, &FrfOptions::default()).unwrap();
-        assert_eq!(result.len(), 2, "{result:?}");
-        let lon = result.iter().find(|c| c.b == "lon").unwrap();
-        let ped = result.iter().find(|c| c.b == "ped").unwrap();
-        assert!(lon.mean < 0.3, "independent noise: {}", lon.mean);
-        assert!(ped.mean > 0.9, "dependent control: {}", ped.mean);
-        assert!(result.iter().all(|c| c.a == "lat" && c.axis == "lat"));
-    }
-
-    /// A control that follows the swept one through a lightly damped mode and nothing
-    /// else is exactly coherent with it; the estimate must read it so (two periods per
-    /// window gave 0.77 here), while unrelated noise stays near zero.
-    #[test]
-    fn a_control_driven_through_dynamics_reads_coherent() {
-        let fs = 50.0;
-        let sweep = Sweep {
-            omega_min: 0.2,
-            omega_max: 31.4,
-            duration: 90.0,
-            amplitude: 0.05,
-        };
-        let len = (95.0 * fs) as usize;
-        let lat: Vec<f64> = (0..len).map(|k| sweep.value(k as f64 / fs)).collect();
-        let lon = Block::second_order(1.0, 1.0, 0.3, 0.0).simulate(&|t| sweep.value(t), fs, len, 4);
-        let mut noise = Noise::new(3);
-        let ped: Vec<f64> = (0..len).map(|_| 0.02 * noise.gaussian()).collect();
-        let p: Vec<f64> = lat.iter().map(|v| 2.0 * v).collect();
-        let rec = record(
-            fs,
-            [0.2, 31.4],
-            vec![("lat", lat), ("lon", lon), ("ped", ped)],
-            vec![("p", p)],
-        );
-        let result = cross_control_coherence(&rec, &FrfOptions::default()).unwrap();
-        let mean = |name: &str| result.iter().find(|c| c.b == name).unwrap().mean;
-        assert!(
-            mean("lon") > 0.85,
-            "driven through dynamics: {}",
-            mean("lon")
-        );
-        assert!(mean("ped") < 0.1, "unrelated noise: {}", mean("ped"));
-    }
-
-    #[test]
-    fn welch_averages_of_hann_windows() {
-        let hann = |n: usize| -> Vec<f64> {
-            (0..n)
-                .map(|i| {
-                    (std::f64::consts::PI * (i as f64 + 0.5) / n as f64)
-                        .sin()
-                        .powi(2)
-                })
-                .collect()
-        };
-        let w = hann(1000);
-        // No overlap: every window independent.
-        assert!((welch_independent_averages(&w, 1000, 10) - 10.0).abs() < 1e-12);
-        // 50 % overlap: ρ(1) = 1/6 exactly for the periodic Hann window.
-        let k = 10.0;
-        let expected = k / (1.0 + 2.0 * (1.0 - 1.0 / k) / 36.0);
-        assert!((welch_independent_averages(&w, 500, 10) - expected).abs() < 1e-3);
-        // 80 % overlap: n_eq ≈ 0.42·K.
-        let n80 = welch_independent_averages(&w, 200, 100);
-        assert!((0.40..0.44).contains(&(n80 / 100.0)), "{n80}");
     }
 
     #[test]

@@ -86,9 +86,9 @@ fn field(raw: &str) -> &str {
 /// Load a record from a CSV file.
 pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, FrfError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| FrfError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| FrfError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse_csv(&text, &path.display().to_string(), columns)
 }

@@ -51,9 +51,9 @@ enum Excitation {
 
 fn load_dump_with(path: impl AsRef<Path>, excitation: Excitation) -> Result<Record, FrfError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| FrfError::Io {
+    let bytes = std::fs::read(path).map_err(|error| FrfError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     load_dump_bytes_with(&bytes, &path.display().to_string(), excitation)
 }
@@ -226,7 +226,7 @@ fn record_from_samples_at(
     }
     if header.rate_hz == 0 {
         return Err(FrfError::InvalidRecord {
-            source: source.into(),
+            record: source.into(),
             message: "Header rate is 0 Hz".into(),
         });
     }
@@ -236,7 +236,7 @@ fn record_from_samples_at(
     if let Some((at, before_tick, tick)) = first_step_back(samples) {
         let index = offset + (first - before) + at;
         return Err(FrfError::InvalidRecord {
-            source: source.into(),
+            record: source.into(),
             message: format!("ticks step back at sample {index} (tick {before_tick} → {tick})"),
         });
     }
@@ -250,7 +250,7 @@ fn record_from_samples_at(
     let missing = span.saturating_sub(samples.len());
     if missing as f64 > MAX_MISSING_FRACTION * span as f64 {
         return Err(FrfError::InvalidRecord {
-            source: source.into(),
+            record: source.into(),
             message: format!("{missing} of {span} sweep ticks are missing"),
         });
     }

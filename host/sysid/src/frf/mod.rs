@@ -13,12 +13,13 @@
 //!    log-spaced frequency grid.
 //! 3. [`miso`] — per frequency and window length, the conditioned responses
 //!    `H = Guu⁻¹·Guy` (Cholesky solve), partial and multiple coherence.
-//!    With a feedback controller in the loop, [`reference`] solves `G_zu·H = G_zy`
+//!    With a feedback controller in the loop, [`reference`](mod@reference) solves `G_zu·H = G_zy`
 //!    with the recorded sweep as instrument z instead (an option).
 //! 4. [`composite`] — per frequency, the window-length estimates are blended with
 //!    weights 1/εr².
-//! 5. [`coherence`] — random error, valid ranges, cross-control coherence.
-//! 6. [`analysis`] — the whole computation into an [`FrfDocument`].
+//! 5. [`coherence`] — random error, valid ranges, coherence bias.
+//! 6. [`analysis`] — the whole computation into an [`FrfDocument`], and the
+//!    cross-control coherence.
 //!
 //! ```no_run
 //! use sysid::frf::{compute_frequency_responses, group_by_primary, load_dump, FrfOptions};
@@ -52,34 +53,38 @@ pub mod spectra;
 pub(crate) mod testing;
 
 pub use analysis::{
-    analyse, compute_frequency_responses, CoherenceCurve, FrfAnalysis, GroupSummary,
-    MultipleCoherence,
+    analyse, compute_frequency_responses, cross_control_coherence, CoherenceCurve, FrfAnalysis,
+    GroupSummary, MultipleCoherence,
 };
 pub use chirp_z::{chirp_z, ChirpZ};
-pub use coherence::{
-    cross_control_coherence, debiased_coherence, random_error, valid_range,
-    welch_independent_averages,
-};
+pub use coherence::{debiased_coherence, random_error, valid_range};
 pub use csv::{load_csv, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };
 pub use options::{FrfOptions, ResponseEstimator, ResponseInputs};
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
+pub use spectra::welch_independent_averages;
 
 use std::path::PathBuf;
 
 /// Why frequency responses could not be computed. Every message fits on one line.
-#[derive(Debug)]
+///
+/// No variant has a `source()`: where one wraps an error (the I/O cause), its message is
+/// part of this one already (`path: cause`), and error chains printed with `{:#}` would
+/// say it twice.
+#[derive(Debug, thiserror::Error)]
 pub enum FrfError {
     /// A file could not be read or written.
+    #[error("{}: {error}", .path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// The error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The dump was written with another protocol major version.
+    #[error("{path}: {message}")]
     Protocol {
         /// The dump.
         path: String,
@@ -87,12 +92,14 @@ pub enum FrfError {
         message: String,
     },
     /// The dump has no Header frame: rate and primary axis are unknown.
+    #[error("{path}: no Header frame (sample rate and swept axis unknown)")]
     NoHeader {
         /// The dump.
         path: String,
     },
     /// The dump holds no sweep (no Sample in the fade-in, sweep or fade-out phases, or
     /// the test was not a sweep).
+    #[error("{path}: no sweep in this dump ({detail})")]
     NoSweep {
         /// The dump.
         path: String,
@@ -100,6 +107,7 @@ pub enum FrfError {
         detail: String,
     },
     /// A CSV file is malformed.
+    #[error("{path}{}: {message}", csv_line(.line))]
     Csv {
         /// The file.
         path: String,
@@ -109,21 +117,27 @@ pub enum FrfError {
         message: String,
     },
     /// A record is unusable (inconsistent lengths, non-finite values, bad rate, …).
+    #[error("{record}: {message}")]
     InvalidRecord {
-        /// The record's source.
-        source: String,
+        /// The record's source (file name or label).
+        record: String,
         /// What is wrong.
         message: String,
     },
     /// Records grouped together disagree (primary axis, rate, channel names).
+    #[error("records do not fit together: {0}")]
     InconsistentGroup(String),
     /// Two groups sweep the same axis.
+    #[error("two record groups sweep `{0}`: put its records in one group")]
     DuplicateAxis(String),
     /// No record was given.
+    #[error("no records given")]
     NoRecords,
     /// The sweep band is unknown (CSV records carry none and no band was given).
+    #[error("{0}")]
     NoBand(String),
     /// The records are too short for the band and windows asked for.
+    #[error("{axis} sweep: record of {seconds:.1} s is too short: {detail}")]
     RecordTooShort {
         /// Primary axis of the group.
         axis: String,
@@ -133,69 +147,21 @@ pub enum FrfError {
         detail: String,
     },
     /// The swept input of a group does not move.
+    #[error("{axis} sweep: the swept input `{axis}` has no excitation (constant)")]
     NoExcitation {
         /// Primary axis of the group.
         axis: String,
     },
     /// An option is out of range.
+    #[error("invalid option: {0}")]
     InvalidOption(String),
 }
 
-impl std::fmt::Display for FrfError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            FrfError::Io { path, source } => write!(f, "{}: {source}", path.display()),
-            FrfError::Protocol { path, message } => write!(f, "{path}: {message}"),
-            FrfError::NoHeader { path } => {
-                write!(
-                    f,
-                    "{path}: no Header frame (sample rate and swept axis unknown)"
-                )
-            }
-            FrfError::NoSweep { path, detail } => {
-                write!(f, "{path}: no sweep in this dump ({detail})")
-            }
-            FrfError::Csv {
-                path,
-                line,
-                message,
-            } if *line > 0 => {
-                write!(f, "{path}:{line}: {message}")
-            }
-            FrfError::Csv { path, message, .. } => write!(f, "{path}: {message}"),
-            FrfError::InvalidRecord { source, message } => write!(f, "{source}: {message}"),
-            FrfError::InconsistentGroup(message) => {
-                write!(f, "records do not fit together: {message}")
-            }
-            FrfError::DuplicateAxis(axis) => {
-                write!(
-                    f,
-                    "two record groups sweep `{axis}`: put its records in one group"
-                )
-            }
-            FrfError::NoRecords => write!(f, "no records given"),
-            FrfError::NoBand(message) => write!(f, "{message}"),
-            FrfError::RecordTooShort {
-                axis,
-                seconds,
-                detail,
-            } => {
-                write!(
-                    f,
-                    "{axis} sweep: record of {seconds:.1} s is too short: {detail}"
-                )
-            }
-            FrfError::NoExcitation { axis } => {
-                write!(
-                    f,
-                    "{axis} sweep: the swept input `{axis}` has no excitation (constant)"
-                )
-            }
-            FrfError::InvalidOption(message) => write!(f, "invalid option: {message}"),
-        }
+/// `:N` after a CSV file's name for a problem on line N (none for the whole file, 0).
+fn csv_line(line: &usize) -> String {
+    if *line > 0 {
+        format!(":{line}")
+    } else {
+        String::new()
     }
 }
-
-/// The I/O cause is part of the message already (`path: cause`), so no `source()`:
-/// error chains printed with `{:#}` would say it twice.
-impl std::error::Error for FrfError {}

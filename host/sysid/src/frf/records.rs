@@ -117,7 +117,7 @@ impl Record {
     pub fn validate(&self) -> Result<(), FrfError> {
         let bad = |message: String| {
             Err(FrfError::InvalidRecord {
-                source: self.source.clone(),
+                record: self.source.clone(),
                 message,
             })
         };

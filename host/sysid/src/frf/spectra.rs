@@ -32,7 +32,6 @@ use num_complex::Complex64;
 use rustfft::FftPlanner;
 
 use super::chirp_z::{separate_pair, ChirpZ};
-use super::coherence::welch_independent_averages;
 
 /// `points` frequencies log-spaced from `lo` to `hi` inclusive.
 pub fn log_grid(lo: f64, hi: f64, points: usize) -> Vec<f64> {
@@ -306,6 +305,38 @@ fn one_window_length(
     spectra
 }
 
+/// Equivalent number of independent averages of a Welch estimate: `segments` windows
+/// `window` long, each moved by `hop` samples (Welch 1967, Eq. 17):
+///
+/// ```text
+/// n_eq = K / (1 + 2 Σ_{j=1}^{K−1} (1 − j/K) ρ(j)²),   ρ(j) = Σ_i w_i w_{i+jH} / Σ_i w_i²
+/// ```
+///
+/// For a Hann window at 50 % overlap ρ(1) = 1/6 (so n_eq ≈ 0.95·K); at 80 % overlap
+/// neighbouring windows share most of their data and n_eq ≈ 0.42·K.
+pub fn welch_independent_averages(window: &[f64], hop: usize, segments: usize) -> f64 {
+    let energy: f64 = window.iter().map(|w| w * w).sum();
+    if segments == 0 || energy <= 0.0 || hop == 0 {
+        return segments as f64;
+    }
+    let k = segments as f64;
+    let mut correlation = 0.0;
+    for j in 1..segments {
+        let shift = j * hop;
+        if shift >= window.len() {
+            break;
+        }
+        let overlap: f64 = window
+            .iter()
+            .zip(&window[shift..])
+            .map(|(a, b)| a * b)
+            .sum();
+        let rho = overlap / energy;
+        correlation += (1.0 - j as f64 / k) * rho * rho;
+    }
+    k / (1.0 + 2.0 * correlation)
+}
+
 /// acc_k += a_k*·b_k
 fn accumulate_cross(acc: &mut [Complex64], a: &[Complex64], b: &[Complex64]) {
     for ((acc, a), b) in acc.iter_mut().zip(a).zip(b) {
@@ -380,5 +411,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn welch_averages_of_hann_windows() {
+        let hann = |n: usize| -> Vec<f64> {
+            (0..n)
+                .map(|i| {
+                    (std::f64::consts::PI * (i as f64 + 0.5) / n as f64)
+                        .sin()
+                        .powi(2)
+                })
+                .collect()
+        };
+        let w = hann(1000);
+        // No overlap: every window independent.
+        assert!((welch_independent_averages(&w, 1000, 10) - 10.0).abs() < 1e-12);
+        // 50 % overlap: ρ(1) = 1/6 exactly for the periodic Hann window.
+        let k = 10.0;
+        let expected = k / (1.0 + 2.0 * (1.0 - 1.0 / k) / 36.0);
+        assert!((welch_independent_averages(&w, 500, 10) - expected).abs() < 1e-3);
+        // 80 % overlap: n_eq ≈ 0.42·K.
+        let n80 = welch_independent_averages(&w, 200, 100);
+        assert!((0.40..0.44).contains(&(n80 / 100.0)), "{n80}");
     }
 }

@@ -39,15 +39,13 @@
 //! fit iterates: fit with θ_T free, derive θ_T, hold it (status `trim`) and refit from
 //! there, re-derive, until θ_T moves less than [`SETTLED_RELATIVE_CHANGE`].
 
-use std::fmt;
-
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::structure::ModelStructure;
 
 /// The state columns of a trim-point file, in their order in [`TrimPoint::states`]:
-/// body velocities [m/s], body rates [rad/s], attitude [rad].
+/// body velocities [m/s], body rates [rad/s], attitude \[rad\].
 pub const STATE_COLUMNS: [&str; 8] = ["u", "v", "w", "p", "q", "r", "phi", "theta"];
 /// The stick columns, in their order in [`TrimPoint::controls`] (fractions of travel).
 pub const CONTROL_COLUMNS: [&str; 4] = ["lat", "lon", "ped", "col"];
@@ -63,7 +61,7 @@ pub const MAX_ROUNDS: usize = 6;
 pub struct TrimPoint {
     /// Free text (`hover`, `forward`, …); may be empty.
     pub label: String,
-    /// u v w [m/s], p q r [rad/s], φ θ [rad] ([`STATE_COLUMNS`]).
+    /// u v w [m/s], p q r [rad/s], φ θ \[rad\] ([`STATE_COLUMNS`]).
     pub states: [f64; 8],
     /// lat lon ped col stick fractions ([`CONTROL_COLUMNS`]).
     pub controls: [f64; 4],
@@ -77,9 +75,10 @@ pub struct TrimPoints {
 }
 
 /// What is wrong with a trim-point file or a derivation.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum TrimError {
     /// The CSV text is malformed (line number, 1-based, and what is wrong).
+    #[error("line {line}: {reason}")]
     Csv {
         /// Line of the problem.
         line: usize,
@@ -87,46 +86,29 @@ pub enum TrimError {
         reason: String,
     },
     /// Fewer than two points: no gradient.
+    #[error("{0} trim point(s): at least two are needed for a gradient")]
     TooFewPoints(usize),
     /// A derived parameter appears in M or among the hidden states' own couplings (F_hh),
     /// so the balance is not linear in it.
+    #[error(
+        "`{0}` couples the states the trim points do not give (or is in M): it cannot be derived from trim points"
+    )]
     NotLinear(String),
     /// The hidden states' rows cannot be solved (F_hh singular).
+    #[error("the rows of the states the trim points do not give cannot be solved (singular)")]
     HiddenStatesSingular,
     /// The points do not vary the state a derived parameter multiplies.
+    #[error(
+        "the trim points do not vary what `{parameter}` multiplies: add points that do (see docs/formats.md, trim points)"
+    )]
     NotInformed {
         /// The parameter.
         parameter: String,
     },
     /// The model could not be built from the values.
+    #[error("{0}")]
     Model(String),
 }
-
-impl fmt::Display for TrimError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TrimError::Csv { line, reason } => write!(f, "line {line}: {reason}"),
-            TrimError::TooFewPoints(n) => {
-                write!(f, "{n} trim point(s): at least two are needed for a gradient")
-            }
-            TrimError::NotLinear(name) => write!(
-                f,
-                "`{name}` couples the states the trim points do not give (or is in M): it cannot be derived from trim points"
-            ),
-            TrimError::HiddenStatesSingular => write!(
-                f,
-                "the rows of the states the trim points do not give cannot be solved (singular)"
-            ),
-            TrimError::NotInformed { parameter } => write!(
-                f,
-                "the trim points do not vary what `{parameter}` multiplies: add points that do (see docs/formats.md, trim points)"
-            ),
-            TrimError::Model(message) => write!(f, "{message}"),
-        }
-    }
-}
-
-impl std::error::Error for TrimError {}
 
 impl TrimPoints {
     /// Parse the CSV form: a header naming the columns (`label` optional, then every one

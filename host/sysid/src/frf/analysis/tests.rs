@@ -2,7 +2,9 @@
 
 use num_complex::Complex64;
 
+use super::responses::anchor_phase_branch;
 use super::*;
+use crate::frf::options::{ResponseEstimator, ResponseInputs};
 use crate::frf::records::Channel;
 use crate::frf::testing::{add_noise, dump_bytes, record, sample, Block, DumpSpec, Noise, Sweep};
 use crate::frf::{load_dump_bytes, Record, RecordGroup};

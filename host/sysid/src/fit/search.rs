@@ -1,0 +1,228 @@
+//! The multi-start search: Levenberg–Marquardt from the structure's start values, then
+//! from perturbed ones, until the same minimum is found twice ([`super::optimizer`]);
+//! then the accuracy analysis and the report at the best minimum.
+
+use nalgebra::DVector;
+
+use super::cost::{self, PairGrid};
+use super::error::FitError;
+use super::optimizer;
+use super::result::parameter_reports;
+use super::structure::ModelStructure;
+use super::{accuracy, FitOptions, FitResult, PairFit, StartOutcome};
+
+/// What a free parameter starting at exactly zero starts at instead (the first start;
+/// the perturbed ones add spread·U(−1, 1)·0.1 to it).
+const ZERO_START_NUDGE: f64 = 1e-3;
+
+/// Base-parameter vector with the free entries replaced by `free_values`.
+fn merge(base: &[f64], free: &[usize], free_values: &DVector<f64>) -> Vec<f64> {
+    let mut values = base.to_vec();
+    for (k, &index) in free.iter().enumerate() {
+        values[index] = free_values[k];
+    }
+    values
+}
+
+/// Multi-start fit on prepared grids, then the accuracy analysis.
+pub(crate) fn fit_on_grids(
+    structure: &ModelStructure,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let mut search = StartSearch::new(options.seed);
+    search_minima(structure, grids, options, options.max_starts, &mut search)?;
+    finish_fit(structure, grids, options, search)
+}
+
+/// The state of a multi-start search: where its random perturbations stand and what each
+/// start reached, so that a search stopped after a share of the starts can go on where
+/// it stopped ([`fit_from_alternative_starts`]) instead of repeating them.
+#[derive(Clone, Debug)]
+pub(super) struct StartSearch {
+    random: crate::random::SplitMix64,
+    /// Starts made so far (including those that could not be evaluated).
+    attempts: usize,
+    starts: Vec<StartOutcome>,
+    /// Final parameter vector and J_ave of each evaluated start.
+    finals: Vec<(DVector<f64>, f64)>,
+    minimum_confirmed: bool,
+    last_error: Option<FitError>,
+}
+
+impl StartSearch {
+    pub(super) fn new(seed: u64) -> Self {
+        StartSearch {
+            random: crate::random::SplitMix64::new(seed),
+            attempts: 0,
+            starts: Vec::new(),
+            finals: Vec::new(),
+            minimum_confirmed: false,
+            last_error: None,
+        }
+    }
+}
+
+/// Levenberg–Marquardt from the structure's start values, then from perturbed ones, until
+/// the best minimum has been reached twice or `max_starts` starts have been made in all.
+pub(super) fn search_minima(
+    structure: &ModelStructure,
+    grids: &[PairGrid],
+    options: &FitOptions,
+    max_starts: usize,
+    search: &mut StartSearch,
+) -> Result<(), FitError> {
+    let base = structure.values();
+    let free = structure.free_indices();
+    let n_pairs = grids.len() as f64;
+    let bounds = optimizer::Bounds {
+        lower: free
+            .iter()
+            .map(|&i| structure.parameters[i].lower)
+            .collect(),
+        upper: free
+            .iter()
+            .map(|&i| structure.parameters[i].upper)
+            .collect(),
+    };
+    let rules = optimizer::StoppingRules {
+        max_iterations: options.max_iterations,
+        ..optimizer::StoppingRules::default()
+    };
+    let evaluate = |x: &DVector<f64>, with_jacobian: bool| {
+        let values = merge(&base, &free, x);
+        if with_jacobian {
+            let (r, j) = cost::residuals_and_jacobian(structure, &values, &free, grids)?;
+            Ok((r, Some(j)))
+        } else {
+            let model = structure.model(&values)?;
+            Ok((DVector::from_vec(cost::residuals(&model, grids)?), None))
+        }
+    };
+
+    let first_start = DVector::from_iterator(free.len(), free.iter().map(|&i| base[i]));
+    let tolerance = |a: f64, b: f64| {
+        (a - b).abs() <= options.same_minimum_tolerance * a.abs().max(b.abs()).max(1.0)
+    };
+    while !search.minimum_confirmed && search.attempts < max_starts.max(1) {
+        let start_number = search.attempts;
+        search.attempts += 1;
+        let start = if start_number == 0 {
+            let mut x = first_start.clone();
+            // A free parameter at exactly zero makes the responses it alone carries
+            // exactly zero, −600 dB on the magnitude floor: J ~10⁶ and a log-magnitude
+            // residual with no usable gradient, so the start goes nowhere (the 6-DOF
+            // file's zero couplings: its first start ended at J_ave 1.8·10⁶, now 63).
+            for value in x.iter_mut().filter(|value| **value == 0.0) {
+                *value = ZERO_START_NUDGE;
+            }
+            bounds.project(&mut x);
+            x
+        } else {
+            optimizer::perturbed_start(
+                &first_start,
+                options.start_spread,
+                0.1,
+                &bounds,
+                &mut search.random,
+            )
+        };
+        if free.is_empty() {
+            search.finals.push((start, f64::NAN));
+            break;
+        }
+        match optimizer::levenberg_marquardt(evaluate, start, &bounds, &rules) {
+            Ok(outcome) => {
+                let average_cost = outcome.cost / n_pairs;
+                search.starts.push(StartOutcome {
+                    average_cost: Some(average_cost),
+                    iterations: outcome.iterations,
+                    stop: format!("{:?}", outcome.reason),
+                });
+                search.finals.push((outcome.x, average_cost));
+            }
+            Err(FitError::SingularSystem { omega }) => {
+                search.starts.push(StartOutcome {
+                    average_cost: None,
+                    iterations: 0,
+                    stop: format!("start not evaluable (singular at ω = {omega})"),
+                });
+                search.last_error = Some(FitError::SingularSystem { omega });
+                continue;
+            }
+            Err(other) => return Err(other),
+        }
+        let best = search
+            .finals
+            .iter()
+            .map(|(_, j)| *j)
+            .fold(f64::INFINITY, f64::min);
+        let hits = search
+            .finals
+            .iter()
+            .filter(|(_, j)| tolerance(*j, best))
+            .count();
+        search.minimum_confirmed = hits >= 2;
+    }
+    Ok(())
+}
+
+/// The best minimum of a search, with its accuracy analysis and report.
+pub(super) fn finish_fit(
+    structure: &ModelStructure,
+    grids: &[PairGrid],
+    options: &FitOptions,
+    search: StartSearch,
+) -> Result<FitResult, FitError> {
+    let base = structure.values();
+    let free = structure.free_indices();
+    let StartSearch {
+        starts,
+        finals,
+        minimum_confirmed,
+        last_error,
+        ..
+    } = search;
+    let best = finals
+        .iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(x, _)| x.clone());
+    let Some(best) = best else {
+        return Err(last_error.unwrap_or(FitError::NoPairs));
+    };
+    let values = merge(&base, &free, &best);
+    let (residual, jacobian) = cost::residuals_and_jacobian(structure, &values, &free, grids)?;
+    let costs = cost::pair_costs_from_residuals(grids, residual.as_slice());
+    let analysis = accuracy::analyse(&jacobian);
+    let fitted_structure = structure.with_values(&values)?;
+    let model = structure.model(&values)?;
+    let parameters = parameter_reports(&fitted_structure, &values, &free, &analysis, options);
+    Ok(FitResult {
+        pairs: grids
+            .iter()
+            .zip(&costs)
+            .map(|(grid, &cost)| PairFit {
+                input: grid.input.clone(),
+                output: grid.output.clone(),
+                range: grid.range,
+                cost,
+            })
+            .collect(),
+        average_cost: cost::average(&costs),
+        correlation_names: free
+            .iter()
+            .map(|&i| structure.parameters[i].name.clone())
+            .collect(),
+        correlation: analysis.correlation.clone(),
+        hessian_singular: analysis.singular,
+        structure: fitted_structure,
+        values,
+        model,
+        parameters,
+        starts,
+        minimum_confirmed,
+        reduction: Vec::new(),
+        skipped_pairs: Vec::new(),
+        trim: None,
+    })
+}

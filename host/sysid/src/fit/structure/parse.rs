@@ -1,0 +1,460 @@
+//! Reading a structure file: TOML text → [`ModelStructure`], every error with its line.
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::path::Path;
+
+use toml::Spanned;
+
+use super::schema::{
+    explain_syntax, line_of, Context, RawParameter, RawRange, RawRows, RawStructure, RawValue,
+};
+use super::validate::{check_band, check_every_parameter_is_used, file_constants};
+use super::{
+    DerivedParameter, MatrixEntry, MatrixName, ModelStructure, PairRange, PairSpec, Parameter,
+    ParameterExpression, ParameterKind,
+};
+use crate::fit::error::{StructureError, StructureProblem};
+use crate::fit::expression::{parse_linear_with_constants, LinearForm};
+
+/// Resolves expressions against base and constrained parameters.
+struct Resolver<'a> {
+    base: &'a HashMap<String, usize>,
+    derived_forms: &'a HashMap<String, LinearForm>,
+}
+
+impl Resolver<'_> {
+    /// Substitute constrained parameters (recursively) and map names to base indices.
+    fn resolve(
+        &self,
+        form: &LinearForm,
+        visiting: &mut Vec<String>,
+    ) -> Result<ParameterExpression, StructureProblem> {
+        let mut constant = form.constant;
+        let mut coefficients: BTreeMap<usize, f64> = BTreeMap::new();
+        for (name, &coefficient) in &form.terms {
+            if let Some(&index) = self.base.get(name) {
+                *coefficients.entry(index).or_insert(0.0) += coefficient;
+            } else if let Some(inner) = self.derived_forms.get(name) {
+                if visiting.contains(name) {
+                    return Err(StructureProblem::CyclicConstraint(name.clone()));
+                }
+                visiting.push(name.clone());
+                let resolved = self.resolve(inner, visiting)?;
+                visiting.pop();
+                constant += coefficient * resolved.constant;
+                for (index, inner_coefficient) in resolved.terms {
+                    *coefficients.entry(index).or_insert(0.0) += coefficient * inner_coefficient;
+                }
+            } else {
+                return Err(StructureProblem::UndefinedParameter(name.clone()));
+            }
+        }
+        Ok(ParameterExpression {
+            constant,
+            terms: coefficients
+                .into_iter()
+                .filter(|&(_, c)| c != 0.0)
+                .collect(),
+        })
+    }
+}
+
+impl ModelStructure {
+    /// Parse a structure from TOML text; `source_name` names it in error messages.
+    pub fn parse(text: &str, source_name: &str) -> Result<Self, StructureError> {
+        Self::parse_with_constants(text, source_name, &BTreeMap::new())
+    }
+
+    /// Parse a structure with some of its `[constants]` replaced — the same structure for
+    /// another aircraft (its hub height, say). Overriding a constant the file does not
+    /// declare is an error, so a misspelt name cannot pass unnoticed.
+    pub fn parse_with_constants(
+        text: &str,
+        source_name: &str,
+        overrides: &BTreeMap<String, f64>,
+    ) -> Result<Self, StructureError> {
+        let context = Context { text, source_name };
+        let raw: RawStructure = toml::from_str(text).map_err(|error| StructureError {
+            source_name: source_name.to_string(),
+            line: error.span().map(|span| line_of(text, span.start)),
+            problem: StructureProblem::Syntax(explain_syntax(error.message())),
+        })?;
+        Self::from_raw(raw, &context, overrides)
+    }
+
+    /// Read and parse a structure file.
+    pub fn from_path(path: &Path) -> Result<Self, StructureError> {
+        Self::from_path_with_constants(path, &BTreeMap::new())
+    }
+
+    /// Read and parse a structure file with some of its `[constants]` replaced (see
+    /// [`Self::parse_with_constants`]).
+    pub fn from_path_with_constants(
+        path: &Path,
+        overrides: &BTreeMap<String, f64>,
+    ) -> Result<Self, StructureError> {
+        let source_name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|error| StructureError {
+            source_name: source_name.clone(),
+            line: None,
+            problem: StructureProblem::Io(error.to_string()),
+        })?;
+        Self::parse_with_constants(&text, &source_name, overrides)
+    }
+
+    fn from_raw(
+        raw: RawStructure,
+        context: &Context<'_>,
+        overrides: &BTreeMap<String, f64>,
+    ) -> Result<Self, StructureError> {
+        let states = context.names(&raw.states, "state")?;
+        let controls = context.names(&raw.controls, "control")?;
+        let outputs = context.names(&raw.outputs, "output")?;
+
+        let constants = file_constants(&raw, context, overrides)?;
+        if states.is_empty() || controls.is_empty() || outputs.is_empty() {
+            return Err(context.error(
+                raw.name.span(),
+                StructureProblem::Syntax("states, controls and outputs must not be empty".into()),
+            ));
+        }
+
+        // Parameters, in file order.
+        let mut raw_parameters: Vec<_> = raw.parameters.into_iter().collect();
+        raw_parameters.sort_by_key(|(key, _)| key.span().start);
+        let mut parameters = Vec::new();
+        let mut base_index = HashMap::new();
+        let mut derived_forms = HashMap::new();
+        let mut derived_order = Vec::new();
+        for (key, value) in &raw_parameters {
+            let name = key.get_ref().clone();
+            let line = context.line(key.span());
+            let bad = |reason: &str| {
+                context.error(
+                    key.span(),
+                    StructureProblem::BadParameter {
+                        name: name.clone(),
+                        reason: reason.to_string(),
+                    },
+                )
+            };
+            let not_finite = |what: String, number: f64| {
+                context.error(
+                    key.span(),
+                    StructureProblem::NotFinite {
+                        what,
+                        value: number,
+                    },
+                )
+            };
+            match value.get_ref() {
+                RawParameter::Start(start) => {
+                    if !start.is_finite() {
+                        return Err(not_finite(format!("parameter `{name}`"), *start));
+                    }
+                    base_index.insert(name.clone(), parameters.len());
+                    parameters.push(Parameter {
+                        name,
+                        value: *start,
+                        kind: ParameterKind::Free,
+                        lower: None,
+                        upper: None,
+                        line,
+                    });
+                }
+                RawParameter::Table(table) => {
+                    let given = usize::from(table.start.is_some())
+                        + usize::from(table.fixed.is_some())
+                        + usize::from(table.expr.is_some());
+                    if given != 1 {
+                        return Err(bad("give exactly one of `start`, `fixed`, `expr`"));
+                    }
+                    for (label, number) in [
+                        ("", table.start),
+                        ("", table.fixed),
+                        (": min", table.min),
+                        (": max", table.max),
+                    ] {
+                        if let Some(number) = number.filter(|n| !n.is_finite()) {
+                            return Err(not_finite(format!("parameter `{name}`{label}"), number));
+                        }
+                    }
+                    if let (Some(lo), Some(hi)) = (table.min, table.max) {
+                        if lo >= hi {
+                            return Err(bad("`min` must be below `max`"));
+                        }
+                    }
+                    if let Some(expression) = &table.expr {
+                        if table.min.is_some() || table.max.is_some() {
+                            return Err(bad("a constrained parameter cannot have bounds"));
+                        }
+                        let form = parse_linear_with_constants(expression, &constants).map_err(
+                            |reason| {
+                                context.error(
+                                    value.span(),
+                                    StructureProblem::BadExpression {
+                                        expression: expression.clone(),
+                                        reason,
+                                    },
+                                )
+                            },
+                        )?;
+                        derived_forms.insert(name.clone(), form);
+                        derived_order.push((name, line, value.span()));
+                    } else {
+                        let (value, kind) = match (table.start, table.fixed) {
+                            (Some(start), None) => (start, ParameterKind::Free),
+                            (None, Some(fixed)) => (fixed, ParameterKind::Fixed),
+                            _ => unreachable!("exactly one of start/fixed was checked above"),
+                        };
+                        if table.min.is_some_and(|lo| value < lo)
+                            || table.max.is_some_and(|hi| value > hi)
+                        {
+                            return Err(bad("the value lies outside [min, max]"));
+                        }
+                        base_index.insert(name.clone(), parameters.len());
+                        parameters.push(Parameter {
+                            name,
+                            value,
+                            kind,
+                            lower: table.min,
+                            upper: table.max,
+                            line,
+                        });
+                    }
+                }
+            }
+        }
+
+        let resolver = Resolver {
+            base: &base_index,
+            derived_forms: &derived_forms,
+        };
+        let mut derived = Vec::new();
+        for (name, line, span) in derived_order {
+            let mut visiting = vec![name.clone()];
+            let expression = resolver
+                .resolve(&derived_forms[&name], &mut visiting)
+                .map_err(|problem| context.error(span.clone(), problem))?;
+            derived.push(DerivedParameter {
+                name,
+                expression,
+                line,
+            });
+        }
+
+        // Parameter names the matrix entries and delays refer to (constrained ones too).
+        let mut referenced: BTreeSet<String> = BTreeSet::new();
+        let mut resolve_value = |value: &Spanned<RawValue>,
+                                 what: &dyn Fn() -> String|
+         -> Result<ParameterExpression, StructureError> {
+            match value.get_ref() {
+                RawValue::Number(number) if !number.is_finite() => Err(context.error(
+                    value.span(),
+                    StructureProblem::NotFinite {
+                        what: what(),
+                        value: *number,
+                    },
+                )),
+                RawValue::Number(number) => Ok(ParameterExpression {
+                    constant: *number,
+                    terms: Vec::new(),
+                }),
+                RawValue::Expression(text) => {
+                    let form = parse_linear_with_constants(text, &constants).map_err(|reason| {
+                        context.error(
+                            value.span(),
+                            StructureProblem::BadExpression {
+                                expression: text.clone(),
+                                reason,
+                            },
+                        )
+                    })?;
+                    referenced.extend(form.terms.keys().cloned());
+                    resolver
+                        .resolve(&form, &mut Vec::new())
+                        .map_err(|problem| context.error(value.span(), problem))
+                }
+            }
+        };
+
+        // Matrix entries.
+        let mut entries = Vec::new();
+        let matrices: [(MatrixName, &RawRows); 5] = [
+            (MatrixName::M, &raw.m),
+            (MatrixName::F, &raw.f),
+            (MatrixName::G, &raw.g),
+            (MatrixName::H0, &raw.h0),
+            (MatrixName::H1, &raw.h1),
+        ];
+        let mut rows_with_measurement = vec![false; outputs.len()];
+        for (matrix, rows) in matrices {
+            let (row_names, row_kind, column_names, column_kind) = match matrix {
+                MatrixName::M | MatrixName::F => (&states, "state", &states, "state"),
+                MatrixName::G => (&states, "state", &controls, "control"),
+                MatrixName::H0 | MatrixName::H1 => (&outputs, "output", &states, "state"),
+            };
+            for (row_key, columns) in rows {
+                let row = context.index_of(row_names, row_key, row_kind)?;
+                if matches!(matrix, MatrixName::H0 | MatrixName::H1) {
+                    rows_with_measurement[row] = true;
+                }
+                for (column_key, value) in columns {
+                    let column = context.index_of(column_names, column_key, column_kind)?;
+                    let what = || {
+                        format!(
+                            "entry {}[{}, {}]",
+                            matrix.as_str(),
+                            row_key.get_ref(),
+                            column_key.get_ref()
+                        )
+                    };
+                    entries.push(MatrixEntry {
+                        matrix,
+                        row,
+                        column,
+                        expression: resolve_value(value, &what)?,
+                        line: context.line(column_key.span()),
+                    });
+                }
+            }
+        }
+        entries.sort_by_key(|entry| entry.line);
+
+        // Outputs that are states and have no measurement row measure that state.
+        let default_output_states = outputs
+            .iter()
+            .enumerate()
+            .filter(|&(index, _)| !rows_with_measurement[index])
+            .filter_map(|(index, name)| {
+                states
+                    .iter()
+                    .position(|state| state == name)
+                    .map(|state| (index, state))
+            })
+            .collect();
+
+        let mut delays = vec![ParameterExpression::default(); controls.len()];
+        for (key, value) in &raw.delays {
+            let control = context.index_of(&controls, key, "control")?;
+            delays[control] = resolve_value(value, &|| format!("delay of `{}`", key.get_ref()))?;
+        }
+        check_every_parameter_is_used(
+            context,
+            &raw_parameters,
+            &base_index,
+            &derived_forms,
+            referenced,
+            entries.iter().map(|entry| &entry.expression).chain(&delays),
+        )?;
+
+        let auto_range_limit = match &raw.auto_range_limit {
+            None => None,
+            Some(band) => Some(check_band(band.get_ref()).map_err(|reason| {
+                context.error(band.span(), StructureProblem::BadRange(reason))
+            })?),
+        };
+
+        let mut pairs: Vec<PairSpec> = Vec::new();
+        for pair in &raw.pairs {
+            let pair_ref = pair.get_ref();
+            let input_index = context.index_of(&controls, &pair_ref.input, "control")?;
+            let output_index = context.index_of(&outputs, &pair_ref.output, "output")?;
+            let line = context.line(pair.span());
+            let range = match &pair_ref.range {
+                None => PairRange::Auto,
+                Some(range) => match range.get_ref() {
+                    RawRange::Keyword(keyword) if keyword == "auto" => PairRange::Auto,
+                    RawRange::Keyword(keyword) => {
+                        return Err(context.error(
+                            range.span(),
+                            StructureProblem::BadRange(format!(
+                                "`{keyword}`: expected \"auto\" or [lo, hi]"
+                            )),
+                        ))
+                    }
+                    RawRange::Band(band) => {
+                        PairRange::Explicit(check_band(band).map_err(|reason| {
+                            context.error(range.span(), StructureProblem::BadRange(reason))
+                        })?)
+                    }
+                },
+            };
+            if pairs
+                .iter()
+                .any(|p| p.input_index == input_index && p.output_index == output_index)
+            {
+                return Err(context.error(
+                    pair.span(),
+                    StructureProblem::DuplicateName(format!(
+                        "pair {}/{}",
+                        pair_ref.output.get_ref(),
+                        pair_ref.input.get_ref()
+                    )),
+                ));
+            }
+            pairs.push(PairSpec {
+                input: controls[input_index].clone(),
+                output: outputs[output_index].clone(),
+                input_index,
+                output_index,
+                range,
+                line,
+            });
+        }
+
+        let mut trim_derived: Vec<String> = Vec::new();
+        for name in &raw.trim_derived {
+            let problem = if trim_derived.contains(name.get_ref()) {
+                Some("listed twice in `trim_derived`")
+            } else if base_index.contains_key(name.get_ref()) {
+                None
+            } else if derived_forms.contains_key(name.get_ref()) {
+                Some("constrained (`expr`): only a free or fixed parameter can be derived from trim points")
+            } else {
+                Some("not a parameter of `[parameters]`")
+            };
+            if let Some(reason) = problem {
+                return Err(context.error(
+                    name.span(),
+                    StructureProblem::BadParameter {
+                        name: name.get_ref().clone(),
+                        reason: reason.to_string(),
+                    },
+                ));
+            }
+            trim_derived.push(name.get_ref().clone());
+        }
+
+        Ok(Self {
+            name: raw.name.into_inner(),
+            description: raw.description,
+            states,
+            controls,
+            outputs,
+            parameters,
+            derived,
+            entries,
+            delays,
+            pairs,
+            auto_range_limit,
+            default_output_states,
+            source_name: context.source_name.to_string(),
+            constants,
+            trim_derived,
+        })
+    }
+
+    /// Parse a structure from TOML text named `<string>` in errors (see [`Self::parse`]).
+    pub fn parse_str(text: &str) -> Result<Self, StructureError> {
+        Self::parse(text, "<string>")
+    }
+}
+
+impl std::str::FromStr for ModelStructure {
+    type Err = StructureError;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        Self::parse_str(text)
+    }
+}
