@@ -291,11 +291,11 @@ pub struct Measurements {
     pub q: f32,
     /// Yaw rate [rad/s].
     pub r: f32,
-    /// Roll attitude φ [rad].
+    /// Roll attitude φ \[rad\].
     pub phi: f32,
-    /// Pitch attitude θ [rad].
+    /// Pitch attitude θ \[rad\].
     pub theta: f32,
-    /// Heading ψ [rad], in (−π, π].
+    /// Heading ψ \[rad\], in (−π, π].
     pub psi: f32,
     /// Body-axis velocity u [m/s].
     pub u: f32,
@@ -325,7 +325,7 @@ pub struct PilotInput {
 #[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SweepSettings {
-    /// Record length T_rec [s] (fades and the ω_min hold come on top).
+    /// Record length T_rec \[s\] (fades and the ω_min hold come on top).
     pub t_rec_s: f32,
     /// Amplitude A, fraction of full stick travel.
     pub amplitude: f32,
@@ -333,7 +333,7 @@ pub struct SweepSettings {
     pub omega_min: f32,
     /// End frequency ω_max [rad/s].
     pub omega_max: f32,
-    /// Raised-cosine fade-in and fade-out length [s]; 0 disables.
+    /// Raised-cosine fade-in and fade-out length \[s\]; 0 disables.
     pub fade_s: f32,
     /// Cycles at ω_min before the sweep proper; 0 disables.
     pub start_hold_cycles: u8,
@@ -345,7 +345,7 @@ pub struct SweepSettings {
 pub struct PulseSettings {
     /// Pulse amplitude, fraction of full stick travel.
     pub amplitude: f32,
-    /// Base pulse width [s].
+    /// Base pulse width \[s\].
     pub width_s: f32,
 }
 
@@ -372,9 +372,9 @@ pub struct TestConfig {
     pub noise_cutoff_rad_s: f32,
     /// Seed of the noise generator.
     pub seed: u32,
-    /// Attitude above which the hold controller engages [rad] (paper: 6°).
+    /// Attitude above which the hold controller engages \[rad\] (paper: 6°).
     pub hold_engage_rad: f32,
-    /// Attitude below which the hold controller releases [rad] (paper: 4°).
+    /// Attitude below which the hold controller releases \[rad\] (paper: 4°).
     pub hold_release_rad: f32,
     /// Freeze the last command inside the hysteresis band instead of keeping the prior form.
     pub freeze_in_band: bool,
@@ -392,7 +392,7 @@ pub struct Header {
     pub firmware: FirmwareVersion,
     /// Configured vehicle.
     pub vehicle: VehicleId,
-    /// Fixed tick rate of the control loop [Hz].
+    /// Fixed tick rate of the control loop \[Hz\].
     pub rate_hz: u16,
     /// The active test.
     pub test: TestConfig,
@@ -457,11 +457,11 @@ pub enum Event {
         tick: u32,
         /// Averaged pilot sticks.
         sticks: Controls,
-        /// Averaged roll attitude [rad].
+        /// Averaged roll attitude \[rad\].
         phi: f32,
-        /// Averaged pitch attitude [rad].
+        /// Averaged pitch attitude \[rad\].
         theta: f32,
-        /// Heading at capture [rad].
+        /// Heading at capture \[rad\].
         psi: f32,
     },
     /// The test was aborted; outputs fell back to pilot pass-through in this tick.
@@ -496,7 +496,7 @@ pub struct ActuatorOut {
     pub seq: u32,
     /// Commands, fractions of full stick travel.
     pub command: Controls,
-    /// Servo pulse widths [µs]: swash servos 1–3, tail.
+    /// Servo pulse widths \[µs\]: swash servos 1–3, tail.
     pub servo_us: [u16; 4],
 }
 
@@ -513,7 +513,7 @@ pub struct ActuatorOut {
 pub struct LinkConfig {
     /// The vehicle whose preset the configuration starts from.
     pub vehicle: VehicleId,
-    /// Tick rate of the flight logic [Hz] (the firmware accepts 50–1000).
+    /// Tick rate of the flight logic \[Hz\] (the firmware accepts 50–1000).
     pub rate_hz: u16,
     /// The test to fly; its `warnings` are recomputed by the flight controller.
     pub test: TestConfig,

@@ -96,7 +96,7 @@ pub struct FrfArgs {
     /// Which inputs get responses (see below).
     #[arg(long, value_enum, default_value_t = ExcitedArg::Auto)]
     pub excited: ExcitedArg,
-    /// CSV: the time column [s].
+    /// CSV: the time column in s.
     #[arg(long, value_name = "COLUMN", default_value = "time_s")]
     pub time: String,
     /// CSV: input columns, `NAME=COLUMN` or `COLUMN`, comma-separated.

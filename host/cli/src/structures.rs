@@ -3,10 +3,8 @@
 //! where the file carries the Bo-105's ([`truth::with_vehicle_data`]).
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
-use anyhow::{anyhow, Context};
-use sweephold_protocol::{Decoder, Event, Frame};
+use anyhow::anyhow;
 
 use sysid::fit::{ModelStructure, StructureError};
 use sysid::models::{self, ShippedStructure, VehicleData};
@@ -47,40 +45,6 @@ fn shipped_for_its_vehicle(
         theta: trim.theta,
     };
     Ok(with_vehicle_data(shipped, vehicle, Some(trim), overrides)?)
-}
-
-/// The trim attitude as the flight controller captured it, read from its dumps (the
-/// `truth` crate, where [`TrimAttitude`] lives, does not read telemetry).
-pub trait CapturedTrim: Sized {
-    /// The mean of the `TrimCaptured` events in `dumps` (one per record), or None when no
-    /// dump has one. What the flight-test engineer has: the aircraft's own trim, not the
-    /// simulator's.
-    fn captured(dumps: &[impl AsRef<Path>]) -> anyhow::Result<Option<Self>>;
-}
-
-impl CapturedTrim for TrimAttitude {
-    fn captured(dumps: &[impl AsRef<Path>]) -> anyhow::Result<Option<TrimAttitude>> {
-        let (mut sum, mut count) = ([0.0; 2], 0usize);
-        for path in dumps {
-            let path = path.as_ref();
-            let bytes =
-                std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-            let mut decoder = Decoder::new();
-            let trim = decoder.feed(&bytes).find_map(|frame| match frame {
-                Ok(Frame::Event(Event::TrimCaptured { phi, theta, .. })) => Some((phi, theta)),
-                _ => None,
-            });
-            if let Some((phi, theta)) = trim {
-                sum[0] += f64::from(phi);
-                sum[1] += f64::from(theta);
-                count += 1;
-            }
-        }
-        Ok((count > 0).then(|| TrimAttitude {
-            phi: sum[0] / count as f64,
-            theta: sum[1] / count as f64,
-        }))
-    }
 }
 
 #[cfg(test)]
@@ -140,45 +104,5 @@ mod tests {
             error.to_string().contains("unknown constant `hub_height`"),
             "{error}"
         );
-    }
-
-    /// A dump holding a corrupt run of bytes and then one `TrimCaptured` event.
-    fn dump_with_trim(dir: &Path, name: &str, phi: f32, theta: f32) -> std::path::PathBuf {
-        use sweephold_protocol::codec::encode_to_vec;
-        use sweephold_protocol::Controls;
-        let event = Frame::Event(Event::TrimCaptured {
-            tick: 210,
-            sticks: Controls::from_array([0.0; 4]),
-            phi,
-            theta,
-            psi: 0.0,
-        });
-        let mut bytes = vec![0x55, 0x13, 0x00];
-        bytes.extend_from_slice(encode_to_vec(&event).unwrap().as_bytes());
-        let path = dir.join(name);
-        std::fs::write(&path, bytes).unwrap();
-        path
-    }
-
-    #[test]
-    fn the_trim_attitude_is_the_mean_of_the_dumps_captures() {
-        let dir = std::env::temp_dir().join(format!("sweephold-trim-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let dumps = [
-            dump_with_trim(&dir, "a.bin", -0.04, 0.03),
-            dump_with_trim(&dir, "b.bin", -0.06, 0.05),
-        ];
-        let trim = TrimAttitude::captured(&dumps).unwrap().unwrap();
-        assert!((trim.phi + 0.05).abs() < 1e-7, "{trim:?}");
-        assert!((trim.theta - 0.04).abs() < 1e-7, "{trim:?}");
-        // A dump without a capture contributes nothing; none at all gives None.
-        let empty = dir.join("empty.bin");
-        std::fs::write(&empty, [0u8; 16]).unwrap();
-        assert_eq!(TrimAttitude::captured(&[&empty]).unwrap(), None);
-        // A missing file is an error naming it.
-        let missing = dir.join("missing.bin");
-        let error = TrimAttitude::captured(&[&missing]).unwrap_err();
-        assert!(error.to_string().contains("missing.bin"), "{error}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

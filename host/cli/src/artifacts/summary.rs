@@ -8,12 +8,12 @@ use serde::{Deserialize, Serialize};
 use sysid::fit::modes::{HoverModeScore, ModeRecord, TruthModeRecord};
 use sysid::fit::verify::BiasMode;
 
-/// Peak |φ| and |θ| over all the records of one mode [deg].
+/// Peak |φ| and |θ| over all the records of one mode \[deg\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PeakAttitudeDeg {
-    /// Peak |φ| [deg] (absolute attitude, trim included).
+    /// Peak |φ| \[deg\] (absolute attitude, trim included).
     pub phi: f64,
-    /// Peak |θ| [deg] (absolute attitude, trim included).
+    /// Peak |θ| \[deg\] (absolute attitude, trim included).
     pub theta: f64,
 }
 
@@ -147,7 +147,7 @@ pub struct VerifyRecordSummary {
     pub tic: BTreeMap<String, f64>,
     /// Mean TIC over the outputs.
     pub tic_mean: f64,
-    /// When the simulated model overflowed [s]; null otherwise.
+    /// When the simulated model overflowed \[s\]; null otherwise.
     pub diverged_at_s: Option<f64>,
 }
 
@@ -242,7 +242,7 @@ pub struct CampaignSummary {
     pub seed: u64,
     /// Seed of the held-out doublet records.
     pub verification_seed: u64,
-    /// Sweep record length [s] (90 by default, shorter with `--quick`).
+    /// Sweep record length \[s\] (90 by default, shorter with `--quick`).
     pub t_rec_s: f64,
     /// Whether `--quick` was given.
     pub quick: bool,
@@ -252,7 +252,7 @@ pub struct CampaignSummary {
     pub fit: Option<FitSummary>,
     /// The verification; null until verified.
     pub verify: Option<VerifySummary>,
-    /// Wall time per completed stage [s], plus `total`.
+    /// Wall time per completed stage \[s\], plus `total`.
     pub timings_s: BTreeMap<String, f64>,
     /// Null when every stage completed.
     pub error: Option<StageFailure>,

@@ -21,7 +21,7 @@ pub struct TruthModelDocument {
     pub outputs: Vec<String>,
     /// M F G H0 H1, row-major.
     pub matrices: ModelMatrices,
-    /// Delay per control [s].
+    /// Delay per control \[s\].
     pub delays: Vec<f64>,
 }
 

@@ -33,11 +33,11 @@ pub struct VerifiedOutput {
 pub struct VerifiedRecord {
     /// Dump file, relative to the campaign folder.
     pub file: String,
-    /// Time step of the stored series [s].
+    /// Time step of the stored series \[s\].
     pub step_s: f64,
     /// Mean TIC over the outputs.
     pub tic_mean: f64,
-    /// When the simulated model overflowed [s]; null otherwise.
+    /// When the simulated model overflowed \[s\]; null otherwise.
     pub diverged_at_s: Option<f64>,
     /// The compared outputs, model order.
     pub outputs: Vec<VerifiedOutput>,

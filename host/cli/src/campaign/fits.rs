@@ -23,7 +23,8 @@ use crate::campaign::error::CampaignError;
 use crate::fit::FitArgs;
 use crate::fly::VehicleArg;
 use crate::output::{write_atomic, write_json};
-use crate::structures::{self, CapturedTrim};
+use crate::structures;
+use truth::TrimAttitude;
 
 impl Campaign<'_> {
     /// `sweephold fit` for this campaign: the structure `model` on `frf.json`, with the
@@ -89,12 +90,12 @@ impl Campaign<'_> {
     }
 
     /// The 9-DOF stage: the hybrid structure (the flown vehicle's data, the trim the
-    /// flight controller captured in `cah_dumps`) fitted to `frf` from the 6-DOF's start
+    /// flight controller captured, `trim`) fitted to `frf` from the 6-DOF's start
     /// values and the file's own, the lower J_ave kept and reduced; `model9.json` and the
     /// summary's `fit` section.
     pub(super) fn fit_9dof(
         &mut self,
-        cah_dumps: &[PathBuf],
+        trim: Option<TrimAttitude>,
         frf: &FrfDocument,
         six: &FitResult,
         trim_points: &Option<TrimPoints>,
@@ -102,7 +103,6 @@ impl Campaign<'_> {
         // As `sweephold fit --start-from model6.json --reduce`.
         let args = self.fit_args(models::BO105_9DOF_HYBRID.name, files::MODEL_9DOF, true)?;
         // Kinematics and gravity about the trim the flight controller captured.
-        let trim = structures::TrimAttitude::captured(cah_dumps)?;
         let hybrid = structures::nine_dof_hybrid(self.args.vehicle.sim(), trim)?;
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
         let starts = [

@@ -15,6 +15,7 @@ use crate::artifacts::summary::{ModeSummary, PeakAttitudeDeg};
 use crate::fly::link::InProcessLink;
 use crate::fly::summary::{FlySummary, MaxAbsDeg};
 use crate::fly::{self, AmplitudeArg, FlyArgs, FlyOutcome, InputArg, ModeArg};
+use truth::TrimAttitude;
 
 /// The records of one mode that did not abort: their dumps and their sweeps, decoded.
 pub struct FlownMode {
@@ -24,6 +25,9 @@ pub struct FlownMode {
     pub dumps: Vec<PathBuf>,
     /// Their sweeps, in the same order; `source` is the dump's path.
     pub records: Vec<Record>,
+    /// The trim attitude each dump's flight controller captured, in the same order as
+    /// `dumps`, as the telemetry streamed.
+    pub trims: Vec<Option<[f32; 2]>>,
 }
 
 impl FlownMode {
@@ -35,6 +39,23 @@ impl FlownMode {
     /// The sweeps, taken out (the dumps stay).
     pub fn take_records(&mut self) -> Vec<Record> {
         std::mem::take(&mut self.records)
+    }
+
+    /// The mean trim attitude the flight controller captured over the records, or None
+    /// when no record has one: what the flight-test engineer has, the aircraft's own trim
+    /// rather than the simulator's.
+    pub fn captured_trim(&self) -> Option<TrimAttitude> {
+        let captured: Vec<[f32; 2]> = self.trims.iter().flatten().copied().collect();
+        let mut sum = [0.0; 2];
+        for [phi, theta] in &captured {
+            sum[0] += f64::from(*phi);
+            sum[1] += f64::from(*theta);
+        }
+        let count = captured.len() as f64;
+        (!captured.is_empty()).then(|| TrimAttitude {
+            phi: sum[0] / count,
+            theta: sum[1] / count,
+        })
     }
 
     /// The same with the lateral sweeps alone.
@@ -112,13 +133,15 @@ impl Campaign<'_> {
             mode,
             dumps: Vec::new(),
             records: Vec::new(),
+            trims: Vec::new(),
         };
-        for ((run, dump), record) in outcome
+        for (((run, dump), record), trim) in outcome
             .summary
             .runs
             .iter()
             .zip(outcome.dumps)
             .zip(outcome.records)
+            .zip(outcome.trims)
         {
             if run.aborted {
                 continue;
@@ -129,6 +152,7 @@ impl Campaign<'_> {
                 flown.records.push(record);
             }
             flown.dumps.push(dump);
+            flown.trims.push(trim);
         }
         Ok((flown, line))
     }
@@ -275,5 +299,25 @@ mod tests {
             .fly_args(ModeArg::Cah, InputArg::Doublet, 8, "verify-doublet")
             .unwrap();
         assert_eq!(doublets.amplitude, AmplitudeArg::Fixed);
+    }
+
+    fn flown(trims: Vec<Option<[f32; 2]>>) -> FlownMode {
+        FlownMode {
+            mode: ModeArg::Cah,
+            dumps: trims.iter().map(|_| PathBuf::from("x.bin")).collect(),
+            records: Vec::new(),
+            trims,
+        }
+    }
+
+    #[test]
+    fn the_captured_trim_is_the_mean_over_the_records_that_captured_one() {
+        let trim = flown(vec![Some([-0.04, 0.03]), None, Some([-0.06, 0.05])])
+            .captured_trim()
+            .unwrap();
+        assert!((trim.phi + 0.05).abs() < 1e-7, "{trim:?}");
+        assert!((trim.theta - 0.04).abs() < 1e-7, "{trim:?}");
+        assert_eq!(flown(vec![None, None]).captured_trim(), None);
+        assert_eq!(flown(Vec::new()).captured_trim(), None);
     }
 }

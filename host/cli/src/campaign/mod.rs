@@ -40,7 +40,7 @@ use error::CampaignError;
 use flights::FlownMode;
 use progress::StageProgress;
 
-/// Sweep record length of `--quick` [s]: long enough for the frequency responses above
+/// Sweep record length of `--quick` \[s\]: long enough for the frequency responses above
 /// ~0.6 rad/s, short enough for a test.
 pub const QUICK_T_REC_S: f64 = 20.0;
 
@@ -85,7 +85,7 @@ pub struct CampaignArgs {
 }
 
 impl CampaignArgs {
-    /// Sweep record length [s].
+    /// Sweep record length \[s\].
     pub fn t_rec_s(&self) -> f64 {
         if self.quick {
             QUICK_T_REC_S
@@ -303,7 +303,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
     let trim_points = run.trim_points()?;
     let six = run.stage(Stage::Fit6Dof, |run| run.fit_6dof(&frf.document))?;
     let nine = run.stage(Stage::Fit9Dof, |run| {
-        run.fit_9dof(&cah.dumps, &frf.document, &six, &trim_points)
+        run.fit_9dof(cah.captured_trim(), &frf.document, &six, &trim_points)
     })?;
     run.stage(Stage::Truth, |run| run.score(&nine))?;
     run.stage(Stage::Verify, |run| run.verify(&nine.model, &doublets))?;

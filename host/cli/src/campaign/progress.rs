@@ -39,7 +39,7 @@ impl StageProgress {
         }
     }
 
-    /// Stop the spinner and print the stage's outcome; returns its wall time [s].
+    /// Stop the spinner and print the stage's outcome; returns its wall time \[s\].
     pub fn finish(self, outcome: &str) -> f64 {
         let seconds = self.started.elapsed().as_secs_f64();
         self.spinner.finish_and_clear();

@@ -40,7 +40,7 @@ const OFFERED_RATES: [u32; 12] = [
 pub struct SerialPort {
     /// The tty, e.g. `/dev/ttyUSB0`.
     pub path: PathBuf,
-    /// Line rate [Bd].
+    /// Line rate \[Bd\].
     pub baud: u32,
 }
 
@@ -70,7 +70,7 @@ pub enum SerialPortError {
     UnofferedRate {
         /// The value after `serial:`.
         text: String,
-        /// The rate asked for [Bd].
+        /// The rate asked for \[Bd\].
         baud: u32,
     },
 }

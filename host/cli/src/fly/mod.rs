@@ -177,12 +177,12 @@ pub struct FlyArgs {
     /// Campaign seed (firmware noise, sensor noise, gusts).
     #[arg(long, default_value_t = 1, value_parser = arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
-    /// Sweep record length T_rec [s] (the paper: 90), 5–1000: shorter records are too
+    /// Sweep record length T_rec in s (the paper: 90), 5–1000: shorter records are too
     /// short for the frequency responses of the sweep's upper band.
     #[arg(long = "t-rec", value_name = "SECONDS", default_value_t = plan::PAPER_T_REC_S,
           value_parser = parse_t_rec, allow_hyphen_values = true)]
     pub t_rec_s: f64,
-    /// Control loop rate [Hz] (50–1000).
+    /// Control loop rate in Hz (50–1000).
     #[arg(long = "rate", value_name = "HZ", default_value_t = 200, allow_hyphen_values = true,
           value_parser = clap::value_parser!(u16).range(50..=1000))]
     pub rate_hz: u16,
@@ -225,7 +225,7 @@ pub struct FlyArgs {
     pub quiet: bool,
     /// Flight controller in the loop: `in-process` (the firmware library called
     /// directly), `qemu` (the board image in qemu-system-arm, one per worker; its defmt
-    /// log is decoded into OUT/<record>.log), `qemu-usart` (the same over its emulated
+    /// log is decoded into OUT/RECORD.log), `qemu-usart` (the same over its emulated
     /// USART: slow, no log), `serial:PATH[@BAUD]` (a real board on a serial port,
     /// default 460800 Bd; records flown one at a time) or `board-sim` (the board
     /// application's sensor-to-servo stack on an emulated IMU and SBUS receiver, booted,
@@ -243,7 +243,7 @@ pub struct FlyArgs {
     /// alone) [default: default].
     #[arg(long, value_enum, value_name = "LEVEL")]
     pub vibration: Option<VibrationArg>,
-    /// `--fc board-sim`: stop sending SBUS frames from this record time on [s], >= 0.
+    /// `--fc board-sim`: stop sending SBUS frames from this record time on (seconds, >= 0).
     #[arg(long = "rc-loss", value_name = "AT_S", value_parser = arg_values::non_negative, allow_hyphen_values = true)]
     pub rc_loss_at_s: Option<f64>,
     /// `--fc board-sim`: IMU fault of the emulated chip: `stuck@AT_S`, `saturate@AT_S`,
@@ -252,7 +252,7 @@ pub struct FlyArgs {
     #[arg(long = "imu-fault", value_name = "FAULT", value_parser = link_board_sim::ImuFaultPlan::parse)]
     pub imu_fault: Option<link_board_sim::ImuFaultPlan>,
     /// `--fc board-sim`: keep flying this long after the test ended (Done or an abort),
-    /// the pilot's hands at trim [s], 0–600.
+    /// the pilot's hands at trim (seconds, 0–600).
     #[arg(long = "fly-on", value_name = "SECONDS", value_parser = parse_fly_on, allow_hyphen_values = true)]
     pub fly_on_s: Option<f64>,
 }
@@ -267,7 +267,7 @@ pub enum VibrationArg {
     None,
 }
 
-/// Longest `--fly-on` [s].
+/// Longest `--fly-on` \[s\].
 pub const MAX_FLY_ON_S: f64 = 600.0;
 
 fn parse_fly_on(text: &str) -> Result<f64, String> {
@@ -321,11 +321,11 @@ pub enum FcArgError {
     Serial(#[from] link_serial::SerialPortError),
 }
 
-/// Shortest `--t-rec` [s]: the upper-band record must hold two windows of ten periods
+/// Shortest `--t-rec` \[s\]: the upper-band record must hold two windows of ten periods
 /// of its ω_max for the cross-control coherence `fly` reports.
 pub const MIN_T_REC_S: f64 = 5.0;
 
-/// Longest `--t-rec` [s].
+/// Longest `--t-rec` \[s\].
 pub const MAX_T_REC_S: f64 = 1000.0;
 
 fn parse_t_rec(text: &str) -> Result<f64, String> {
@@ -467,6 +467,9 @@ pub struct FlyOutcome {
     /// flying order (`None` for an aborted record or another input than a sweep), so that
     /// a caller needs not decode the dumps again. Its `source` is the dump's file name.
     pub records: Vec<Option<Record>>,
+    /// The trim attitude φ, θ \[rad\] each record's flight controller captured, in flying
+    /// order, as the telemetry streamed (`None` where it captured none).
+    pub trims: Vec<Option<[f32; 2]>>,
 }
 
 /// Run `sweephold fly`: the records are flown into `OUT.partial`, which replaces OUT
@@ -722,14 +725,16 @@ pub fn fly_with_workers(
 
     let mut runs = Vec::new();
     let mut records = Vec::new();
+    let mut trims = Vec::new();
     for (plan, result) in plans
         .iter()
         .zip(results.into_inner().unwrap_or_else(|e| e.into_inner()))
     {
         let run = result.unwrap_or_else(|| Err(anyhow::anyhow!("not flown")));
-        let (run, record) = run.with_context(|| format!("record {}", plan.file_name()))?;
+        let (run, record, trim) = run.with_context(|| format!("record {}", plan.file_name()))?;
         runs.push(run);
         records.push(record);
+        trims.push(trim);
     }
     let link = make_link().describe();
     let summary = FlySummary {
@@ -753,6 +758,7 @@ pub fn fly_with_workers(
         summary,
         dumps,
         records,
+        trims,
     })
 }
 
@@ -763,9 +769,9 @@ pub fn expected_duration_s(config: &Config) -> f64 {
     f64::from(config.trim_capture_s) + excitation.duration_s()
 }
 
-/// A record written: its summary, and its sweep as decoded for the summary (if a sweep
-/// that did not abort).
-type FinishedRecord = (RunSummary, Option<Record>);
+/// A record written: its summary, its sweep as decoded for the summary (if a sweep that
+/// did not abort) and the trim attitude its flight controller captured.
+type FinishedRecord = (RunSummary, Option<Record>, Option<[f32; 2]>);
 
 fn finish_record(
     args: &FlyArgs,
@@ -801,7 +807,7 @@ fn finish_record(
         }),
         after: flown.after,
     };
-    Ok((run, record))
+    Ok((run, record, flown.trim_captured))
 }
 
 /// Mean coherence between the primary control and each other excited control over the

@@ -18,7 +18,7 @@ pub struct RecordPlan {
     pub omega_min: f64,
     /// Sweep end frequency [rad/s].
     pub omega_max: f64,
-    /// Sweep record length T_rec [s].
+    /// Sweep record length T_rec \[s\].
     pub t_rec_s: f64,
     /// Sweep or pulse amplitude, fraction of full stick travel.
     pub amplitude: f64,
@@ -40,7 +40,7 @@ pub const PAPER_BANDS: [(f64, f64); 2] = [(0.2, 31.4), (0.01, 18.85)];
 /// The paper's sweep amplitude: 5 % of stick travel.
 pub const PAPER_AMPLITUDE: f64 = 0.05;
 
-/// The paper's record length [s].
+/// The paper's record length \[s\].
 pub const PAPER_T_REC_S: f64 = 90.0;
 
 /// Records for `axes`: two sweeps per axis (the paper's bands), or one pulse input per

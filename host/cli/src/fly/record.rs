@@ -19,7 +19,7 @@ pub struct Disturbances {
     pub sensor_dropout: f64,
     /// Per-tick probability of a sensor spike.
     pub sensor_spike: f64,
-    /// Time [s] after arming at which the pilot moves the lateral stick 20 % off trim.
+    /// Time \[s\] after arming at which the pilot moves the lateral stick 20 % off trim.
     pub pilot_override_at_s: Option<f64>,
     /// RMS of random pilot stick motion around trim, fraction of travel (0: hands still).
     pub pilot_stick_noise: f64,
@@ -51,6 +51,9 @@ pub struct FlownRecord {
     pub attitude_error_deg: AttitudeDeg,
     /// The flight after the test (`Disturbances::fly_on_s` > 0).
     pub after: Option<AfterTest>,
+    /// The trim attitude φ, θ \[rad\] the flight controller captured (its first
+    /// `TrimCaptured` event), if it captured one.
+    pub trim_captured: Option<[f32; 2]>,
 }
 
 /// Watches the telemetry as it streams, as a ground station would.
@@ -59,6 +62,8 @@ struct TelemetryMonitor {
     decoder: Decoder,
     phase: Option<Phase>,
     abort: Option<sweephold_protocol::AbortReason>,
+    /// The first `TrimCaptured` event's attitude.
+    trim_captured: Option<[f32; 2]>,
     start_psi: Option<f32>,
     max_abs: MaxAbsDeg,
     excitation_ticks: u64,
@@ -84,6 +89,9 @@ impl TelemetryMonitor {
                     self.last = Some(sample);
                 }
                 Frame::Event(Event::Abort { reason, .. }) => self.abort = Some(reason),
+                Frame::Event(Event::TrimCaptured { phi, theta, .. }) => {
+                    self.trim_captured.get_or_insert([phi, theta]);
+                }
                 _ => {}
             }
         }
@@ -290,6 +298,7 @@ pub fn fly_record(
         frames: monitor.decoder.stats().good_frames,
         ticks: test_ticks,
         abort: monitor.abort,
+        trim_captured: monitor.trim_captured,
         max_abs_deg: monitor.max_abs,
         hold_fraction: monitor.hold_fraction(),
         final_phase,

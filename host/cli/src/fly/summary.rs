@@ -5,14 +5,14 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-/// Peak absolute attitude excursions over a record [deg].
+/// Peak absolute attitude excursions over a record \[deg\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MaxAbsDeg {
-    /// Peak |φ| [deg] (absolute attitude, trim included).
+    /// Peak |φ| \[deg\] (absolute attitude, trim included).
     pub phi: f64,
-    /// Peak |θ| [deg] (absolute attitude, trim included).
+    /// Peak |θ| \[deg\] (absolute attitude, trim included).
     pub theta: f64,
-    /// Peak |ψ − ψ_start| wrapped to ±180° [deg].
+    /// Peak |ψ − ψ_start| wrapped to ±180° \[deg\].
     pub psi: f64,
 }
 
@@ -27,12 +27,12 @@ pub struct HoldFraction {
     pub ped: f64,
 }
 
-/// A pair of roll and pitch angles [deg].
+/// A pair of roll and pitch angles \[deg\].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct AttitudeDeg {
-    /// Roll φ [deg].
+    /// Roll φ \[deg\].
     pub phi: f64,
-    /// Pitch θ [deg].
+    /// Pitch θ \[deg\].
     pub theta: f64,
 }
 
@@ -40,7 +40,7 @@ pub struct AttitudeDeg {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EstimatorSummary {
     /// Largest |estimate − simulator| over the excitation (over the whole test if it
-    /// had none) [deg].
+    /// had none) \[deg\].
     pub max_error_deg: AttitudeDeg,
 }
 
@@ -50,9 +50,9 @@ pub struct AfterTest {
     /// The board application's mode at the end (`pilot`, `rc_failsafe`,
     /// `imu_failsafe`, `disarmed`).
     pub mode: String,
-    /// Time flown after the test ended [s].
+    /// Time flown after the test ended \[s\].
     pub duration_s: f64,
-    /// Peak |φ|, |θ| of the simulated aircraft over that time [deg].
+    /// Peak |φ|, |θ| of the simulated aircraft over that time \[deg\].
     pub max_abs_deg: AttitudeDeg,
 }
 
@@ -70,7 +70,7 @@ pub struct RunSummary {
     /// Sweep end frequency [rad/s].
     pub omega_max: f64,
     /// Flown duration, from the record's start to the end of the test (Done or the abort)
-    /// [s]; the time flown on after it is `after.duration_s`.
+    /// \[s\]; the time flown on after it is `after.duration_s`.
     pub duration_s: f64,
     /// Frames in the dump.
     pub frames: u64,
@@ -100,7 +100,7 @@ pub struct FlySummary {
     pub vehicle: String,
     /// Excitation mode (`cah`, `standard`, `noise`).
     pub mode: String,
-    /// Tick rate [Hz].
+    /// Tick rate \[Hz\].
     pub rate_hz: u32,
     /// Campaign seed.
     pub seed: u64,

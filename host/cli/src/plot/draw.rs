@@ -59,7 +59,7 @@ fn bold<'a>() -> TextStyle<'a> {
 }
 
 impl Figure {
-    /// Width and height of the drawing [px].
+    /// Width and height of the drawing \[px\].
     pub fn size(&self) -> (u32, u32) {
         let height = LEGEND_HEIGHT + self.row_heights().iter().sum::<u32>();
         (self.width, height)

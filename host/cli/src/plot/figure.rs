@@ -4,7 +4,7 @@
 
 use plotters::style::RGBColor;
 
-/// Width of a full-width figure [px] (the page scales it to its column).
+/// Width of a full-width figure \[px\] (the page scales it to its column).
 pub const FIGURE_WIDTH: u32 = 900;
 
 /// Colours of the series (colour-blind-safe Okabe–Ito palette, and greys).
@@ -252,7 +252,7 @@ pub struct Series {
     pub color: RGBColor,
     /// Dashed stroke.
     pub dashed: bool,
-    /// Stroke width [px].
+    /// Stroke width \[px\].
     pub width: u32,
 }
 
@@ -274,7 +274,7 @@ impl Series {
         self
     }
 
-    /// The same, with stroke width `width` [px].
+    /// The same, with stroke width `width` \[px\].
     pub fn width(mut self, width: u32) -> Self {
         self.width = width;
         self
@@ -296,7 +296,7 @@ pub struct Panel {
     pub shaded: Option<[f64; 2]>,
     /// Horizontal reference lines: value and label.
     pub references: Vec<(f64, String)>,
-    /// Height of the plotting area [px].
+    /// Height of the plotting area \[px\].
     pub height: u32,
 }
 
@@ -362,7 +362,7 @@ pub struct Figure {
     pub columns: usize,
     /// Legend entries.
     pub legend: Vec<LegendEntry>,
-    /// Width [px]: [`FIGURE_WIDTH`] for a full-width figure, less for one shown in a
+    /// Width \[px\]: [`FIGURE_WIDTH`] for a full-width figure, less for one shown in a
     /// half-width column (so that its text keeps a readable size once scaled).
     pub width: u32,
 }

@@ -5,7 +5,7 @@
 use sysid::document::PairResponse;
 use sysid::fit::Model;
 
-/// Unwrap a phase series [deg] so that consecutive points differ by less than 180°.
+/// Unwrap a phase series \[deg\] so that consecutive points differ by less than 180°.
 pub fn unwrap_deg(phase: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(phase.len());
     let mut offset = 0.0;
@@ -25,7 +25,7 @@ pub fn unwrap_deg(phase: &[f64]) -> Vec<f64> {
     out
 }
 
-/// A model's response on the data's frequencies: magnitude [dB] and phase [deg], the
+/// A model's response on the data's frequencies: magnitude \[dB\] and phase \[deg\], the
 /// phase unwrapped and shifted by whole turns onto the data at the fit range's start.
 pub fn model_response(
     model: &Model,

@@ -79,7 +79,7 @@ pub struct FittedModel {
     pub outputs: Vec<String>,
     /// M F G H0 H1, row-major.
     pub matrices: ModelMatrices,
-    /// Delay per control [s].
+    /// Delay per control \[s\].
     pub delays: Vec<f64>,
     /// J per fitted pair, with its range.
     pub pairs: Vec<PairFit>,
