@@ -1,4 +1,6 @@
 //! Shared helpers of the cross-crate integration tests in this folder.
+//!
+//! The tests may import every crate of the workspace; nothing imports them.
 
 use std::path::{Path, PathBuf};
 

@@ -27,6 +27,11 @@
 //! The tick path has no `unwrap`, `expect`, panicking index or `unsafe`, runs in bounded
 //! time and turns NaN or infinite inputs into an abort and finite, clamped outputs.
 //!
+//! **What it may import.** Of the workspace, only the wire protocol
+//! (`sweephold-protocol`); otherwise `no_std` crates that allocate nothing (heapless,
+//! libm, micromath, embedded-hal, embedded-io, rand_pcg, defmt). It never imports the
+//! host crates: they drive it (in-process, in QEMU or over a serial port).
+//!
 //! Modules, one concept each: [`sweep`] (the sweep, its closed-form phase and its
 //! `f64`-free tick evaluation), [`turns`] (angles as fixed-point fractions of a turn and
 //! their `f32` sine),

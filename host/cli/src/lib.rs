@@ -1,5 +1,12 @@
 //! The `sweephold` command-line tool, as a library so that integration tests and
 //! benchmarks drive the same code the binary runs.
+//!
+//! **What it may import.** Every library crate of the workspace: the protocol, the
+//! firmware (with `std`, flown in-process), the simulator `bo105`, the identification
+//! `sysid` and the `truth` mapping. Nothing imports it but the integration tests.
+//! Inside it, the verbs (`fly`, `frf`, `fit`, `verify`, `decode`, `sim`) own their
+//! options; `campaign` runs them as stages and writes `artifacts`, which `report`
+//! only reads; `plot` draws every figure.
 
 use clap::{Parser, Subcommand};
 
