@@ -25,6 +25,11 @@ pub struct ModeSummary {
     pub cross_coherence_lat_lon: Option<f64>,
     /// Peak attitudes over all the records of the mode.
     pub max_abs_deg: PeakAttitudeDeg,
+    /// Peak excursions from the trim the flight controller captured, over all the
+    /// records of the mode that captured one (|φ − φ_trim|, |θ − θ_trim| \[deg\]); null
+    /// when none did.
+    #[serde(default)]
+    pub max_from_trim_deg: Option<PeakAttitudeDeg>,
     /// Number of records the firmware aborted.
     pub aborts: usize,
     /// Number of records flown.

@@ -199,6 +199,17 @@ pub fn mode_summary(summary: &FlySummary, folder: &str) -> ModeSummary {
             phi: peak(|m| m.phi),
             theta: peak(|m| m.theta),
         },
+        max_from_trim_deg: summary
+            .runs
+            .iter()
+            .filter_map(|run| run.max_from_trim_deg)
+            .fold(None, |peak: Option<PeakAttitudeDeg>, run| {
+                let peak = peak.unwrap_or_default();
+                Some(PeakAttitudeDeg {
+                    phi: peak.phi.max(run.phi),
+                    theta: peak.theta.max(run.theta),
+                })
+            }),
         aborts: summary.runs.iter().filter(|run| run.aborted).count(),
         records: summary.runs.len(),
         folder: folder.to_string(),
@@ -208,7 +219,7 @@ pub fn mode_summary(summary: &FlySummary, folder: &str) -> ModeSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fly::summary::{HoldFraction, RunSummary};
+    use crate::fly::summary::{FromTrimDeg, HoldFraction, RunSummary};
 
     fn run(axis: &str, phi: f64, aborted: bool, lon: Option<f64>) -> RunSummary {
         RunSummary {
@@ -226,6 +237,12 @@ mod tests {
                 theta: phi / 2.0,
                 psi: 0.0,
             },
+            // A trim rolled 4° to the left: the excursions from it are the absolute
+            // attitude shifted.
+            max_from_trim_deg: Some(FromTrimDeg {
+                phi: phi - 4.0,
+                theta: phi / 4.0,
+            }),
             hold_fraction: HoldFraction::default(),
             cross_coherence: lon.map(|c| ("lon".to_string(), c)).into_iter().collect(),
             estimator: None,
@@ -249,9 +266,16 @@ mod tests {
             ],
         };
         let mode = mode_summary(&fly, "fly-cah");
+        let mut no_capture = fly.clone();
+        for run in &mut no_capture.runs {
+            run.max_from_trim_deg = None;
+        }
+        assert_eq!(mode_summary(&no_capture, "fly-cah").max_from_trim_deg, None);
         assert!((mode.cross_coherence_lat_lon.unwrap() - 0.2).abs() < 1e-12);
         assert_eq!(mode.max_abs_deg.phi, 9.0);
         assert_eq!(mode.max_abs_deg.theta, 4.5);
+        let from_trim = mode.max_from_trim_deg.unwrap();
+        assert_eq!((from_trim.phi, from_trim.theta), (5.0, 2.25));
         assert_eq!(mode.aborts, 1);
         assert_eq!(mode.records, 3);
     }

@@ -800,6 +800,7 @@ fn finish_record(
         aborted: flown.abort.is_some(),
         abort_reason: flown.abort.map(|r| r.name().to_string()),
         max_abs_deg: flown.max_abs_deg,
+        max_from_trim_deg: flown.max_from_trim_deg,
         hold_fraction: flown.hold_fraction,
         cross_coherence,
         estimator: (args.fc == FcArg::BoardSim).then_some(summary::EstimatorSummary {

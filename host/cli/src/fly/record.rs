@@ -8,7 +8,7 @@ use sweephold_protocol::{
 use sysid::random::SplitMix64;
 
 use super::link::FlightControllerLink;
-use super::summary::{AfterTest, AttitudeDeg, HoldFraction, MaxAbsDeg};
+use super::summary::{AfterTest, AttitudeDeg, FromTrimDeg, HoldFraction, MaxAbsDeg};
 
 /// Disturbances and faults injected into one record.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -41,6 +41,9 @@ pub struct FlownRecord {
     pub abort: Option<sweephold_protocol::AbortReason>,
     /// Peak attitude excursions over the excitation.
     pub max_abs_deg: MaxAbsDeg,
+    /// Peak excursions from the captured trim over the excitation (None without a trim
+    /// capture).
+    pub max_from_trim_deg: Option<FromTrimDeg>,
     /// Share of excitation ticks with the hold engaged.
     pub hold_fraction: HoldFraction,
     /// The final sequencer phase (at the end of the test).
@@ -56,6 +59,11 @@ pub struct FlownRecord {
     pub trim_captured: Option<[f32; 2]>,
 }
 
+/// Whether `phase` is part of the excitation (fades included).
+fn is_excitation(phase: Phase) -> bool {
+    matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
+}
+
 /// Watches the telemetry as it streams, as a ground station would.
 #[derive(Default)]
 struct TelemetryMonitor {
@@ -66,6 +74,7 @@ struct TelemetryMonitor {
     trim_captured: Option<[f32; 2]>,
     start_psi: Option<f32>,
     max_abs: MaxAbsDeg,
+    max_from_trim: Option<FromTrimDeg>,
     excitation_ticks: u64,
     engaged_ticks: [u64; 3],
     /// The last Sample seen.
@@ -86,6 +95,16 @@ impl TelemetryMonitor {
                         &mut self.excitation_ticks,
                         &mut self.engaged_ticks,
                     );
+                    if let (Some([phi0, theta0]), true) =
+                        (self.trim_captured, is_excitation(sample.phase))
+                    {
+                        let peak = self.max_from_trim.get_or_insert_with(FromTrimDeg::default);
+                        let from = |value: f32, trim: f32| {
+                            (f64::from(value) - f64::from(trim)).abs().to_degrees()
+                        };
+                        peak.phi = peak.phi.max(from(sample.meas.phi, phi0));
+                        peak.theta = peak.theta.max(from(sample.meas.theta, theta0));
+                    }
                     self.last = Some(sample);
                 }
                 Frame::Event(Event::Abort { reason, .. }) => self.abort = Some(reason),
@@ -106,7 +125,7 @@ impl TelemetryMonitor {
         engaged_ticks: &mut [u64; 3],
     ) {
         *phase = Some(sample.phase);
-        if !matches!(sample.phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut) {
+        if !is_excitation(sample.phase) {
             return;
         }
         let m = &sample.meas;
@@ -300,6 +319,7 @@ pub fn fly_record(
         abort: monitor.abort,
         trim_captured: monitor.trim_captured,
         max_abs_deg: monitor.max_abs,
+        max_from_trim_deg: monitor.max_from_trim,
         hold_fraction: monitor.hold_fraction(),
         final_phase,
         attitude_error_deg: errors.result(),

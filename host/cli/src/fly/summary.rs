@@ -16,6 +16,18 @@ pub struct MaxAbsDeg {
     pub psi: f64,
 }
 
+/// Peak excursions from the trim the flight controller captured, over a record's
+/// excitation \[deg\]: |φ − φ_trim|, |θ − θ_trim|. On a helicopter that hovers rolled
+/// (the TREX 700L: about −5°) this, not the absolute attitude, is what the hold's
+/// thresholds and the pilot see.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FromTrimDeg {
+    /// Peak |φ − φ_trim| \[deg\].
+    pub phi: f64,
+    /// Peak |θ − θ_trim| \[deg\].
+    pub theta: f64,
+}
+
 /// Share of the excitation ticks with the hold controller engaged, per held axis.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct HoldFraction {
@@ -80,6 +92,10 @@ pub struct RunSummary {
     pub abort_reason: Option<String>,
     /// Peak attitude excursions during the excitation.
     pub max_abs_deg: MaxAbsDeg,
+    /// Peak excursions from the captured trim during the excitation; null when the
+    /// flight controller captured no trim.
+    #[serde(default)]
+    pub max_from_trim_deg: Option<FromTrimDeg>,
     /// Share of excitation ticks with the hold engaged, per axis.
     pub hold_fraction: HoldFraction,
     /// Average coherence between the primary control and each other control over the
