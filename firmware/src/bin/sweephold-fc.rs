@@ -16,6 +16,11 @@ mod board;
 #[path = "../board/dividers.rs"]
 mod dividers;
 
+/// Host unit tests of the board's pin map.
+#[cfg(all(test, not(target_os = "none")))]
+#[path = "../board/pins.rs"]
+mod pins;
+
 /// Host unit tests of the board's byte ring.
 #[cfg(all(test, not(target_os = "none")))]
 #[path = "../board/ring.rs"]

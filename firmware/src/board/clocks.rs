@@ -102,6 +102,8 @@ pub struct Clocks {
     pub pclk2_hz: u32,
     /// Kernel clock of the APB1 timers TIM2..TIM5 [Hz].
     pub apb1_timer_hz: u32,
+    /// Kernel clock of the APB2 timers (TIM8) [Hz].
+    pub apb2_timer_hz: u32,
     /// How the clock tree came up.
     pub source: ClockSource,
 }
@@ -114,6 +116,7 @@ impl Clocks {
             pclk1_hz: HSI_HZ,
             pclk2_hz: HSI_HZ,
             apb1_timer_hz: HSI_HZ,
+            apb2_timer_hz: HSI_HZ,
             source,
         }
     }
@@ -127,6 +130,8 @@ impl Clocks {
             pclk2_hz: PLL_SYSCLK_HZ / 2,
             // APB1 prescaler ≠ 1 → timers at 2·PCLK1.
             apb1_timer_hz: 2 * pclk1,
+            // APB2 prescaler ≠ 1 → timers at 2·PCLK2.
+            apb2_timer_hz: PLL_SYSCLK_HZ,
             source: ClockSource::HsePll,
         }
     }
@@ -203,10 +208,18 @@ impl ClockGate {
     pub const GPIOA: ClockGate = ClockGate::at(rcc::AHB1ENR, 1 << 0);
     /// GPIO port B (AHB1ENR.GPIOBEN).
     pub const GPIOB: ClockGate = ClockGate::at(rcc::AHB1ENR, 1 << 1);
+    /// GPIO port C (AHB1ENR.GPIOCEN).
+    pub const GPIOC: ClockGate = ClockGate::at(rcc::AHB1ENR, 1 << 2);
     /// TIM2 (APB1ENR.TIM2EN).
     pub const TIM2: ClockGate = ClockGate::at(rcc::APB1ENR, 1 << 0);
     /// TIM3 (APB1ENR.TIM3EN).
     pub const TIM3: ClockGate = ClockGate::at(rcc::APB1ENR, 1 << 1);
+    /// TIM4 (APB1ENR.TIM4EN).
+    pub const TIM4: ClockGate = ClockGate::at(rcc::APB1ENR, 1 << 2);
+    /// TIM5 (APB1ENR.TIM5EN).
+    pub const TIM5: ClockGate = ClockGate::at(rcc::APB1ENR, 1 << 3);
+    /// TIM8 (APB2ENR.TIM8EN).
+    pub const TIM8: ClockGate = ClockGate::at(rcc::APB2ENR, 1 << 1);
     /// USART1 (APB2ENR.USART1EN).
     pub const USART1: ClockGate = ClockGate::at(rcc::APB2ENR, 1 << 4);
 

@@ -1,6 +1,8 @@
 //! Pin muxing: the pins the image uses, switched to their alternate functions.
 
-use super::regs::GpioPort;
+use super::clocks::ClockGate;
+use super::pins::{Pin, Port};
+use super::regs::{GpioPort, GPIOA, GPIOB, GPIOC};
 
 /// Pull resistor of an input.
 #[derive(Clone, Copy)]
@@ -11,9 +13,23 @@ pub enum Pull {
     Up,
 }
 
-/// Put `pin` of `port` in alternate-function mode `af` (RM0090 §8.3.7, Table 9 of the
-/// STM32F405 datasheet for the AF numbers), fast output speed.
-pub fn alternate_function(port: GpioPort, pin: u32, af: u32, pull: Pull) {
+/// The registers and the clock gate of `port`.
+fn port_of(port: Port) -> (GpioPort, ClockGate) {
+    match port {
+        Port::A => (GPIOA, ClockGate::GPIOA),
+        Port::B => (GPIOB, ClockGate::GPIOB),
+        Port::C => (GPIOC, ClockGate::GPIOC),
+    }
+}
+
+/// Put `pin` (of the board's [`super::pins`] map) in its alternate function (RM0090
+/// §8.3.7, Table 9 of the STM32F405 datasheet for the AF numbers), fast output speed;
+/// the port's clock is switched on first.
+pub fn alternate_function(pin: Pin, pull: Pull) {
+    let (port, gate) = port_of(pin.port);
+    gate.enable();
+    let af = u32::from(pin.af);
+    let pin = u32::from(pin.number);
     const MODE_ALTERNATE: u32 = 0b10;
     const SPEED_FAST: u32 = 0b10;
     port.moder.write_field(2 * pin, 2, MODE_ALTERNATE);

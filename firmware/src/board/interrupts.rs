@@ -11,7 +11,7 @@ use super::nvic::Irq;
 /// image never enabled, which the caller treats as a fault.
 pub fn dispatch(number: i16) -> bool {
     match Irq::from_number(number) {
-        Some(Irq::Tim2) => super::ticker::on_interrupt(),
+        Some(Irq::Tim5) => super::ticker::on_interrupt(),
         Some(Irq::Usart1) => super::usart::on_interrupt(),
         None => return false,
     }

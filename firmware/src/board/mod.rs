@@ -2,14 +2,10 @@
 //! the USART frame link and the loop that ties them to
 //! [`sweephold_firmware::FlightController`].
 //!
-//! | function            | peripheral | pins                  |
-//! |---------------------|------------|-----------------------|
-//! | frame link (8N1)    | USART1     | PA9 TX, PA10 RX (AF7) |
-//! | servo 1, 2 (swash)  | TIM3 CH1/2 | PA6, PA7 (AF2)        |
-//! | servo 3 (swash)     | TIM3 CH3   | PB0 (AF2)             |
-//! | servo 4 (tail)      | TIM3 CH4   | PB1 (AF2)             |
-//! | loop tick           | TIM2       | —                     |
-//! | logs (defmt)        | RTT        | SWD (QEMU: semihosting file, see [`log`]) |
+//! Which pin and peripheral does what is the board's pin map, [`pins`] (a SpeedyBee
+//! F405 V4 flying a TREX 700L): the frame link on USART1, the servos and the ESC on
+//! TIM4/TIM3/TIM8/TIM2, the loop tick on TIM5, logs over RTT (SWD; QEMU: a semihosting
+//! file, see [`log`]).
 //!
 //! Register access goes through [`regs`] only (no PAC); the drivers above it are safe
 //! code. See `firmware/README.md` for wiring, flashing and the QEMU boot check.
@@ -21,6 +17,7 @@ pub mod interrupts;
 pub mod link;
 pub mod log;
 pub mod nvic;
+pub mod pins;
 pub mod regs;
 pub mod ring;
 pub mod runner;
@@ -30,7 +27,7 @@ pub mod ticker;
 pub mod usart;
 
 /// Put the aircraft in the safe state from any context (panic, fault): interrupts off,
-/// servos to their failsafe pulses, the link's interrupt masked. Touches registers only,
+/// servos to their failsafe pulses, the ESC to the throttle cut, the link's interrupt masked. Touches registers only,
 /// no driver state, so it works whatever the interrupted code held.
 pub fn safe_state() {
     cortex_m::interrupt::disable();

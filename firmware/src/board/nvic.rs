@@ -7,8 +7,8 @@ use super::regs::nvic::{ICER, ISER};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Irq {
-    /// TIM2 global interrupt: the loop tick.
-    Tim2 = 28,
+    /// TIM5 global interrupt: the loop tick.
+    Tim5 = 50,
     /// USART1 global interrupt: receive, and transmit on silicon.
     Usart1 = 37,
 }
@@ -17,7 +17,7 @@ impl Irq {
     /// The interrupt of IRQ number `number` (CMSIS IRQn), if the image uses it.
     pub fn from_number(number: i16) -> Option<Irq> {
         match number {
-            28 => Some(Irq::Tim2),
+            50 => Some(Irq::Tim5),
             37 => Some(Irq::Usart1),
             _ => None,
         }

@@ -120,6 +120,8 @@ const fn gpio_port(base: usize) -> GpioPort {
 pub const GPIOA: GpioPort = gpio_port(0x4002_0000);
 /// GPIO port B.
 pub const GPIOB: GpioPort = gpio_port(0x4002_0400);
+/// GPIO port C.
+pub const GPIOC: GpioPort = gpio_port(0x4002_0800);
 
 /// USART1 (RM0090 §30.6).
 pub mod usart1 {
@@ -139,7 +141,7 @@ pub mod usart1 {
     pub const CR3: Reg = Reg::at(BASE, 0x14);
 }
 
-/// A general-purpose timer's registers (TIM2..TIM5, RM0090 §18.4).
+/// A timer's registers (TIM2..TIM5 RM0090 §18.4; TIM8 §17.4 shares the offsets).
 #[derive(Clone, Copy)]
 pub struct GeneralTimer {
     /// Control 1: enable, direction, auto-reload preload.
@@ -162,6 +164,8 @@ pub struct GeneralTimer {
     pub arr: Reg,
     /// Compare values of channels 1..=4.
     pub ccr: [Reg; 4],
+    /// Break and dead time (advanced timers TIM1/TIM8 only: MOE gates their outputs).
+    pub bdtr: Reg,
 }
 
 const fn general_timer(base: usize) -> GeneralTimer {
@@ -181,13 +185,21 @@ const fn general_timer(base: usize) -> GeneralTimer {
             Reg::at(base, 0x3C),
             Reg::at(base, 0x40),
         ],
+        bdtr: Reg::at(base, 0x44),
     }
 }
 
-/// TIM2: 32-bit, the control-loop tick.
+/// TIM2: 32-bit, the ESC output.
 pub const TIM2: GeneralTimer = general_timer(0x4000_0000);
-/// TIM3: 16-bit, the four servo PWM outputs.
+/// TIM3: 16-bit, swash servo 3.
 pub const TIM3: GeneralTimer = general_timer(0x4000_0400);
+/// TIM4: 16-bit, swash servos 1 and 2.
+pub const TIM4: GeneralTimer = general_timer(0x4000_0800);
+/// TIM5: 32-bit, the control-loop tick.
+pub const TIM5: GeneralTimer = general_timer(0x4000_0C00);
+/// TIM8: advanced 16-bit timer (same layout for what the image uses, plus BDTR), the
+/// tail servo (RM0090 §17.4).
+pub const TIM8: GeneralTimer = general_timer(0x4001_0400);
 
 /// Nested vectored interrupt controller (ARMv7-M ARM §B3.4).
 pub mod nvic {

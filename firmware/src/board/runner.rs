@@ -1,6 +1,6 @@
 //! The control loop: boot sequence, the two run modes, and the tick itself.
 //!
-//! **Standalone** (from boot): TIM2 paces the loop at the configured rate. There is no
+//! **Standalone** (from boot): TIM5 paces the loop at the configured rate. There is no
 //! sensor or receiver driver on this board yet, so each tick runs the flight logic on a
 //! neutral [`SensorIn`] (all zeros, test switch off, `seq` 0): the sequencer stays Idle
 //! and passes the (centred) pilot through, and every tick still streams its Sample.
@@ -11,7 +11,7 @@
 //! last frame of the tick, so the host knows the tick's telemetry is complete when it
 //! arrives. Lockstep keeps a simulation deterministic whatever the emulator's or the
 //! host's speed. A Header goes out when the mode is entered, so a dump recorded from
-//! that point on starts with one. TIM2 keeps running as the link watchdog: after
+//! that point on starts with one. TIM5 keeps running as the link watchdog: after
 //! [`LINK_TIMEOUT_S`] without a SensorIn the loop steps on its own again, on the last
 //! SensorIn, whose unchanging `seq` makes the flight logic's stale-sensor check abort
 //! any running test to pilot pass-through; the next SensorIn resumes lockstep.
@@ -22,7 +22,7 @@
 //! logic on it (tick 0); a configuration the flight logic refuses leaves the running
 //! one in place. Either way a [`ConfigureResult`] answers, preceded by the new Header
 //! when accepted, and the loop is in the loop from then on (the Header is the mode
-//! entry's, so the first SensorIn does not send another). TIM2 keeps the boot rate: in
+//! entry's, so the first SensorIn does not send another). TIM5 keeps the boot rate: in
 //! the loop it is only the link watchdog, still [`LINK_TIMEOUT_S`] long.
 
 use sweephold_firmware::{Config, FlightController};
@@ -132,7 +132,7 @@ fn link_config(request: &LinkConfig) -> Config {
 /// How the loop is paced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
 pub enum Mode {
-    /// No host: TIM2 paces the loop on the neutral input.
+    /// No host: TIM5 paces the loop on the neutral input.
     Standalone,
     /// Host in the loop: one tick per SensorIn.
     InTheLoop {
@@ -395,7 +395,7 @@ fn run_semihosting(mut runner: Runner) -> ! {
     usart::capture();
     // The host is the clock: the loop timer's interrupt would only land in the middle of
     // ticks (and, in QEMU, at host-speed-dependent places).
-    nvic::disable(Irq::Tim2);
+    nvic::disable(Irq::Tim5);
     let (Some(input), Some(output)) = (
         semihosting::open(b"sweephold-in\0", false),
         semihosting::open(b"sweephold-out\0", true),

@@ -1,14 +1,13 @@
-//! Servo outputs: four PWM channels of TIM3 behind `embedded_hal::pwm::SetDutyCycle`.
+//! Servo and ESC outputs: PWM compare channels behind `embedded_hal::pwm::SetDutyCycle`.
 //!
-//! | output | signal            | pin | TIM3 channel | AF |
-//! |--------|-------------------|-----|--------------|----|
-//! | 1      | swash servo 1     | PA6 | CH1          | 2  |
-//! | 2      | swash servo 2     | PA7 | CH2          | 2  |
-//! | 3      | swash servo 3     | PB0 | CH3          | 2  |
-//! | 4      | tail servo        | PB1 | CH4          | 2  |
+//! Which pad, timer and channel drives what is the board's pin map ([`super::pins`]):
+//! swash servos 1–3 on TIM4 CH1/CH2 and TIM3 CH3, the tail servo on TIM8 CH3, the ESC on
+//! TIM2 CH3. Each timer counts microseconds (prescaler from its actual kernel clock) at
+//! the frame rate of its group ([`super::pins::OutputTimer::frame_hz`]), so a channel's
+//! duty value is the pulse width in µs and `max_duty_cycle()` is the frame period in µs.
 //!
-//! TIM3 counts microseconds (prescaler from its actual kernel clock), so a channel's duty
-//! value is the pulse width in µs and `max_duty_cycle()` is the frame period in µs.
+//! From boot the servos hold their failsafe pulses and the ESC the throttle cut
+//! ([`ESC_CUT_US`]): the pins carry them before any other driver starts.
 
 use core::convert::Infallible;
 use core::sync::atomic::{AtomicU16, Ordering};
@@ -18,16 +17,14 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use super::clocks::{ClockGate, Clocks};
 use super::dividers::{self, DividerError};
 use super::gpio::{self, Pull};
-use super::regs::{Reg, GPIOA, GPIOB, TIM3};
+use super::pins::{self, Output, OutputTimer};
+use super::regs::{GeneralTimer, Reg, TIM2, TIM3, TIM4, TIM8};
 
-/// PWM frame rate [Hz]. 50 Hz is safe for every servo; digital swash servos of the
-/// 700 class accept up to 333 Hz (then the frame is 3003 µs, still above the pulse).
-pub const FRAME_HZ: u32 = 50;
+pub use super::pins::{MAX_PULSE_US, MIN_PULSE_US};
 
-/// Shortest pulse ever put on a pin [µs]; the flight logic's outputs are clamped here.
-pub const MIN_PULSE_US: u16 = 900;
-/// Longest pulse ever put on a pin [µs].
-pub const MAX_PULSE_US: u16 = 2100;
+/// The ESC's pulse while the motor must not run [µs]: the throttle cut of the board
+/// application's standard ESC range (`ThrottleSettings::standard().esc_min_us`).
+pub const ESC_CUT_US: u16 = 1000;
 
 /// Pulses of the safe state until the flight logic's mixer is known [µs]: the servo
 /// centre of the standard RC convention.
@@ -55,8 +52,35 @@ const CCMR_PWM1_PRELOAD: u32 = (0b110 << 4) | (1 << 3); // OCxM = PWM mode 1, OC
 const CR1_CEN: u32 = 1 << 0;
 const CR1_ARPE: u32 = 1 << 7;
 const EGR_UG: u32 = 1 << 0;
+const BDTR_MOE: u32 = 1 << 15;
 
-/// One servo output (a TIM3 compare channel).
+/// The registers, clock gate and kernel clock of an output timer.
+fn timer_of(timer: OutputTimer, clocks: &Clocks) -> (GeneralTimer, ClockGate, u32) {
+    match timer {
+        OutputTimer::Tim2 => (TIM2, ClockGate::TIM2, clocks.apb1_timer_hz),
+        OutputTimer::Tim3 => (TIM3, ClockGate::TIM3, clocks.apb1_timer_hz),
+        OutputTimer::Tim4 => (TIM4, ClockGate::TIM4, clocks.apb1_timer_hz),
+        OutputTimer::Tim8 => (TIM8, ClockGate::TIM8, clocks.apb2_timer_hz),
+    }
+}
+
+/// The registers of an output timer (no clock needed).
+const fn registers(timer: OutputTimer) -> GeneralTimer {
+    match timer {
+        OutputTimer::Tim2 => TIM2,
+        OutputTimer::Tim3 => TIM3,
+        OutputTimer::Tim4 => TIM4,
+        OutputTimer::Tim8 => TIM8,
+    }
+}
+
+/// The compare register of `output`.
+fn compare(output: &Output) -> Reg {
+    let ccr = registers(output.timer).ccr;
+    ccr[usize::from(output.channel.clamp(1, 4) - 1)]
+}
+
+/// One servo output (a timer compare channel).
 pub struct ServoChannel {
     compare: Reg,
     period_us: u16,
@@ -93,39 +117,61 @@ impl<P: SetDutyCycle> Servos<P> {
     }
 }
 
-/// Start TIM3 with the failsafe pulses loaded before the outputs are enabled.
+/// Start every output timer at its group's frame rate with the failsafe pulses (servos)
+/// and the throttle cut (ESC) loaded before the outputs are enabled.
 pub fn init(clocks: &Clocks) -> Result<Servos<ServoChannel>, DividerError> {
-    // TIM3 shares TIM2's APB1 timer clock.
-    let (prescaler, reload) = dividers::servo_dividers(clocks.apb1_timer_hz, FRAME_HZ)?;
-    ClockGate::TIM3.enable();
-    ClockGate::GPIOA.enable();
-    ClockGate::GPIOB.enable();
-    TIM3.cr1.write(0);
-    TIM3.psc.write(u32::from(prescaler));
-    TIM3.arr.write(u32::from(reload));
+    for timer in OutputTimer::ALL {
+        let (regs, gate, timer_hz) = timer_of(timer, clocks);
+        let (prescaler, reload) = dividers::servo_dividers(timer_hz, timer.frame_hz())?;
+        gate.enable();
+        regs.cr1.write(0);
+        regs.psc.write(u32::from(prescaler));
+        regs.arr.write(u32::from(reload));
+    }
     force_failsafe();
-    TIM3.ccmr1
-        .write(CCMR_PWM1_PRELOAD | (CCMR_PWM1_PRELOAD << 8));
-    TIM3.ccmr2
-        .write(CCMR_PWM1_PRELOAD | (CCMR_PWM1_PRELOAD << 8));
-    // Load prescaler, reload and compare preloads, then enable the four outputs.
-    TIM3.egr.write(EGR_UG);
-    TIM3.ccer.write((1 << 0) | (1 << 4) | (1 << 8) | (1 << 12));
-    TIM3.cr1.write(CR1_ARPE | CR1_CEN);
-    gpio::alternate_function(GPIOA, 6, 2, Pull::None);
-    gpio::alternate_function(GPIOA, 7, 2, Pull::None);
-    gpio::alternate_function(GPIOB, 0, 2, Pull::None);
-    gpio::alternate_function(GPIOB, 1, 2, Pull::None);
-    let period_us = reload.saturating_add(1);
+    let outputs = pins::SERVOS.iter().chain([&pins::ESC]);
+    for output in outputs.clone() {
+        let regs = registers(output.timer);
+        let (ccmr, shift) = match output.channel {
+            1 => (regs.ccmr1, 0),
+            2 => (regs.ccmr1, 8),
+            3 => (regs.ccmr2, 0),
+            _ => (regs.ccmr2, 8),
+        };
+        ccmr.write_field(shift, 8, CCMR_PWM1_PRELOAD);
+        regs.ccer
+            .set_bits(1 << (4 * u32::from(output.channel.clamp(1, 4) - 1)));
+    }
+    // Load prescaler, reload and compare preloads, then start the counters; the advanced
+    // timer's outputs also need their main output enable.
+    for timer in OutputTimer::ALL {
+        let regs = registers(timer);
+        regs.egr.write(EGR_UG);
+        if timer == OutputTimer::Tim8 {
+            regs.bdtr.write(BDTR_MOE);
+        }
+        regs.cr1.write(CR1_ARPE | CR1_CEN);
+    }
+    for output in outputs {
+        gpio::alternate_function(output.pin, Pull::None);
+    }
     Ok(Servos {
-        channels: TIM3.ccr.map(|compare| ServoChannel { compare, period_us }),
+        channels: pins::SERVOS.map(|output| {
+            let frame_us = dividers::SERVO_COUNTER_HZ / output.timer.frame_hz();
+            ServoChannel {
+                compare: compare(&output),
+                period_us: u16::try_from(frame_us).unwrap_or(u16::MAX),
+            }
+        }),
     })
 }
 
-/// Write the failsafe pulses straight into the compare registers. Needs no driver
-/// state, so the panic and fault handlers can call it whatever the program was doing.
+/// Write the failsafe pulses and the throttle cut straight into the compare registers.
+/// Needs no driver state, so the panic and fault handlers can call it whatever the
+/// program was doing.
 pub fn force_failsafe() {
-    for (compare, pulse) in TIM3.ccr.iter().zip(&FAILSAFE_PULSE_US) {
-        compare.write(u32::from(pulse.load(Ordering::Relaxed)));
+    for (output, pulse) in pins::SERVOS.iter().zip(&FAILSAFE_PULSE_US) {
+        compare(output).write(u32::from(pulse.load(Ordering::Relaxed)));
     }
+    compare(&pins::ESC).write(u32::from(ESC_CUT_US));
 }

@@ -24,7 +24,8 @@ use super::clocks::{ClockGate, Clocks};
 use super::dividers::{self, DividerError};
 use super::gpio::{self, Pull};
 use super::nvic::{self, Irq};
-use super::regs::{usart1, GPIOA};
+use super::pins;
+use super::regs::usart1;
 
 /// Line rate [Bd]. A 200 Hz loop in the loop with a host sends a Sample (~130 bytes on
 /// the wire) and an ActuatorOut (~35) per tick: 33 kB/s, 72 % of the 46 kB/s that
@@ -58,10 +59,9 @@ static RX_LOST: AtomicU32 = AtomicU32::new(0);
 /// Configure pins, baud rate and interrupts; returns the two halves of the link.
 pub fn init(clocks: &Clocks) -> Result<(UsartTx, UsartRx), DividerError> {
     let brr = dividers::usart_brr(clocks.pclk2_hz, BAUD)?;
-    ClockGate::GPIOA.enable();
     ClockGate::USART1.enable();
-    gpio::alternate_function(GPIOA, 9, 7, Pull::None);
-    gpio::alternate_function(GPIOA, 10, 7, Pull::Up);
+    gpio::alternate_function(pins::LINK_TX, Pull::None);
+    gpio::alternate_function(pins::LINK_RX, Pull::Up);
     usart1::CR1.write(0);
     usart1::BRR.write(brr);
     usart1::CR2.write(0); // 1 stop bit
