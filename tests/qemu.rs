@@ -2,8 +2,8 @@
 //! firmware library in-process, byte for byte, and its defmt log comes back decoded.
 //!
 //! Needs `qemu-system-arm` and the image (`cargo fw`; or the path in `SWEEPHOLD_FC_ELF`),
-//! built after the last change to `firmware/src` and `shared/src`. Without them the test
-//! prints why and passes, so `cargo test --workspace` stays green on
+//! built after the last change to `firmware/src`, `firmware/board/src` and `shared/src`.
+//! Without them the test prints why and passes, so `cargo test --workspace` stays green on
 //! machines without QEMU — unless `SWEEPHOLD_REQUIRE_QEMU=1` (CI) turns that into a failure.
 //!
 //! Why the bytes can be equal at all: the flight logic is the same source compiled for
@@ -37,7 +37,7 @@ fn qemu_and_image() -> Result<PathBuf, String> {
         // expected to match (or to speak protocol 1.1): say so instead of failing on it.
         let built = modified(&image).ok_or_else(|| format!("cannot stat {}", image.display()))?;
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let newest = ["firmware/src", "shared/src"]
+        let newest = ["firmware/src", "firmware/board/src", "shared/src"]
             .iter()
             .filter_map(|dir| newest_in(&root.join(dir)))
             .max();

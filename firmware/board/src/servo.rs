@@ -1,9 +1,9 @@
 //! Servo and ESC outputs: PWM compare channels behind `embedded_hal::pwm::SetDutyCycle`.
 //!
-//! Which pad, timer and channel drives what is the board's pin map ([`super::pins`]):
+//! Which pad, timer and channel drives what is the board's pin map ([`crate::pins`]):
 //! swash servos 1–3 on TIM4 CH1/CH2 and TIM3 CH3, the tail servo on TIM8 CH3, the ESC on
 //! TIM2 CH3. Each timer counts microseconds (prescaler from its actual kernel clock) at
-//! the frame rate of its group ([`super::pins::OutputTimer::frame_hz`]), so a channel's
+//! the frame rate of its group ([`crate::pins::OutputTimer::frame_hz`]), so a channel's
 //! duty value is the pulse width in µs and `max_duty_cycle()` is the frame period in µs.
 //!
 //! From boot the servos hold their failsafe pulses and the ESC the throttle cut
@@ -14,13 +14,14 @@ use core::sync::atomic::{AtomicU16, Ordering};
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 
-use super::clocks::{ClockGate, Clocks};
-use super::dividers::{self, DividerError};
-use super::gpio::{self, Pull};
-use super::pins::{self, Output, OutputTimer};
-use super::regs::{GeneralTimer, Reg, TIM2, TIM3, TIM4, TIM8};
+use stm32f4::stm32f405 as pac;
 
-pub use super::pins::{MAX_PULSE_US, MIN_PULSE_US};
+use crate::clocks::{ClockGate, Clocks};
+use crate::dividers::{self, DividerError};
+use crate::gpio::{self, Pull};
+use crate::pins::{self, Output, OutputTimer};
+
+pub use crate::pins::{MAX_PULSE_US, MIN_PULSE_US};
 
 /// The ESC's pulse while the motor must not run [µs]: the throttle cut of the board
 /// application's standard ESC range (`ThrottleSettings::standard().esc_min_us`).
@@ -48,41 +49,62 @@ pub fn set_failsafe(pulse_us: [u16; 4]) {
     }
 }
 
-const CCMR_PWM1_PRELOAD: u32 = (0b110 << 4) | (1 << 3); // OCxM = PWM mode 1, OCxPE
-const CR1_CEN: u32 = 1 << 0;
-const CR1_ARPE: u32 = 1 << 7;
-const EGR_UG: u32 = 1 << 0;
-const BDTR_MOE: u32 = 1 << 15;
+/// Run `$body` with `$tim` bound to the register block of `$timer` (the PAC gives the
+/// 32-bit, the 16-bit general-purpose and the advanced timers their own types; the
+/// field API the image uses is the same).
+macro_rules! with_timer {
+    ($timer:expr, |$tim:ident| $body:expr) => {
+        match $timer {
+            OutputTimer::Tim2 => {
+                // SAFETY: TIM2's register block is always mapped. This module is its only
+                // user; its read-modify-writes run in thread mode at boot, before any
+                // interrupt exists that could touch it, and afterwards only whole
+                // compare registers are written (single volatile stores).
+                let $tim = unsafe { &*pac::TIM2::ptr() };
+                $body
+            }
+            OutputTimer::Tim3 => {
+                // SAFETY: as for TIM2.
+                let $tim = unsafe { &*pac::TIM3::ptr() };
+                $body
+            }
+            OutputTimer::Tim4 => {
+                // SAFETY: as for TIM2.
+                let $tim = unsafe { &*pac::TIM4::ptr() };
+                $body
+            }
+            OutputTimer::Tim8 => {
+                // SAFETY: as for TIM2.
+                let $tim = unsafe { &*pac::TIM8::ptr() };
+                $body
+            }
+        }
+    };
+}
 
-/// The registers, clock gate and kernel clock of an output timer.
-fn timer_of(timer: OutputTimer, clocks: &Clocks) -> (GeneralTimer, ClockGate, u32) {
+/// The kernel clock and the clock gate of an output timer.
+fn clock_of(timer: OutputTimer, clocks: &Clocks) -> (ClockGate, u32) {
     match timer {
-        OutputTimer::Tim2 => (TIM2, ClockGate::TIM2, clocks.apb1_timer_hz),
-        OutputTimer::Tim3 => (TIM3, ClockGate::TIM3, clocks.apb1_timer_hz),
-        OutputTimer::Tim4 => (TIM4, ClockGate::TIM4, clocks.apb1_timer_hz),
-        OutputTimer::Tim8 => (TIM8, ClockGate::TIM8, clocks.apb2_timer_hz),
+        OutputTimer::Tim2 => (ClockGate::Tim2, clocks.apb1_timer_hz),
+        OutputTimer::Tim3 => (ClockGate::Tim3, clocks.apb1_timer_hz),
+        OutputTimer::Tim4 => (ClockGate::Tim4, clocks.apb1_timer_hz),
+        OutputTimer::Tim8 => (ClockGate::Tim8, clocks.apb2_timer_hz),
     }
 }
 
-/// The registers of an output timer (no clock needed).
-const fn registers(timer: OutputTimer) -> GeneralTimer {
-    match timer {
-        OutputTimer::Tim2 => TIM2,
-        OutputTimer::Tim3 => TIM3,
-        OutputTimer::Tim4 => TIM4,
-        OutputTimer::Tim8 => TIM8,
-    }
-}
-
-/// The compare register of `output`.
-fn compare(output: &Output) -> Reg {
-    let ccr = registers(output.timer).ccr;
-    ccr[usize::from(output.channel.clamp(1, 4) - 1)]
+/// Write `pulse_us` into the compare register of `output` (a single store).
+// One body serves the 32-bit TIM2 (u32 fields) and the 16-bit timers (u16 fields).
+#[allow(clippy::useless_conversion)]
+fn write_compare(output: &Output, pulse_us: u16) {
+    let index = usize::from(output.channel.clamp(1, 4) - 1);
+    with_timer!(output.timer, |tim| tim
+        .ccr(index)
+        .write(|w| w.ccr().set(pulse_us.into())));
 }
 
 /// One servo output (a timer compare channel).
 pub struct ServoChannel {
-    compare: Reg,
+    output: Output,
     period_us: u16,
 }
 
@@ -96,7 +118,7 @@ impl SetDutyCycle for ServoChannel {
     }
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
-        self.compare.write(u32::from(duty.min(self.period_us)));
+        write_compare(&self.output, duty.min(self.period_us));
         Ok(())
     }
 }
@@ -119,39 +141,51 @@ impl<P: SetDutyCycle> Servos<P> {
 
 /// Start every output timer at its group's frame rate with the failsafe pulses (servos)
 /// and the throttle cut (ESC) loaded before the outputs are enabled.
+// One body serves the 32-bit TIM2 (u32 fields) and the 16-bit timers (u16 fields).
+#[allow(clippy::useless_conversion)]
 pub fn init(clocks: &Clocks) -> Result<Servos<ServoChannel>, DividerError> {
     for timer in OutputTimer::ALL {
-        let (regs, gate, timer_hz) = timer_of(timer, clocks);
+        let (gate, timer_hz) = clock_of(timer, clocks);
         let (prescaler, reload) = dividers::servo_dividers(timer_hz, timer.frame_hz())?;
         gate.enable();
-        regs.cr1.write(0);
-        regs.psc.write(u32::from(prescaler));
-        regs.arr.write(u32::from(reload));
+        with_timer!(timer, |tim| {
+            tim.cr1().reset();
+            tim.psc().write(|w| w.psc().set(prescaler));
+            tim.arr().write(|w| w.arr().set(reload.into()));
+        });
     }
     force_failsafe();
     let outputs = pins::SERVOS.iter().chain([&pins::ESC]);
     for output in outputs.clone() {
-        let regs = registers(output.timer);
-        let (ccmr, shift) = match output.channel {
-            1 => (regs.ccmr1, 0),
-            2 => (regs.ccmr1, 8),
-            3 => (regs.ccmr2, 0),
-            _ => (regs.ccmr2, 8),
-        };
-        ccmr.write_field(shift, 8, CCMR_PWM1_PRELOAD);
-        regs.ccer
-            .set_bits(1 << (4 * u32::from(output.channel.clamp(1, 4) - 1)));
+        // PWM mode 1 with the compare preload on; channels 1, 2 in CCMR1, 3, 4 in CCMR2.
+        let index = output.channel.clamp(1, 4) - 1;
+        let within = index % 2;
+        with_timer!(output.timer, |tim| {
+            if index < 2 {
+                tim.ccmr1_output().modify(|_, w| {
+                    w.ocm(within).pwm_mode1();
+                    w.ocpe(within).set_bit()
+                });
+            } else {
+                tim.ccmr2_output().modify(|_, w| {
+                    w.ocm(within).pwm_mode1();
+                    w.ocpe(within).set_bit()
+                });
+            }
+            tim.ccer().modify(|_, w| w.cce(index).set_bit());
+        });
     }
     // Load prescaler, reload and compare preloads, then start the counters; the advanced
     // timer's outputs also need their main output enable.
     for timer in OutputTimer::ALL {
-        let regs = registers(timer);
-        regs.egr.write(EGR_UG);
-        if timer == OutputTimer::Tim8 {
-            regs.bdtr.write(BDTR_MOE);
-        }
-        regs.cr1.write(CR1_ARPE | CR1_CEN);
+        with_timer!(timer, |tim| {
+            tim.egr().write(|w| w.ug().set_bit());
+            tim.cr1().write(|w| w.arpe().set_bit().cen().set_bit());
+        });
     }
+    // SAFETY: as in `with_timer!`: TIM8 is this module's, written at boot only.
+    let tim8 = unsafe { &*pac::TIM8::ptr() };
+    tim8.bdtr().modify(|_, w| w.moe().set_bit());
     for output in outputs {
         gpio::alternate_function(output.pin, Pull::None);
     }
@@ -159,7 +193,7 @@ pub fn init(clocks: &Clocks) -> Result<Servos<ServoChannel>, DividerError> {
         channels: pins::SERVOS.map(|output| {
             let frame_us = dividers::SERVO_COUNTER_HZ / output.timer.frame_hz();
             ServoChannel {
-                compare: compare(&output),
+                output,
                 period_us: u16::try_from(frame_us).unwrap_or(u16::MAX),
             }
         }),
@@ -171,7 +205,7 @@ pub fn init(clocks: &Clocks) -> Result<Servos<ServoChannel>, DividerError> {
 /// program was doing.
 pub fn force_failsafe() {
     for (output, pulse) in pins::SERVOS.iter().zip(&FAILSAFE_PULSE_US) {
-        compare(output).write(u32::from(pulse.load(Ordering::Relaxed)));
+        write_compare(output, pulse.load(Ordering::Relaxed));
     }
-    compare(&pins::ESC).write(u32::from(ESC_CUT_US));
+    write_compare(&pins::ESC, ESC_CUT_US);
 }

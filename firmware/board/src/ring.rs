@@ -67,46 +67,14 @@ impl<const N: usize> ByteRing<N> {
             slot.copy_from_slice(stored);
         }
         self.len -= count;
-        // An empty ring starts over at 0: the next frame then finds the whole array free
-        // in one piece (see `fill_contiguous`).
+        // An empty ring starts over at 0, so its bytes stay in one piece as long as
+        // possible.
         self.head = if self.len == 0 {
             0
         } else {
             (self.head + count) % N
         };
         count
-    }
-
-    /// Let `fill` write up to `at_least` bytes straight into the ring, when that much
-    /// room is free in one piece after the newest byte; it returns how many it wrote
-    /// (kept) or `None` (nothing kept). `false` when the room was not there (`fill` not
-    /// called): the caller copies instead. This saves the copy of a frame that is
-    /// encoded where it will be sent from.
-    pub fn fill_contiguous(
-        &mut self,
-        at_least: usize,
-        fill: impl FnOnce(&mut [u8]) -> Option<usize>,
-    ) -> bool {
-        let tail = (self.head + self.len) % N;
-        // Free bytes in one piece: up to the end of the array, or up to the head once
-        // the stored bytes wrap.
-        let end = if tail >= self.head && self.len < N {
-            N
-        } else {
-            self.head
-        };
-        let Some(space) = self
-            .bytes
-            .get_mut(tail..end)
-            .filter(|s| s.len() >= at_least)
-        else {
-            return false;
-        };
-        let room = space.len();
-        if let Some(written) = fill(space) {
-            self.len += written.min(room);
-        }
-        true
     }
 
     /// Take the oldest byte.
@@ -153,40 +121,6 @@ mod tests {
             assert_eq!(16 - ring.room(), model.len());
             assert_eq!(ring.is_empty(), model.is_empty());
         }
-    }
-
-    #[test]
-    fn fills_in_place_only_where_there_is_room_in_one_piece() {
-        let mut ring: ByteRing<8> = ByteRing::new();
-        assert!(ring.fill_contiguous(8, |space| {
-            assert_eq!(space.len(), 8);
-            space[..3].copy_from_slice(&[1, 2, 3]);
-            Some(3)
-        }));
-        // 5 free in one piece after the three.
-        assert!(!ring.fill_contiguous(6, |_| unreachable!()));
-        assert!(ring.fill_contiguous(5, |space| {
-            space[0] = 4;
-            Some(1)
-        }));
-        let mut out = [0u8; 2];
-        assert_eq!(ring.pop_slice(&mut out), 2);
-        // Stored 3, 4 at 2..4; free in one piece: 4..8.
-        assert!(ring.fill_contiguous(4, |space| {
-            assert_eq!(space.len(), 4);
-            space.copy_from_slice(&[5, 6, 7, 8]);
-            Some(4)
-        }));
-        // Now wrapped free space is 0..2 only.
-        assert!(ring.fill_contiguous(2, |space| {
-            assert_eq!(space.len(), 2);
-            None
-        }));
-        let mut all = [0u8; 8];
-        assert_eq!(ring.pop_slice(&mut all), 6);
-        assert_eq!(&all[..6], &[3, 4, 5, 6, 7, 8]);
-        // Emptied: starts over with the whole array.
-        assert!(ring.fill_contiguous(8, |_| None));
     }
 
     #[test]

@@ -31,15 +31,15 @@ use sweephold_protocol::{
     VehicleId,
 };
 
-use super::clocks::{self, ClockSource, Clocks};
-use super::dividers;
-use super::link::{self, FrameScratch, Inbound, Telemetry};
-use super::log;
-use super::nvic::{self, Irq};
-use super::semihosting;
-use super::servo::{self, ServoChannel, Servos};
-use super::ticker::Ticker;
-use super::usart::{self, UsartTx};
+use crate::clocks::{self, ClockSource, Clocks};
+use crate::dividers;
+use crate::link::{self, FrameScratch, Inbound, Telemetry};
+use crate::log;
+use crate::nvic::{self, Irq};
+use crate::semihosting;
+use crate::servo::{self, ServoChannel, Servos};
+use crate::ticker::Ticker;
+use crate::usart::{self, UsartTx};
 
 /// Host silence after which the loop steps on its own again [s].
 pub const LINK_TIMEOUT_S: u32 = 1;
