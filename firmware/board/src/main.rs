@@ -42,6 +42,8 @@ mod servo;
 mod ticker;
 #[cfg(target_os = "none")]
 mod usart;
+#[cfg(target_os = "none")]
+mod watchdog;
 
 #[cfg(target_os = "none")]
 mod image {

@@ -16,6 +16,9 @@
 //! SensorIn, whose unchanging `seq` makes the flight logic's stale-sensor check abort
 //! any running test to pilot pass-through; the next SensorIn resumes lockstep.
 //!
+//! Every SensorIn is also the fresh sample that feeds the independent watchdog
+//! ([`crate::watchdog`]), which the first one starts.
+//!
 //! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the compiled-in
 //! configuration at run time. The image builds the preset of the frame's vehicle for
 //! its test's primary axis, puts the frame's rate and test in, and restarts the flight
@@ -40,6 +43,7 @@ use crate::semihosting;
 use crate::servo::{self, ServoChannel, Servos};
 use crate::ticker::Ticker;
 use crate::usart::{self, UsartTx};
+use crate::watchdog::Watchdog;
 
 /// Host silence after which the loop steps on its own again [s].
 pub const LINK_TIMEOUT_S: u32 = 1;
@@ -174,6 +178,8 @@ pub struct Runner {
     stats: LoopStats,
     /// Where frames are encoded before they go into the transmit ring.
     scratch: FrameScratch,
+    /// Fed by every fresh sample (in the loop: every SensorIn).
+    watchdog: Watchdog,
 }
 
 impl Runner {
@@ -189,6 +195,7 @@ impl Runner {
             ticks_since_status: 0,
             stats: LoopStats::default(),
             scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
+            watchdog: Watchdog::new(),
         }
     }
 
@@ -313,6 +320,8 @@ impl Runner {
                 self.mode = Mode::InTheLoop { silent_ticks: 0 };
                 self.input = input;
                 self.step(Some(input.seq));
+                // The host's SensorIn is the fresh sample of the loop.
+                self.watchdog.fed_by_fresh_sample();
             }
             Ok(Frame::Configure(request)) => self.configure(&request),
             Ok(_) => self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1),
