@@ -312,3 +312,56 @@ fn qemu_refuses_a_bad_configuration_and_keeps_flying() {
         assert!(log.contains(expected), "no {expected:?} in\n{log}");
     }
 }
+
+/// The onboard log: standalone, the image sends the same frames to the logger's UART
+/// (USART3, the third `-serial`) as to the host link (USART1), and the logger's file
+/// decodes as a dump does.
+#[test]
+fn qemu_log_uart_carries_the_same_frames_as_the_link() {
+    let Some(image) = image_or_skip("qemu_log_uart_carries_the_same_frames_as_the_link") else {
+        return;
+    };
+    let dir = Scratch::new("qemu-log-uart");
+    let (link, log) = (dir.path().join("usart1.bin"), dir.path().join("usart3.bin"));
+    let mut qemu = std::process::Command::new("qemu-system-arm")
+        .args([
+            "-M",
+            "netduinoplus2",
+            "-nographic",
+            "-monitor",
+            "none",
+            "-kernel",
+        ])
+        .arg(&image)
+        .arg("-serial")
+        .arg(format!("file:{}", link.display()))
+        .args(["-serial", "null", "-serial"])
+        .arg(format!("file:{}", log.display()))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("qemu-system-arm starts");
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    qemu.kill().expect("QEMU stops");
+    qemu.wait().expect("QEMU is reaped");
+    let decode = |path: &std::path::Path| -> Vec<Frame> {
+        let bytes = std::fs::read(path).unwrap();
+        // The kill may cut the last frame: decode whole frames only.
+        let end = bytes.iter().rposition(|&b| b == 0).map_or(0, |i| i + 1);
+        frames(&bytes[..end])
+    };
+    let (link_frames, log_frames) = (decode(&link), decode(&log));
+    assert!(
+        matches!(log_frames.first(), Some(Frame::Header(_))),
+        "the log starts with the boot Header: {:?}",
+        log_frames.first()
+    );
+    let samples = log_frames
+        .iter()
+        .filter(|f| matches!(f, Frame::Sample(_)))
+        .count();
+    assert!(samples >= 20, "{samples} Samples in the log");
+    let common = link_frames.len().min(log_frames.len());
+    assert!(common + 2 >= link_frames.len().max(log_frames.len()));
+    assert_eq!(link_frames[..common], log_frames[..common]);
+}

@@ -225,6 +225,8 @@ pub enum ClockGate {
     Tim8,
     /// USART1 (APB2ENR.USART1EN).
     Usart1,
+    /// USART3 (APB1ENR.USART3EN).
+    Usart3,
 }
 
 impl ClockGate {
@@ -242,6 +244,7 @@ impl ClockGate {
             ClockGate::Tim5 => rcc.apb1enr().modify(|_, w| w.tim5en().set_bit()),
             ClockGate::Tim8 => rcc.apb2enr().modify(|_, w| w.tim8en().set_bit()),
             ClockGate::Usart1 => rcc.apb2enr().modify(|_, w| w.usart1en().set_bit()),
+            ClockGate::Usart3 => rcc.apb1enr().modify(|_, w| w.usart3en().set_bit()),
         };
         let _ = rcc.ahb1enr().read();
         let _ = rcc.apb1enr().read();

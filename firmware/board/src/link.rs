@@ -4,6 +4,7 @@ use sweephold_firmware::FrameSink;
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{encode, Decoder, Frame, FrameError, MAX_FRAME_LEN};
 
+use crate::logport;
 use crate::usart::{UsartRx, UsartTx};
 
 /// Bytes taken from the receive ring per decoder pass.
@@ -63,6 +64,7 @@ pub fn send_waiting(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame)
     // Encoded with interrupts enabled; only the copy into the ring masks them.
     if let Ok(len) = encode(frame, scratch) {
         if let Some(bytes) = scratch.get(..len) {
+            logport::log_frame(bytes);
             // Infallible, and `write` never returns Ok(0) for a non-empty buffer.
             let _ = embedded_io::Write::write_all(tx, bytes);
         }

@@ -27,6 +27,8 @@ mod link;
 #[cfg(target_os = "none")]
 mod log;
 #[cfg(target_os = "none")]
+mod logport;
+#[cfg(target_os = "none")]
 mod nvic;
 #[cfg(any(target_os = "none", test))]
 mod pins;
@@ -50,7 +52,7 @@ mod image {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use stm32f4::stm32f405::interrupt;
 
-    use crate::{log, runner, servo, ticker, usart};
+    use crate::{log, logport, runner, servo, ticker, usart};
 
     // Log lines carry the loop tick they were written in (the `tick` of the Sample).
     defmt::timestamp!("{=u32}", log::tick());
@@ -79,6 +81,12 @@ mod image {
         usart::on_interrupt();
     }
 
+    /// The onboard log: room in its transmitter.
+    #[interrupt]
+    fn USART3() {
+        logport::on_interrupt();
+    }
+
     /// Put the aircraft in the safe state from any context (panic, fault): interrupts
     /// off, servos to their failsafe pulses, the ESC to the throttle cut, the link's
     /// interrupt masked. Touches registers only, no driver state, so it works whatever
@@ -87,6 +95,7 @@ mod image {
         cortex_m::interrupt::disable();
         servo::force_failsafe();
         usart::silence();
+        logport::silence();
     }
 
     /// An interrupt or exception the image never enabled: a fault like any other.

@@ -16,6 +16,8 @@ pub enum Irq {
     Tim5,
     /// USART1 global interrupt: the host link (receive, and transmit on silicon).
     Usart1,
+    /// USART3 global interrupt: the onboard log's transmitter.
+    Usart3,
 }
 
 // 0x00 is the IMU's data-ready line and SPI transfer, 0x80 the receiver's UART: the
@@ -32,6 +34,7 @@ impl Irq {
         match self {
             Irq::Tim5 => pac::Interrupt::TIM5,
             Irq::Usart1 => pac::Interrupt::USART1,
+            Irq::Usart3 => pac::Interrupt::USART3,
         }
     }
 
@@ -39,7 +42,7 @@ impl Irq {
     pub fn priority(self) -> u8 {
         match self {
             Irq::Tim5 => PRIORITY_TICK,
-            Irq::Usart1 => PRIORITY_LINK,
+            Irq::Usart1 | Irq::Usart3 => PRIORITY_LINK,
         }
     }
 }

@@ -39,7 +39,7 @@
 //! (its writes go nowhere), which leaves the emulated runs unchanged.
 
 // The map names the whole board: pins of drivers the image does not start yet (IMU,
-// SBUS receiver, onboard log, LED) are part of it, so they are reserved here.
+// SBUS receiver, LED) are part of it, so they are reserved here.
 #![allow(dead_code)]
 
 /// A GPIO port of the pins the image uses.

@@ -87,6 +87,46 @@ impl<const N: usize> ByteRing<N> {
     pub fn push(&mut self, byte: u8) -> bool {
         self.push_slice(&[byte]) == 1
     }
+
+    /// Append `frame`, one whole COBS frame ending in its `0x00` delimiter, dropping the
+    /// oldest frames (each up to and including its delimiter) until it fits: the ring
+    /// then always holds the newest frames. Returns how many frames were dropped: the
+    /// oldest ones, or `frame` itself when it is longer than the ring. The oldest frame
+    /// may already be partly on the wire: after a drop an extra delimiter goes to the
+    /// front of the ring, so such a cut frame ends there (the reader's decoder skips it
+    /// as one corrupt frame, and skips the empty frame the delimiter makes otherwise).
+    pub fn push_frame_dropping_oldest(&mut self, frame: &[u8]) -> u32 {
+        if frame.len() >= N {
+            return 1;
+        }
+        if self.room() >= frame.len() {
+            self.push_slice(frame);
+            return 0;
+        }
+        let mut dropped = 0;
+        while self.room() < frame.len() + 1 {
+            while let Some(byte) = self.pop() {
+                if byte == 0 {
+                    break;
+                }
+            }
+            dropped += 1;
+        }
+        self.push_front(0);
+        self.push_slice(frame);
+        dropped
+    }
+
+    /// Put `byte` before the oldest byte (the caller has checked the room).
+    fn push_front(&mut self, byte: u8) {
+        if self.len < N {
+            self.head = (self.head + N - 1) % N;
+            if let Some(slot) = self.bytes.get_mut(self.head) {
+                *slot = byte;
+            }
+            self.len += 1;
+        }
+    }
 }
 
 #[cfg(test)]
@@ -121,6 +161,77 @@ mod tests {
             assert_eq!(16 - ring.room(), model.len());
             assert_eq!(ring.is_empty(), model.is_empty());
         }
+    }
+
+    /// The onboard log's path: frames as the encoder makes them, through the drop-oldest
+    /// ring, drained in bursts as the log UART sends them, and decoded as
+    /// `sweephold decode` reads a logger's file.
+    #[test]
+    fn a_log_drained_like_the_uart_decodes_like_a_dump() {
+        use sweephold_protocol::{encode, Axis, Decoder, Event, Frame, SensorIn, MAX_FRAME_LEN};
+
+        let frames: Vec<Frame> = (0..400u32)
+            .map(|tick| {
+                if tick % 50 == 7 {
+                    Frame::Event(Event::HoldEngaged {
+                        tick,
+                        axis: Axis::Lat,
+                    })
+                } else {
+                    Frame::SensorIn(SensorIn {
+                        seq: tick,
+                        ..SensorIn::default()
+                    })
+                }
+            })
+            .collect();
+        let mut ring: ByteRing<1024> = ByteRing::new();
+        let mut file = Vec::new();
+        let mut dropped = 0;
+        let mut scratch = [0u8; MAX_FRAME_LEN];
+        for (i, frame) in frames.iter().enumerate() {
+            let len = encode(frame, &mut scratch).unwrap();
+            dropped += ring.push_frame_dropping_oldest(&scratch[..len]);
+            // The logger's line is slower than the loop: it takes fewer bytes per tick
+            // than a tick queues, in bursts of varying size, so the ring overflows.
+            let mut burst = vec![0u8; 40 + (i * 37) % 60];
+            let count = ring.pop_slice(&mut burst);
+            file.extend_from_slice(&burst[..count]);
+        }
+        let mut rest = vec![0u8; 1024];
+        let count = ring.pop_slice(&mut rest);
+        file.extend_from_slice(&rest[..count]);
+
+        let mut decoder = Decoder::new();
+        let results: Vec<_> = decoder.feed(&file).collect();
+        let decoded: Vec<Frame> = results
+            .iter()
+            .filter_map(|r| r.as_ref().ok().copied())
+            .collect();
+        let corrupt = results.len() - decoded.len();
+        assert!(dropped > 0, "the test must overflow the ring");
+        // Every frame either arrives intact, in order, or was counted as dropped; a cut
+        // frame (dropped while partly sent) is the only kind of corrupt one.
+        assert_eq!(decoded.len() + dropped as usize, frames.len());
+        assert!(corrupt <= dropped as usize);
+        let mut expected = frames.iter();
+        for frame in &decoded {
+            assert!(expected.any(|f| f == frame), "{frame:?} out of order");
+        }
+        assert_eq!(decoded.last(), frames.last(), "the newest frames survive");
+    }
+
+    #[test]
+    fn frames_too_long_for_the_ring_are_dropped_whole() {
+        let mut ring: ByteRing<8> = ByteRing::new();
+        assert_eq!(ring.push_frame_dropping_oldest(&[1, 2, 3, 0]), 0);
+        assert_eq!(ring.push_frame_dropping_oldest(&[4, 5, 0]), 0);
+        assert_eq!(ring.push_frame_dropping_oldest(&[1; 9]), 1);
+        // Needs 4 bytes and a delimiter, 1 free: the oldest frame goes.
+        assert_eq!(ring.push_frame_dropping_oldest(&[6, 7, 8, 0]), 1);
+        let mut out = [0u8; 8];
+        let count = ring.pop_slice(&mut out);
+        assert_eq!(&out[..count], &[0, 4, 5, 0, 6, 7, 8, 0]);
     }
 
     #[test]

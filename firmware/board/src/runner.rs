@@ -38,6 +38,7 @@ use crate::clocks::{self, ClockSource, Clocks};
 use crate::dividers;
 use crate::link::{self, FrameScratch, Inbound, Telemetry};
 use crate::log;
+use crate::logport;
 use crate::nvic::{self, Irq};
 use crate::semihosting;
 use crate::servo::{self, ServoChannel, Servos};
@@ -259,11 +260,12 @@ impl Runner {
         if self.ticks_since_status >= self.status_period_ticks {
             self.ticks_since_status = 0;
             defmt::info!(
-                "mode {} {} tx dropped {=u32} rx lost {=u32}",
+                "mode {} {} tx dropped {=u32} rx lost {=u32} log dropped {=u32}",
                 self.mode,
                 self.stats,
                 self.tx.dropped_frames(),
-                usart::rx_lost()
+                usart::rx_lost(),
+                logport::dropped()
             );
         }
     }
@@ -351,6 +353,10 @@ pub fn run() -> ! {
         tx.brr(),
         dividers::baud_error_ppm(clocks.pclk2_hz, usart::BAUD, tx.brr())
     );
+
+    if let Err(error) = logport::init(&clocks) {
+        defmt::panic!("USART3 (log): {}", error);
+    }
 
     let fc = match FlightController::new(image_config()) {
         Ok(fc) => fc,

@@ -23,6 +23,7 @@ use cortex_m::interrupt::{self, CriticalSection, Mutex};
 use crate::clocks::{ClockGate, Clocks};
 use crate::dividers::{self, DividerError};
 use crate::gpio::{self, Pull};
+use crate::logport;
 use crate::nvic::{self, Irq};
 use crate::pins;
 use stm32f4::stm32f405 as pac;
@@ -157,6 +158,9 @@ impl UsartTx {
     /// Queue `frame` whole, or drop it whole when the ring lacks room (a partial frame
     /// would only cost the host a corrupt frame too). Returns `false` when dropped.
     pub fn queue_frame(&mut self, frame: &[u8]) -> bool {
+        // Every frame the link carries also goes to the onboard log, whether or not the
+        // link has room for it.
+        logport::log_frame(frame);
         let queued = interrupt::free(|cs| {
             let fits = {
                 let mut ring = TX.borrow(cs).borrow_mut();
