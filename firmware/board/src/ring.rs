@@ -77,10 +77,22 @@ impl<const N: usize> ByteRing<N> {
         count
     }
 
-    /// Take the oldest byte.
+    /// Take the oldest byte. Direct, not through [`pop_slice`](Self::pop_slice): the
+    /// transmitters take their bytes one at a time, and a one-byte `memcpy` call per byte
+    /// would cost several times the byte's own work.
     pub fn pop(&mut self) -> Option<u8> {
-        let mut byte = [0u8];
-        (self.pop_slice(&mut byte) == 1).then_some(byte[0])
+        if self.len == 0 {
+            return None;
+        }
+        let byte = self.bytes.get(self.head).copied();
+        self.len -= 1;
+        // As in `pop_slice`: an empty ring starts over at 0.
+        self.head = if self.len == 0 {
+            0
+        } else {
+            (self.head + 1) % N
+        };
+        byte
     }
 
     /// Append one byte; `false` when full.
