@@ -4,7 +4,7 @@
 //! Boots on the board and, unchanged, in `qemu-system-arm -M netduinoplus2`. The board
 //! support is this crate, on the `stm32f4` peripheral access crate: clocks, the tick
 //! timer, the servo and ESC outputs, the USART frame link and the loop that ties them to
-//! [`sweephold_firmware::FlightController`]. Which pin does what is [`pins`]. The flight
+//! [`sweephold_firmware::FlightController`]. Which pin does what is `pins.rs`. The flight
 //! logic is the `sweephold_firmware` library. On the host this is an empty program (so
 //! that `cargo build --workspace` works) whose unit tests cover the pin map, the divider
 //! arithmetic and the byte ring.
