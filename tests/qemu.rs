@@ -2,8 +2,8 @@
 //! firmware library in-process, byte for byte, and its defmt log comes back decoded.
 //!
 //! Needs `qemu-system-arm` and the image (`cargo fw`; or the path in `SWEEPHOLD_FC_ELF`),
-//! built after the last change to `firmware/src` and `shared/src`. Without them the test
-//! prints why and passes, so `cargo test --workspace` stays green on
+//! built after the last change to `firmware/src`, `firmware/board/src` and `shared/src`.
+//! Without them the test prints why and passes, so `cargo test --workspace` stays green on
 //! machines without QEMU — unless `SWEEPHOLD_REQUIRE_QEMU=1` (CI) turns that into a failure.
 //!
 //! Why the bytes can be equal at all: the flight logic is the same source compiled for
@@ -37,7 +37,7 @@ fn qemu_and_image() -> Result<PathBuf, String> {
         // expected to match (or to speak protocol 1.1): say so instead of failing on it.
         let built = modified(&image).ok_or_else(|| format!("cannot stat {}", image.display()))?;
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let newest = ["firmware/src", "shared/src"]
+        let newest = ["firmware/src", "firmware/board/src", "shared/src"]
             .iter()
             .filter_map(|dir| newest_in(&root.join(dir)))
             .max();
@@ -311,4 +311,57 @@ fn qemu_refuses_a_bad_configuration_and_keeps_flying() {
     ] {
         assert!(log.contains(expected), "no {expected:?} in\n{log}");
     }
+}
+
+/// The onboard log: standalone, the image sends the same frames to the logger's UART
+/// (USART3, the third `-serial`) as to the host link (USART1), and the logger's file
+/// decodes as a dump does.
+#[test]
+fn qemu_log_uart_carries_the_same_frames_as_the_link() {
+    let Some(image) = image_or_skip("qemu_log_uart_carries_the_same_frames_as_the_link") else {
+        return;
+    };
+    let dir = Scratch::new("qemu-log-uart");
+    let (link, log) = (dir.path().join("usart1.bin"), dir.path().join("usart3.bin"));
+    let mut qemu = std::process::Command::new("qemu-system-arm")
+        .args([
+            "-M",
+            "netduinoplus2",
+            "-nographic",
+            "-monitor",
+            "none",
+            "-kernel",
+        ])
+        .arg(&image)
+        .arg("-serial")
+        .arg(format!("file:{}", link.display()))
+        .args(["-serial", "null", "-serial"])
+        .arg(format!("file:{}", log.display()))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("qemu-system-arm starts");
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    qemu.kill().expect("QEMU stops");
+    qemu.wait().expect("QEMU is reaped");
+    let decode = |path: &std::path::Path| -> Vec<Frame> {
+        let bytes = std::fs::read(path).unwrap();
+        // The kill may cut the last frame: decode whole frames only.
+        let end = bytes.iter().rposition(|&b| b == 0).map_or(0, |i| i + 1);
+        frames(&bytes[..end])
+    };
+    let (link_frames, log_frames) = (decode(&link), decode(&log));
+    assert!(
+        matches!(log_frames.first(), Some(Frame::Header(_))),
+        "the log starts with the boot Header: {:?}",
+        log_frames.first()
+    );
+    let samples = log_frames
+        .iter()
+        .filter(|f| matches!(f, Frame::Sample(_)))
+        .count();
+    assert!(samples >= 20, "{samples} Samples in the log");
+    let common = link_frames.len().min(log_frames.len());
+    assert!(common + 2 >= link_frames.len().max(log_frames.len()));
+    assert_eq!(link_frames[..common], log_frames[..common]);
 }

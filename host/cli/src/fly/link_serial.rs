@@ -21,7 +21,7 @@ use sweephold_protocol::{ActuatorOut, SensorIn};
 use super::frame_channel::{check_configure_answer, link_config, ByteWire, FrameChannel};
 use super::link::FlightControllerLink;
 
-/// The board image's USART rate (`firmware/src/board/usart.rs`).
+/// The board image's USART rate (`firmware/board/src/usart.rs`).
 pub const DEFAULT_BAUD: u32 = 460_800;
 
 /// How long the board may take to answer one frame (a Configure or a SensorIn). A tick

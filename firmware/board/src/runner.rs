@@ -1,6 +1,6 @@
 //! The control loop: boot sequence, the two run modes, and the tick itself.
 //!
-//! **Standalone** (from boot): TIM2 paces the loop at the configured rate. There is no
+//! **Standalone** (from boot): TIM5 paces the loop at the configured rate. There is no
 //! sensor or receiver driver on this board yet, so each tick runs the flight logic on a
 //! neutral [`SensorIn`] (all zeros, test switch off, `seq` 0): the sequencer stays Idle
 //! and passes the (centred) pilot through, and every tick still streams its Sample.
@@ -11,10 +11,13 @@
 //! last frame of the tick, so the host knows the tick's telemetry is complete when it
 //! arrives. Lockstep keeps a simulation deterministic whatever the emulator's or the
 //! host's speed. A Header goes out when the mode is entered, so a dump recorded from
-//! that point on starts with one. TIM2 keeps running as the link watchdog: after
+//! that point on starts with one. TIM5 keeps running as the link watchdog: after
 //! [`LINK_TIMEOUT_S`] without a SensorIn the loop steps on its own again, on the last
 //! SensorIn, whose unchanging `seq` makes the flight logic's stale-sensor check abort
 //! any running test to pilot pass-through; the next SensorIn resumes lockstep.
+//!
+//! Every SensorIn is also the fresh sample that feeds the independent watchdog
+//! ([`crate::watchdog`]), which the first one starts.
 //!
 //! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the compiled-in
 //! configuration at run time. The image builds the preset of the frame's vehicle for
@@ -22,7 +25,7 @@
 //! logic on it (tick 0); a configuration the flight logic refuses leaves the running
 //! one in place. Either way a [`ConfigureResult`] answers, preceded by the new Header
 //! when accepted, and the loop is in the loop from then on (the Header is the mode
-//! entry's, so the first SensorIn does not send another). TIM2 keeps the boot rate: in
+//! entry's, so the first SensorIn does not send another). TIM5 keeps the boot rate: in
 //! the loop it is only the link watchdog, still [`LINK_TIMEOUT_S`] long.
 
 use sweephold_firmware::{Config, FlightController};
@@ -31,15 +34,17 @@ use sweephold_protocol::{
     VehicleId,
 };
 
-use super::clocks::{self, ClockSource, Clocks};
-use super::dividers;
-use super::link::{self, FrameScratch, Inbound, Telemetry};
-use super::log;
-use super::nvic::{self, Irq};
-use super::semihosting;
-use super::servo::{self, ServoChannel, Servos};
-use super::ticker::Ticker;
-use super::usart::{self, UsartTx};
+use crate::clocks::{self, ClockSource, Clocks};
+use crate::dividers;
+use crate::link::{self, FrameScratch, Inbound, Telemetry};
+use crate::log;
+use crate::logport;
+use crate::nvic::{self, Irq};
+use crate::semihosting;
+use crate::servo::{self, ServoChannel, Servos};
+use crate::ticker::Ticker;
+use crate::usart::{self, UsartTx};
+use crate::watchdog::Watchdog;
 
 /// Host silence after which the loop steps on its own again [s].
 pub const LINK_TIMEOUT_S: u32 = 1;
@@ -132,7 +137,7 @@ fn link_config(request: &LinkConfig) -> Config {
 /// How the loop is paced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
 pub enum Mode {
-    /// No host: TIM2 paces the loop on the neutral input.
+    /// No host: TIM5 paces the loop on the neutral input.
     Standalone,
     /// Host in the loop: one tick per SensorIn.
     InTheLoop {
@@ -174,6 +179,8 @@ pub struct Runner {
     stats: LoopStats,
     /// Where frames are encoded before they go into the transmit ring.
     scratch: FrameScratch,
+    /// Fed by every fresh sample (in the loop: every SensorIn).
+    watchdog: Watchdog,
 }
 
 impl Runner {
@@ -189,6 +196,7 @@ impl Runner {
             ticks_since_status: 0,
             stats: LoopStats::default(),
             scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
+            watchdog: Watchdog::new(),
         }
     }
 
@@ -252,11 +260,12 @@ impl Runner {
         if self.ticks_since_status >= self.status_period_ticks {
             self.ticks_since_status = 0;
             defmt::info!(
-                "mode {} {} tx dropped {=u32} rx lost {=u32}",
+                "mode {} {} tx dropped {=u32} rx lost {=u32} log dropped {=u32}",
                 self.mode,
                 self.stats,
                 self.tx.dropped_frames(),
-                usart::rx_lost()
+                usart::rx_lost(),
+                logport::dropped()
             );
         }
     }
@@ -313,6 +322,8 @@ impl Runner {
                 self.mode = Mode::InTheLoop { silent_ticks: 0 };
                 self.input = input;
                 self.step(Some(input.seq));
+                // The host's SensorIn is the fresh sample of the loop.
+                self.watchdog.fed_by_fresh_sample();
             }
             Ok(Frame::Configure(request)) => self.configure(&request),
             Ok(_) => self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1),
@@ -342,6 +353,10 @@ pub fn run() -> ! {
         tx.brr(),
         dividers::baud_error_ppm(clocks.pclk2_hz, usart::BAUD, tx.brr())
     );
+
+    if let Err(error) = logport::init(&clocks) {
+        defmt::panic!("USART3 (log): {}", error);
+    }
 
     let fc = match FlightController::new(image_config()) {
         Ok(fc) => fc,
@@ -395,7 +410,7 @@ fn run_semihosting(mut runner: Runner) -> ! {
     usart::capture();
     // The host is the clock: the loop timer's interrupt would only land in the middle of
     // ticks (and, in QEMU, at host-speed-dependent places).
-    nvic::disable(Irq::Tim2);
+    nvic::disable(Irq::Tim5);
     let (Some(input), Some(output)) = (
         semihosting::open(b"sweephold-in\0", false),
         semihosting::open(b"sweephold-out\0", true),

@@ -4,7 +4,8 @@ use sweephold_firmware::FrameSink;
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{encode, Decoder, Frame, FrameError, MAX_FRAME_LEN};
 
-use super::usart::{UsartRx, UsartTx};
+use crate::logport;
+use crate::usart::{UsartRx, UsartTx};
 
 /// Bytes taken from the receive ring per decoder pass.
 const RX_CHUNK: usize = 64;
@@ -60,12 +61,10 @@ pub fn send(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) -> bool
 /// the line needs to drain it, ~22 ms for 1 KiB at 460 800 Bd) instead of dropping the
 /// frame.
 pub fn send_waiting(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) {
-    // Straight into the ring when there is room (the usual case), else wait for it.
-    if tx.encode_in_place(frame).is_some() {
-        return;
-    }
+    // Encoded with interrupts enabled; only the copy into the ring masks them.
     if let Ok(len) = encode(frame, scratch) {
         if let Some(bytes) = scratch.get(..len) {
+            logport::log_frame(bytes);
             // Infallible, and `write` never returns Ok(0) for a non-empty buffer.
             let _ = embedded_io::Write::write_all(tx, bytes);
         }

@@ -17,14 +17,24 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use sweephold_protocol::{encode, Frame, MAX_FRAME_LEN};
 
-use super::ring::ByteRing;
+use crate::ring::ByteRing;
 use cortex_m::interrupt::{self, CriticalSection, Mutex};
 
-use super::clocks::{ClockGate, Clocks};
-use super::dividers::{self, DividerError};
-use super::gpio::{self, Pull};
-use super::nvic::{self, Irq};
-use super::regs::{usart1, GPIOA};
+use crate::clocks::{ClockGate, Clocks};
+use crate::dividers::{self, DividerError};
+use crate::gpio::{self, Pull};
+use crate::logport;
+use crate::nvic::{self, Irq};
+use crate::pins;
+use stm32f4::stm32f405 as pac;
+
+/// USART1's registers.
+fn usart1() -> &'static pac::usart1::RegisterBlock {
+    // SAFETY: USART1's register block is always mapped. This module is its only user;
+    // the one read-modify-write (CR1's TXEIE in `pump`) runs inside a critical section,
+    // so the interrupt handler cannot interleave with it.
+    unsafe { &*pac::USART1::ptr() }
+}
 
 /// Line rate [Bd]. A 200 Hz loop in the loop with a host sends a Sample (~130 bytes on
 /// the wire) and an ActuatorOut (~35) per tick: 33 kB/s, 72 % of the 46 kB/s that
@@ -40,16 +50,6 @@ pub const TX_CAPACITY: usize = 1024;
 /// and waits for the answer, so a few frames' worth is plenty.
 pub const RX_CAPACITY: usize = 256;
 
-const SR_ORE: u32 = 1 << 3;
-const SR_RXNE: u32 = 1 << 5;
-const SR_TC: u32 = 1 << 6;
-const SR_TXE: u32 = 1 << 7;
-const CR1_RE: u32 = 1 << 2;
-const CR1_TE: u32 = 1 << 3;
-const CR1_RXNEIE: u32 = 1 << 5;
-const CR1_TXEIE: u32 = 1 << 7;
-const CR1_UE: u32 = 1 << 13;
-
 static TX: Mutex<RefCell<ByteRing<TX_CAPACITY>>> = Mutex::new(RefCell::new(ByteRing::new()));
 static RX: Mutex<RefCell<ByteRing<RX_CAPACITY>>> = Mutex::new(RefCell::new(ByteRing::new()));
 /// Received bytes lost: hardware overruns plus bytes that found the ring full.
@@ -58,15 +58,28 @@ static RX_LOST: AtomicU32 = AtomicU32::new(0);
 /// Configure pins, baud rate and interrupts; returns the two halves of the link.
 pub fn init(clocks: &Clocks) -> Result<(UsartTx, UsartRx), DividerError> {
     let brr = dividers::usart_brr(clocks.pclk2_hz, BAUD)?;
-    ClockGate::GPIOA.enable();
-    ClockGate::USART1.enable();
-    gpio::alternate_function(GPIOA, 9, 7, Pull::None);
-    gpio::alternate_function(GPIOA, 10, 7, Pull::Up);
-    usart1::CR1.write(0);
-    usart1::BRR.write(brr);
-    usart1::CR2.write(0); // 1 stop bit
-    usart1::CR3.write(0); // no flow control, no DMA
-    usart1::CR1.write(CR1_UE | CR1_TE | CR1_RE | CR1_RXNEIE);
+    ClockGate::Usart1.enable();
+    let usart1 = usart1();
+    gpio::alternate_function(pins::LINK_TX, Pull::None);
+    gpio::alternate_function(pins::LINK_RX, Pull::Up);
+    usart1.cr1().reset();
+    // BRR is 16 bits wide (`usart_brr` checks the range): mantissa and fraction.
+    usart1.brr().write(|w| {
+        w.div_mantissa().set((brr >> 4) as u16);
+        w.div_fraction().set((brr & 0xF) as u8)
+    });
+    usart1.cr2().reset(); // 1 stop bit
+    usart1.cr3().reset(); // no flow control, no DMA
+    usart1.cr1().write(|w| {
+        w.ue()
+            .set_bit()
+            .te()
+            .set_bit()
+            .re()
+            .set_bit()
+            .rxneie()
+            .set_bit()
+    });
     nvic::enable(Irq::Usart1);
     Ok((
         UsartTx {
@@ -83,22 +96,22 @@ fn pump(cs: &CriticalSection) {
     if CAPTURED.load(Ordering::Relaxed) {
         return;
     }
+    let usart1 = usart1();
     let mut ring = TX.borrow(cs).borrow_mut();
-    while usart1::SR.read() & SR_TXE != 0 {
+    while usart1.sr().read().txe().bit_is_set() {
         match ring.pop() {
-            Some(byte) => usart1::DR.write(u32::from(byte)),
+            Some(byte) => {
+                usart1.dr().write(|w| w.dr().set(u16::from(byte)));
+            }
             None => break,
         }
     }
-    if ring.is_empty() {
-        usart1::CR1.clear_bits(CR1_TXEIE);
-    } else {
-        usart1::CR1.set_bits(CR1_TXEIE);
-    }
+    let waiting = !ring.is_empty();
+    usart1.cr1().modify(|_, w| w.txeie().bit(waiting));
 }
 
 /// Set when the frames leave through semihosting instead of the pin (QEMU only, see
-/// `board::semihosting`): the transmit ring then keeps what is queued until
+/// [`crate::semihosting`]): the transmit ring then keeps what is queued until
 /// [`take_captured`] empties it.
 static CAPTURED: AtomicBool = AtomicBool::new(false);
 
@@ -115,10 +128,11 @@ pub fn take_captured(buf: &mut [u8]) -> usize {
 /// USART1 interrupt: move a received byte into the ring, feed the transmitter.
 pub fn on_interrupt() {
     // Reading SR then DR clears RXNE and the error flags (ORE, NE, FE).
-    let status = usart1::SR.read();
-    if status & (SR_RXNE | SR_ORE) != 0 {
-        let byte = (usart1::DR.read() & 0xFF) as u8;
-        if status & SR_ORE != 0 {
+    let usart1 = usart1();
+    let status = usart1.sr().read();
+    if status.rxne().bit_is_set() || status.ore().bit_is_set() {
+        let byte = (usart1.dr().read().dr().bits() & 0xFF) as u8;
+        if status.ore().bit_is_set() {
             RX_LOST.fetch_add(1, Ordering::Relaxed);
         }
         let pushed = interrupt::free(|cs| RX.borrow(cs).borrow_mut().push(byte));
@@ -144,6 +158,9 @@ impl UsartTx {
     /// Queue `frame` whole, or drop it whole when the ring lacks room (a partial frame
     /// would only cost the host a corrupt frame too). Returns `false` when dropped.
     pub fn queue_frame(&mut self, frame: &[u8]) -> bool {
+        // Every frame the link carries also goes to the onboard log, whether or not the
+        // link has room for it.
+        logport::log_frame(frame);
         let queued = interrupt::free(|cs| {
             let fits = {
                 let mut ring = TX.borrow(cs).borrow_mut();
@@ -162,46 +179,18 @@ impl UsartTx {
         queued
     }
 
-    /// Encode `frame` straight into the ring when a frame's worth of room is free there
-    /// in one piece (no copy; the usual case: the ring starts over at its beginning
-    /// whenever it drains). `None` when that room is not there (nothing done), else
-    /// whether the frame was encoded (it always is, for the protocol's types).
-    pub fn encode_in_place(&mut self, frame: &Frame) -> Option<bool> {
-        let mut encoded = false;
-        let in_place = interrupt::free(|cs| {
-            let in_place = TX
-                .borrow(cs)
-                .borrow_mut()
-                .fill_contiguous(MAX_FRAME_LEN, |space| {
-                    let written = encode(frame, space).ok();
-                    encoded = written.is_some();
-                    written
-                });
-            if in_place {
-                pump(cs);
-            }
-            in_place
-        });
-        in_place.then_some(encoded)
-    }
-
-    /// Queue `frame` without waiting: encoded in place ([`encode_in_place`]) or, when
-    /// the room for that is missing, in `scratch` and queued whole if it fits
-    /// ([`queue_frame`](Self::queue_frame)). `false` when dropped (counted).
-    ///
-    /// [`encode_in_place`]: Self::encode_in_place
+    /// Queue `frame` without waiting: encoded in `scratch` with interrupts enabled,
+    /// then copied into the ring whole if it fits ([`queue_frame`](Self::queue_frame)):
+    /// the critical section holds only the copy, never the encoding. `false` when
+    /// dropped (counted).
     pub fn queue_encoded(&mut self, frame: &Frame, scratch: &mut [u8; MAX_FRAME_LEN]) -> bool {
-        let queued = match self.encode_in_place(frame) {
-            Some(encoded) => encoded,
-            None => match encode(frame, scratch) {
-                Ok(len) => return self.queue_frame(scratch.get(..len).unwrap_or(&[])),
-                Err(_) => false,
-            },
-        };
-        if !queued {
-            self.dropped_frames = self.dropped_frames.wrapping_add(1);
+        match encode(frame, scratch) {
+            Ok(len) => self.queue_frame(scratch.get(..len).unwrap_or(&[])),
+            Err(_) => {
+                self.dropped_frames = self.dropped_frames.wrapping_add(1);
+                false
+            }
         }
-        queued
     }
 
     /// Frames dropped so far because the ring was full.
@@ -244,7 +233,7 @@ impl embedded_io::Write for UsartTx {
                 pump(cs);
                 TX.borrow(cs).borrow().is_empty()
             });
-            if empty && usart1::SR.read() & SR_TC != 0 {
+            if empty && usart1().sr().read().tc().bit_is_set() {
                 return Ok(());
             }
         }

@@ -1,25 +1,30 @@
-//! The fixed-rate tick: TIM2 update interrupt at the loop rate.
+//! The fixed-rate tick: TIM5 update interrupt at the loop rate.
 //!
-//! TIM2 is 32-bit, so it runs with prescaler 0 and an auto-reload computed from its
-//! actual kernel clock ([`super::clocks::Clocks::apb1_timer_hz`]). The interrupt handler
+//! TIM5 is 32-bit, so it runs with prescaler 0 and an auto-reload computed from its
+//! actual kernel clock ([`crate::clocks::Clocks::apb1_timer_hz`]). The interrupt handler
 //! only counts; the flight logic runs in thread mode and takes the count with
 //! [`take_due`], so an overrun (a tick that took longer than the period) shows up as a
 //! count above one instead of nested or lost interrupts.
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use super::clocks::{ClockGate, Clocks};
-use super::dividers::{self, DividerError};
-use super::nvic::{self, Irq};
-use super::regs::TIM2;
+use stm32f4::stm32f405 as pac;
+
+use crate::clocks::{ClockGate, Clocks};
+use crate::dividers::{self, DividerError};
+use crate::nvic::{self, Irq};
 
 /// Ticks signalled by the timer and not yet taken by the loop.
 static DUE: AtomicU32 = AtomicU32::new(0);
 
-const CR1_CEN: u32 = 1 << 0;
-const CR1_URS: u32 = 1 << 2;
-const DIER_UIE: u32 = 1 << 0;
-const SR_UIF: u32 = 1 << 0;
+/// TIM5's registers.
+fn tim5() -> &'static pac::tim5::RegisterBlock {
+    // SAFETY: TIM5's register block is always mapped. This module is its only user: the
+    // set-up writes run in thread mode before its interrupt is unmasked, after which
+    // only the interrupt handler touches it (whole-register writes, no read-modify-write
+    // shared with other code).
+    unsafe { &*pac::TIM5::ptr() }
+}
 
 /// The running tick timer.
 pub struct Ticker {
@@ -28,23 +33,24 @@ pub struct Ticker {
 }
 
 impl Ticker {
-    /// Start TIM2 at `rate_hz` from its kernel clock and enable its interrupt.
+    /// Start TIM5 at `rate_hz` from its kernel clock and enable its interrupt.
     pub fn start(clocks: &Clocks, rate_hz: u32) -> Result<Ticker, DividerError> {
         let reload = dividers::tick_reload(clocks.apb1_timer_hz, rate_hz)?;
-        ClockGate::TIM2.enable();
+        ClockGate::Tim5.enable();
+        let tim5 = tim5();
         // Out of reset PSC = 0 (also in the shadow register) and ARR preload is off, so
         // no update event (EGR.UG) is needed: the ARR write takes effect at once.
-        // Written in this order for QEMU's TIM2 model, which arms its alarm on the ARR
+        // Written in this order for QEMU's TIM2..TIM5 model, which arms its alarm on the ARR
         // write and computes the period as ARR + the virtual time of the last PSC, CNT
         // or UG write (its `tick_offset`, ~0 from reset): writing none of those keeps
         // the emulated period at ARR counts (the silicon's is ARR + 1: 0.2 ppm apart).
-        TIM2.cr1.write(0);
-        TIM2.sr.write(0);
-        TIM2.dier.write(DIER_UIE);
+        tim5.cr1().reset();
+        tim5.sr().reset();
+        tim5.dier().write(|w| w.uie().set_bit());
         // URS: only counter overflow raises the update interrupt.
-        TIM2.cr1.write(CR1_URS | CR1_CEN);
-        TIM2.arr.write(reload);
-        nvic::enable(Irq::Tim2);
+        tim5.cr1().write(|w| w.urs().set_bit().cen().set_bit());
+        tim5.arr().write(|w| w.arr().set(reload));
+        nvic::enable(Irq::Tim5);
         Ok(Ticker {
             achieved_millihz: dividers::achieved_rate_millihz(clocks.apb1_timer_hz, reload),
         })
@@ -61,11 +67,12 @@ impl Ticker {
     }
 }
 
-/// TIM2 interrupt: acknowledge the update and count it.
+/// TIM5 interrupt: acknowledge the update and count it.
 pub fn on_interrupt() {
-    if TIM2.sr.read() & SR_UIF != 0 {
-        // rc_w0: writing 0 clears UIF, writing 1 elsewhere leaves the other flags alone.
-        TIM2.sr.write(!SR_UIF);
+    let tim5 = tim5();
+    if tim5.sr().read().uif().bit_is_set() {
+        // rc_w0: the PAC writes 1 to the other flags (no effect) and 0 to UIF.
+        tim5.sr().write(|w| w.uif().clear());
         DUE.fetch_add(1, Ordering::AcqRel);
     }
 }

@@ -21,7 +21,22 @@
 //! The timer clock rule (RM0090 §6.2): a timer on an APB bus whose prescaler is 1 runs at
 //! PCLK, otherwise at 2·PCLK.
 
-use super::regs::{flash, rcc, Reg};
+use stm32f4::stm32f405 as pac;
+
+/// The reset and clock control's registers.
+fn rcc() -> &'static pac::rcc::RegisterBlock {
+    // SAFETY: the RCC register block is always mapped. This module is its only user;
+    // the clock-enable read-modify-writes run in thread mode at boot, before any
+    // interrupt that could touch the RCC is enabled (none does).
+    unsafe { &*pac::RCC::ptr() }
+}
+
+/// The flash interface's registers (wait states).
+fn flash() -> &'static pac::flash::RegisterBlock {
+    // SAFETY: always mapped; only the clock set-up below writes the access control
+    // register, once, at boot.
+    unsafe { &*pac::FLASH::ptr() }
+}
 
 /// Frequency of the board's crystal [Hz]. 8 MHz is what STM32F405 flight-controller
 /// boards and the STM32F4 Discovery carry; change it (it must be a multiple of 2 MHz)
@@ -43,32 +58,10 @@ const READY_POLLS: u32 = 100_000;
 /// 1 GHz whatever the (absent) RCC says. Used only when the RCC reads back all zeros.
 pub const EMULATED_TIMER_HZ: u32 = 1_000_000_000;
 
-// RCC_CR bits.
-const CR_HSIRDY: u32 = 1 << 1;
-const CR_HSEON: u32 = 1 << 16;
-const CR_HSERDY: u32 = 1 << 17;
-const CR_PLLON: u32 = 1 << 24;
-const CR_PLLRDY: u32 = 1 << 25;
-
-// RCC_PLLCFGR fields: PLLM[5:0], PLLN[14:6], PLLP[17:16], PLLSRC[22], PLLQ[27:24].
-const PLLCFGR_FIELDS: u32 = 0x3F | (0x1FF << 6) | (0b11 << 16) | (1 << 22) | (0xF << 24);
-const PLLCFGR_SRC_HSE: u32 = 1 << 22;
-const PLLM: u32 = HSE_HZ / 2_000_000;
-const PLLN: u32 = 168;
-const PLLP: u32 = 2;
-const PLLQ: u32 = 7;
-
-// RCC_CFGR fields: SW[1:0], SWS[3:2], HPRE[7:4], PPRE1[12:10], PPRE2[15:13].
-const CFGR_SW_HSI: u32 = 0b00;
-const CFGR_SW_PLL: u32 = 0b10;
-const CFGR_PPRE_DIV2: u32 = 0b100;
-const CFGR_PPRE_DIV4: u32 = 0b101;
-
-// FLASH_ACR: 5 wait states at 168 MHz and 2.7–3.6 V (RM0090 Table 10), prefetch, caches.
-const ACR_LATENCY_5WS: u32 = 5;
-const ACR_PRFTEN: u32 = 1 << 8;
-const ACR_ICEN: u32 = 1 << 9;
-const ACR_DCEN: u32 = 1 << 10;
+// RCC_PLLCFGR fields (RM0090 §7.3.2): VCO input 2 MHz, VCO 336 MHz, SYSCLK /2, 48 MHz /7.
+const PLLM: u8 = (HSE_HZ / 2_000_000) as u8;
+const PLLN: u16 = 168;
+const PLLQ: u8 = 7;
 
 /// Where the system clock comes from, and why.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,6 +95,8 @@ pub struct Clocks {
     pub pclk2_hz: u32,
     /// Kernel clock of the APB1 timers TIM2..TIM5 [Hz].
     pub apb1_timer_hz: u32,
+    /// Kernel clock of the APB2 timers (TIM8) [Hz].
+    pub apb2_timer_hz: u32,
     /// How the clock tree came up.
     pub source: ClockSource,
 }
@@ -114,6 +109,7 @@ impl Clocks {
             pclk1_hz: HSI_HZ,
             pclk2_hz: HSI_HZ,
             apb1_timer_hz: HSI_HZ,
+            apb2_timer_hz: HSI_HZ,
             source,
         }
     }
@@ -127,6 +123,8 @@ impl Clocks {
             pclk2_hz: PLL_SYSCLK_HZ / 2,
             // APB1 prescaler ≠ 1 → timers at 2·PCLK1.
             apb1_timer_hz: 2 * pclk1,
+            // APB2 prescaler ≠ 1 → timers at 2·PCLK2.
+            apb2_timer_hz: PLL_SYSCLK_HZ,
             source: ClockSource::HsePll,
         }
     }
@@ -139,7 +137,8 @@ fn wait_for(mut ready: impl FnMut() -> bool) -> bool {
 
 /// Bring up the clock tree (see the module documentation) and report what it is.
 pub fn init() -> Clocks {
-    if rcc::CR.read() & CR_HSIRDY == 0 {
+    let rcc = rcc();
+    if rcc.cr().read().hsirdy().bit_is_clear() {
         // Out of reset a real STM32F4 runs on HSI with HSION and HSIRDY set.
         return Clocks {
             apb1_timer_hz: EMULATED_TIMER_HZ,
@@ -147,73 +146,108 @@ pub fn init() -> Clocks {
         };
     }
 
-    rcc::CR.set_bits(CR_HSEON);
-    if !wait_for(|| rcc::CR.read() & CR_HSERDY != 0) {
-        rcc::CR.clear_bits(CR_HSEON);
+    rcc.cr().modify(|_, w| w.hseon().set_bit());
+    if !wait_for(|| rcc.cr().read().hserdy().bit_is_set()) {
+        rcc.cr().modify(|_, w| w.hseon().clear_bit());
         return Clocks::hsi(ClockSource::HsiHseTimeout);
     }
 
     // The PLL may only be configured while it is off (it is, out of reset). Reserved
     // bits keep their reset values.
-    rcc::PLLCFGR.modify(|value| {
-        (value & !PLLCFGR_FIELDS)
-            | PLLM
-            | (PLLN << 6)
-            | ((PLLP / 2 - 1) << 16)
-            | PLLCFGR_SRC_HSE
-            | (PLLQ << 24)
+    rcc.pllcfgr().modify(|_, w| {
+        // SAFETY: PLLM = 4 (2..=63), PLLN = 168 (50..=432), PLLQ = 7 (2..=15): values
+        // RM0090 §7.3.2 allows, giving the frequencies of the module documentation.
+        unsafe {
+            w.pllm().bits(PLLM);
+            w.plln().bits(PLLN);
+            w.pllq().bits(PLLQ);
+        }
+        w.pllp().div2();
+        w.pllsrc().hse()
     });
-    rcc::CR.set_bits(CR_PLLON);
-    if !wait_for(|| rcc::CR.read() & CR_PLLRDY != 0) {
-        rcc::CR.clear_bits(CR_PLLON | CR_HSEON);
+    rcc.cr().modify(|_, w| w.pllon().set_bit());
+    if !wait_for(|| rcc.cr().read().pllrdy().bit_is_set()) {
+        rcc.cr()
+            .modify(|_, w| w.pllon().clear_bit().hseon().clear_bit());
         return Clocks::hsi(ClockSource::HsiPllTimeout);
     }
 
-    // Wait states before the clock goes up; read back so the new latency is in effect.
-    flash::ACR.write(ACR_LATENCY_5WS | ACR_PRFTEN | ACR_ICEN | ACR_DCEN);
-    if !wait_for(|| flash::ACR.read() & 0xF == ACR_LATENCY_5WS) {
-        rcc::CR.clear_bits(CR_PLLON | CR_HSEON);
+    // Wait states before the clock goes up (5 at 168 MHz and 2.7–3.6 V, RM0090 Table
+    // 10); read back so the new latency is in effect.
+    let flash = flash();
+    flash.acr().write(|w| {
+        w.latency().ws5();
+        w.prften().set_bit();
+        w.icen().set_bit();
+        w.dcen().set_bit()
+    });
+    if !wait_for(|| flash.acr().read().latency().is_ws5()) {
+        rcc.cr()
+            .modify(|_, w| w.pllon().clear_bit().hseon().clear_bit());
         return Clocks::hsi(ClockSource::HsiFlashLatency);
     }
 
     // Bus prescalers first (AHB /1, APB1 /4, APB2 /2), then the switch.
-    rcc::CFGR.write((CFGR_PPRE_DIV4 << 10) | (CFGR_PPRE_DIV2 << 13) | CFGR_SW_HSI);
-    rcc::CFGR.write_field(0, 2, CFGR_SW_PLL);
-    if !wait_for(|| (rcc::CFGR.read() >> 2) & 0b11 == CFGR_SW_PLL) {
-        rcc::CFGR.write(CFGR_SW_HSI);
-        rcc::CR.clear_bits(CR_PLLON | CR_HSEON);
+    rcc.cfgr().write(|w| {
+        w.hpre().div1();
+        w.ppre1().div4();
+        w.ppre2().div2();
+        w.sw().hsi()
+    });
+    rcc.cfgr().modify(|_, w| w.sw().pll());
+    if !wait_for(|| rcc.cfgr().read().sws().is_pll()) {
+        rcc.cfgr().write(|w| w.sw().hsi());
+        rcc.cr()
+            .modify(|_, w| w.pllon().clear_bit().hseon().clear_bit());
         return Clocks::hsi(ClockSource::HsiSwitchTimeout);
     }
     Clocks::pll()
 }
 
 /// A peripheral's clock-enable bit.
-#[derive(Clone, Copy)]
-pub struct ClockGate {
-    register: Reg,
-    bit: u32,
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClockGate {
+    /// GPIO port A (AHB1ENR.GPIOAEN).
+    GpioA,
+    /// GPIO port B (AHB1ENR.GPIOBEN).
+    GpioB,
+    /// GPIO port C (AHB1ENR.GPIOCEN).
+    GpioC,
+    /// TIM2 (APB1ENR.TIM2EN).
+    Tim2,
+    /// TIM3 (APB1ENR.TIM3EN).
+    Tim3,
+    /// TIM4 (APB1ENR.TIM4EN).
+    Tim4,
+    /// TIM5 (APB1ENR.TIM5EN).
+    Tim5,
+    /// TIM8 (APB2ENR.TIM8EN).
+    Tim8,
+    /// USART1 (APB2ENR.USART1EN).
+    Usart1,
+    /// USART3 (APB1ENR.USART3EN).
+    Usart3,
 }
 
 impl ClockGate {
-    const fn at(register: Reg, bit: u32) -> ClockGate {
-        ClockGate { register, bit }
-    }
-
-    /// GPIO port A (AHB1ENR.GPIOAEN).
-    pub const GPIOA: ClockGate = ClockGate::at(rcc::AHB1ENR, 1 << 0);
-    /// GPIO port B (AHB1ENR.GPIOBEN).
-    pub const GPIOB: ClockGate = ClockGate::at(rcc::AHB1ENR, 1 << 1);
-    /// TIM2 (APB1ENR.TIM2EN).
-    pub const TIM2: ClockGate = ClockGate::at(rcc::APB1ENR, 1 << 0);
-    /// TIM3 (APB1ENR.TIM3EN).
-    pub const TIM3: ClockGate = ClockGate::at(rcc::APB1ENR, 1 << 1);
-    /// USART1 (APB2ENR.USART1EN).
-    pub const USART1: ClockGate = ClockGate::at(rcc::APB2ENR, 1 << 4);
-
     /// Turn the clock on, then read the register back: RM0090 §7.3 asks for two bus
     /// cycles between the enable and the first access to the peripheral.
     pub fn enable(self) {
-        self.register.set_bits(self.bit);
-        let _ = self.register.read();
+        let rcc = rcc();
+        match self {
+            ClockGate::GpioA => rcc.ahb1enr().modify(|_, w| w.gpioaen().set_bit()),
+            ClockGate::GpioB => rcc.ahb1enr().modify(|_, w| w.gpioben().set_bit()),
+            ClockGate::GpioC => rcc.ahb1enr().modify(|_, w| w.gpiocen().set_bit()),
+            ClockGate::Tim2 => rcc.apb1enr().modify(|_, w| w.tim2en().set_bit()),
+            ClockGate::Tim3 => rcc.apb1enr().modify(|_, w| w.tim3en().set_bit()),
+            ClockGate::Tim4 => rcc.apb1enr().modify(|_, w| w.tim4en().set_bit()),
+            ClockGate::Tim5 => rcc.apb1enr().modify(|_, w| w.tim5en().set_bit()),
+            ClockGate::Tim8 => rcc.apb2enr().modify(|_, w| w.tim8en().set_bit()),
+            ClockGate::Usart1 => rcc.apb2enr().modify(|_, w| w.usart1en().set_bit()),
+            ClockGate::Usart3 => rcc.apb1enr().modify(|_, w| w.usart3en().set_bit()),
+        };
+        let _ = rcc.ahb1enr().read();
+        let _ = rcc.apb1enr().read();
+        let _ = rcc.apb2enr().read();
     }
 }

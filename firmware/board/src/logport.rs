@@ -1,0 +1,110 @@
+//! The onboard log: every frame the image sends to the host also goes, as the same COBS
+//! bytes, to an OpenLog-style serial logger on USART3 TX (pad T3, PC10), whose file
+//! `sweephold decode` then reads as it reads a dump.
+//!
+//! The log never blocks the loop: a frame is copied into a 4 KiB ring (a short critical
+//! section: the copy, never the encoding) that the TXE interrupt drains at the line rate.
+//! When the logger falls behind, the oldest frames make room for the newest
+//! ([`ByteRing::push_frame_dropping_oldest`]); the drops are counted ([`dropped`]) and
+//! the file then lacks those frames (a frame that was being sent leaves one cut frame,
+//! which the decoder skips).
+//!
+//! Line rate [`BAUD`] (8N1): a 200 Hz tick's Sample and ActuatorOut are about 33 kB/s,
+//! which needs a logger that takes 460 800 Bd (OpenLog Artemis class); a slower logger
+//! records what its rate allows, newest frames first. Under QEMU USART3 is the third
+//! `-serial` (none given: its bytes go nowhere).
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use cortex_m::interrupt::{self, CriticalSection, Mutex};
+use stm32f4::stm32f405 as pac;
+
+use crate::clocks::{ClockGate, Clocks};
+use crate::dividers::{self, DividerError};
+use crate::gpio::{self, Pull};
+use crate::nvic::{self, Irq};
+use crate::pins;
+use crate::ring::ByteRing;
+
+/// Line rate of the logger [Bd].
+pub const BAUD: u32 = 460_800;
+
+/// Log ring [bytes]: a few ticks' frames; what does not fit drops the oldest.
+pub const CAPACITY: usize = 4096;
+
+static RING: Mutex<RefCell<ByteRing<CAPACITY>>> = Mutex::new(RefCell::new(ByteRing::new()));
+/// Frames dropped so far to make room (or too long for the ring).
+static DROPPED: AtomicU32 = AtomicU32::new(0);
+
+/// USART3's registers.
+fn usart3() -> &'static pac::usart1::RegisterBlock {
+    // SAFETY: USART3's register block is always mapped. This module is its only user;
+    // its one read-modify-write (CR1's TXEIE in `pump`) runs inside a critical section.
+    unsafe { &*pac::USART3::ptr() }
+}
+
+/// Configure the pin, the baud rate (from PCLK1: USART3 is on APB1) and the interrupt.
+pub fn init(clocks: &Clocks) -> Result<(), DividerError> {
+    let brr = dividers::usart_brr(clocks.pclk1_hz, BAUD)?;
+    ClockGate::Usart3.enable();
+    gpio::alternate_function(pins::LOG_TX, Pull::None);
+    let usart3 = usart3();
+    usart3.cr1().reset();
+    usart3.brr().write(|w| {
+        w.div_mantissa().set((brr >> 4) as u16);
+        w.div_fraction().set((brr & 0xF) as u8)
+    });
+    usart3.cr2().reset();
+    usart3.cr3().reset();
+    usart3.cr1().write(|w| w.ue().set_bit().te().set_bit());
+    nvic::enable(Irq::Usart3);
+    Ok(())
+}
+
+/// Log one whole encoded frame (delimiter included).
+pub fn log_frame(bytes: &[u8]) {
+    let dropped = interrupt::free(|cs| {
+        let dropped = RING
+            .borrow(cs)
+            .borrow_mut()
+            .push_frame_dropping_oldest(bytes);
+        pump(cs);
+        dropped
+    });
+    if dropped > 0 {
+        DROPPED.fetch_add(dropped, Ordering::Relaxed);
+    }
+}
+
+/// Frames dropped from the log so far.
+pub fn dropped() -> u32 {
+    DROPPED.load(Ordering::Relaxed)
+}
+
+/// Feed the data register while it has room; the TXE interrupt stays on exactly while
+/// bytes are waiting.
+fn pump(cs: &CriticalSection) {
+    let usart3 = usart3();
+    let mut ring = RING.borrow(cs).borrow_mut();
+    while usart3.sr().read().txe().bit_is_set() {
+        match ring.pop() {
+            Some(byte) => {
+                usart3.dr().write(|w| w.dr().set(u16::from(byte)));
+            }
+            None => break,
+        }
+    }
+    let waiting = !ring.is_empty();
+    usart3.cr1().modify(|_, w| w.txeie().bit(waiting));
+}
+
+/// USART3 interrupt: room in the transmitter.
+pub fn on_interrupt() {
+    interrupt::free(pump);
+}
+
+/// Stop the log's interrupt (panic path).
+pub fn silence() {
+    nvic::disable(Irq::Usart3);
+}

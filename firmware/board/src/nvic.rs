@@ -1,0 +1,67 @@
+//! The device interrupts the image uses: their priorities and their masks in the NVIC.
+//! The handlers are the named vectors of `main.rs` (the PAC's vector table).
+//!
+//! Priorities (Cortex-M: a lower number preempts a higher one; the STM32F4 implements
+//! the upper four bits) follow what must never wait: the IMU's data-ready and SPI
+//! transfer first, then the control tick, then the receiver's UART, and last the
+//! host link and the log, whose bytes can wait in their rings.
+
+use cortex_m::peripheral::NVIC;
+use stm32f4::stm32f405 as pac;
+
+/// The device interrupts of the image, by the PAC's names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Irq {
+    /// TIM5 global interrupt: the loop tick.
+    Tim5,
+    /// USART1 global interrupt: the host link (receive, and transmit on silicon).
+    Usart1,
+    /// USART3 global interrupt: the onboard log's transmitter.
+    Usart3,
+}
+
+// 0x00 is the IMU's data-ready line and SPI transfer, 0x80 the receiver's UART: the
+// levels those drivers take when they join the image.
+
+/// Priority of the control tick.
+pub const PRIORITY_TICK: u8 = 0x40;
+/// Priority of the host link and the log.
+pub const PRIORITY_LINK: u8 = 0xC0;
+
+impl Irq {
+    /// The PAC's interrupt number.
+    fn interrupt(self) -> pac::Interrupt {
+        match self {
+            Irq::Tim5 => pac::Interrupt::TIM5,
+            Irq::Usart1 => pac::Interrupt::USART1,
+            Irq::Usart3 => pac::Interrupt::USART3,
+        }
+    }
+
+    /// The interrupt's priority (see the module documentation).
+    pub fn priority(self) -> u8 {
+        match self {
+            Irq::Tim5 => PRIORITY_TICK,
+            Irq::Usart1 | Irq::Usart3 => PRIORITY_LINK,
+        }
+    }
+}
+
+/// Set `irq`'s priority, then unmask it in the NVIC.
+pub fn enable(irq: Irq) {
+    // SAFETY: the image uses no priority-based critical sections (its critical sections
+    // mask every interrupt), so a priority change cannot break one; the NVIC's
+    // priority registers are written by this function only, from thread mode at boot.
+    unsafe {
+        let mut core = cortex_m::Peripherals::steal();
+        core.NVIC.set_priority(irq.interrupt(), irq.priority());
+        // SAFETY: as above: unmasking cannot break a mask-based critical section, and
+        // the handler of each unmasked interrupt exists (named vectors in main.rs).
+        NVIC::unmask(irq.interrupt());
+    }
+}
+
+/// Mask `irq` in the NVIC.
+pub fn disable(irq: Irq) {
+    NVIC::mask(irq.interrupt());
+}

@@ -1,0 +1,59 @@
+//! The independent watchdog (IWDG): a reset unless a fresh sensor sample keeps being
+//! processed.
+//!
+//! The IWDG runs from the 32 kHz LSI, independent of the main clock tree, and once
+//! started nothing but a reset stops it. It is started by the first fresh sample the
+//! loop processes and fed by every fresh sample after that ([`Watchdog::fed_by_fresh_sample`]):
+//! a loop that stops processing fresh samples (stuck in a handler, a lock-up, a host
+//! in the loop gone silent) resets the MCU, and the boot path starts Disarmed with the
+//! servos at their failsafe pulses and the ESC at the throttle cut. In the loop, the
+//! host's SensorIn is the fresh sample; standalone the image has no sensor driver yet, so
+//! there the watchdog is not started.
+//!
+//! Timeout: LSI / 64 with a reload of 1000, nominally 2 s (LSI 32 kHz), 1.36 s at the
+//! LSI's fastest (47 kHz, datasheet): always longer than the link timeout, so a host
+//! that falls silent first gets the stale-sensor abort, logged, then the reset.
+//!
+//! QEMU's `netduinoplus2` does not emulate the IWDG (its registers read zero and ignore
+//! writes): there the watchdog is a no-op by construction and the emulated runs are
+//! unchanged.
+
+use stm32f4::stm32f405 as pac;
+
+/// IWDG reload value (12 bits): 1000 counts of LSI / 64.
+const RELOAD: u16 = 1000;
+
+/// The IWDG's registers.
+fn iwdg() -> &'static pac::iwdg::RegisterBlock {
+    // SAFETY: the IWDG register block is always mapped; this module is its only user,
+    // from thread mode only.
+    unsafe { &*pac::IWDG::ptr() }
+}
+
+/// The watchdog: not started until the first fresh sample.
+pub struct Watchdog {
+    started: bool,
+}
+
+impl Watchdog {
+    /// A watchdog that has not started.
+    pub const fn new() -> Self {
+        Watchdog { started: false }
+    }
+
+    /// A fresh sample was processed: start the watchdog (the first time) or feed it.
+    pub fn fed_by_fresh_sample(&mut self) {
+        let iwdg = iwdg();
+        if !self.started {
+            self.started = true;
+            // Start first (the LSI comes up with it), then unlock and set the prescaler
+            // and reload (RM0090 §21.3.2); the values take effect at the next feed.
+            iwdg.kr().write(|w| w.key().start());
+            iwdg.kr().write(|w| w.key().unlock());
+            iwdg.pr().write(|w| w.pr().divide_by64());
+            iwdg.rlr().write(|w| w.rl().set(RELOAD));
+            defmt::info!("watchdog started: fed by every fresh sample");
+        }
+        iwdg.kr().write(|w| w.key().feed());
+    }
+}
