@@ -25,6 +25,7 @@
 //! ```
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod cobs;
 pub mod codec;

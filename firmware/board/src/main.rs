@@ -13,6 +13,11 @@
 //! failsafe pulses, the ESC at the throttle cut) and resets the MCU; the boot path
 //! starts with the same outputs. `unsafe` appears only where the PAC or the Cortex-M
 //! core requires it, each with a `SAFETY` comment.
+//!
+//! **What it may import.** The flight logic (`sweephold-firmware`), the wire protocol
+//! (`sweephold-protocol`), the PAC and the Cortex-M runtime crates; no host crate. It is
+//! the only library or program of the workspace with `unsafe`: every other one forbids
+//! it (`#![forbid(unsafe_code)]`).
 #![cfg_attr(target_os = "none", no_std, no_main)]
 #![deny(unsafe_op_in_unsafe_fn)]
 

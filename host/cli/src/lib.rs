@@ -7,6 +7,7 @@
 //! Inside it, the verbs (`fly`, `frf`, `fit`, `verify`, `decode`, `sim`) own their
 //! options; `campaign` runs them as stages and writes `artifacts`, which `report`
 //! only reads; `plot` draws every figure.
+#![forbid(unsafe_code)]
 
 use clap::{Parser, Subcommand};
 

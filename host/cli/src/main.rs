@@ -1,4 +1,6 @@
 //! `sweephold`: see `sweephold --help`. Without arguments: `sweephold campaign`.
+#![forbid(unsafe_code)]
+
 use std::process::ExitCode;
 
 use clap::error::ErrorKind;

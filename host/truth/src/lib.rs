@@ -15,7 +15,7 @@
 //! It builds on the simulator (`bo105`) and the identification library (`sysid`) and
 //! joins the two; neither of them imports it, nor does it import the command-line tool or
 //! read telemetry.
-
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 mod error;
