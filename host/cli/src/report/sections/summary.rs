@@ -76,6 +76,14 @@ folder (`sweephold report DIR` redraws it).",
             attitude_bar,
             (mode == "cah").then_some(m.max_abs_deg.phi <= 10.0 && m.max_abs_deg.theta <= 10.0),
         ));
+        if let Some(from_trim) = m.max_from_trim_deg {
+            rows.push(bar_row(
+                &format!("{mode}: max |φ − φ_trim|, |θ − θ_trim| from the captured trim"),
+                format!("{:.1}°, {:.1}°", from_trim.phi, from_trim.theta),
+                attitude_bar,
+                (mode == "cah").then_some(from_trim.phi <= 10.0 && from_trim.theta <= 10.0),
+            ));
+        }
         rows.push(bar_row(
             &format!("{mode}: aborted records"),
             format!("{} of {}", m.aborts, m.records),
