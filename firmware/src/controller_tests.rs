@@ -495,7 +495,7 @@ fn adaptive_sweep_is_announced_and_shapes_the_amplitude() {
     assert_eq!(frames, run().1);
 }
 
-const PROTOCOL_VERSION_FOR_TESTS: ProtocolVersion = sweephold_protocol::PROTOCOL_VERSION;
+const PROTOCOL_VERSION_FOR_TESTS: ProtocolVersion = ProtocolVersion { major: 1, minor: 3 };
 
 /// Drive into the sweep, apply `fault`, step once (or `ticks` times), and check the abort.
 fn assert_aborts(reason: AbortReason, fault: impl FnOnce(&mut SensorIn)) -> Rig {

@@ -12,6 +12,8 @@
 use postcard::experimental::max_size::MaxSize;
 use serde::{Deserialize, Serialize};
 
+pub use crate::board_events::{FlightMode, HostFrame, ImuHealth, RefusedCheck, Request};
+
 /// Version of the wire protocol. A host refuses a dump whose `major` differs from its
 /// own; `minor` bumps only add frame variants at the end of [`Frame`] or enum variants at
 /// the end of an enum, which an older host reports as corrupt frames and skips.
@@ -27,20 +29,39 @@ pub struct ProtocolVersion {
 /// The protocol version this crate speaks.
 /// 1.1 added [`Frame::Configure`] and [`Frame::ConfigureResult`]; 1.2 the board
 /// application's abort reasons [`AbortReason::RcLost`], [`AbortReason::ImuFault`] and
-/// [`AbortReason::Disarmed`]; 1.3 [`InputKind::AdaptiveSweep`].
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 3 };
+/// [`AbortReason::Disarmed`]; 1.3 [`InputKind::AdaptiveSweep`]; 1.4 the board
+/// application's events ([`Event::ModeChange`], [`Event::ImuHealthChange`],
+/// [`Event::Refused`], [`Event::HostLinkIgnored`]).
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 4 };
 
 impl ProtocolVersion {
     /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
     /// everything the test streams. A test that uses nothing added since 1.2 announces
     /// 1.2, so its dumps are byte for byte those of a 1.2 flight controller and every
-    /// 1.2 host reads them whole; [`InputKind::AdaptiveSweep`] needs 1.3.
+    /// 1.2 host reads them whole; [`InputKind::AdaptiveSweep`] needs 1.3. A board
+    /// application's stream also carries the 1.4 events: it announces
+    /// [`ProtocolVersion::BOARD_APPLICATION`] whatever its test.
     pub const fn for_test(test: &TestConfig) -> ProtocolVersion {
         match test.input {
-            InputKind::AdaptiveSweep => PROTOCOL_VERSION,
+            InputKind::AdaptiveSweep => ProtocolVersion { major: 1, minor: 3 },
             InputKind::Sweep | InputKind::Doublet | InputKind::ThreeTwoOneOne => {
                 ProtocolVersion { major: 1, minor: 2 }
             }
+        }
+    }
+}
+
+impl ProtocolVersion {
+    /// The version the board application's Headers announce: its streams carry the
+    /// events added in 1.4.
+    pub const BOARD_APPLICATION: ProtocolVersion = ProtocolVersion { major: 1, minor: 4 };
+
+    /// The later of `self` and `other`.
+    pub const fn max(self, other: ProtocolVersion) -> ProtocolVersion {
+        if other.major > self.major || (other.major == self.major && other.minor > self.minor) {
+            other
+        } else {
+            self
         }
     }
 }
@@ -470,6 +491,41 @@ pub enum Event {
         tick: u32,
         /// Why.
         reason: AbortReason,
+    },
+    /// The board application changed flight mode. Since 1.4.
+    ModeChange {
+        /// Tick of the change.
+        tick: u32,
+        /// Mode before.
+        from: FlightMode,
+        /// Mode after.
+        to: FlightMode,
+    },
+    /// The IMU's health changed; also sent on the board application's first tick.
+    /// Since 1.4.
+    ImuHealthChange {
+        /// Tick of the change.
+        tick: u32,
+        /// Health from this tick on.
+        health: ImuHealth,
+    },
+    /// The board application refused an arm or test request. Since 1.4.
+    Refused {
+        /// Tick of the request.
+        tick: u32,
+        /// What was asked.
+        request: Request,
+        /// The first check that failed.
+        check: RefusedCheck,
+    },
+    /// A host frame arrived while the board was armed and was ignored: hardware in the
+    /// loop is entered on the ground only. Sent for the first such frame of each armed
+    /// period. Since 1.4.
+    HostLinkIgnored {
+        /// Tick of the frame.
+        tick: u32,
+        /// Which frame.
+        frame: HostFrame,
     },
 }
 

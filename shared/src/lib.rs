@@ -27,6 +27,7 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod board_events;
 pub mod cobs;
 pub mod codec;
 pub mod decoder;

@@ -56,14 +56,14 @@ pub mod inputs;
 pub mod modes;
 pub mod outputs;
 pub mod pilot_mode;
+pub mod reporting;
 pub mod throttle;
 
 #[cfg(test)]
 mod tests;
 
-use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{
-    AbortReason, Axis, Controls, Event, Frame, Measurements, Phase, PilotInput, SensorIn,
+    Axis, Controls, Header, Measurements, Phase, PilotInput, ProtocolVersion, SensorIn,
 };
 
 use crate::attitude_hold::clamp_finite;
@@ -75,6 +75,7 @@ use crate::trim::Trim;
 
 use arming::{CheckInput, SwitchEdge};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
+use reporting::{BoardTap, Reporter};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
 use throttle::{Throttle, ThrottleSettings};
 
@@ -204,25 +205,6 @@ impl StickMean {
     }
 }
 
-/// Passes frames on and notes the reason of an Abort Event among them.
-struct AbortTap<'a, S: FrameSink> {
-    inner: &'a mut S,
-    reason: Option<AbortReason>,
-}
-
-impl<S: FrameSink> FrameSink for AbortTap<'_, S> {
-    fn write_frame(&mut self, bytes: &[u8]) {
-        self.inner.write_frame(bytes);
-    }
-
-    fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {
-        if let Frame::Event(Event::Abort { reason, .. }) = frame {
-            self.reason = Some(*reason);
-        }
-        self.inner.send_frame(frame)
-    }
-}
-
 /// The board application. See the [module documentation](self).
 #[derive(Clone, Debug)]
 pub struct BoardApp {
@@ -254,6 +236,8 @@ pub struct BoardApp {
     stick_reference: StickMean,
     /// Trim sticks (lat, lon, ped) of the IMU failsafe.
     imu_trim: [f32; 3],
+    /// What the board events last reported.
+    reporter: Reporter,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -299,6 +283,7 @@ impl BoardApp {
             loss: None,
             stick_reference: StickMean::default(),
             imu_trim: [0.0; 3],
+            reporter: Reporter::default(),
             fc,
             config,
         })
@@ -317,6 +302,14 @@ impl BoardApp {
     /// The sequencer (phase, trim, tick, header).
     pub fn flight_controller(&self) -> &FlightController {
         &self.fc
+    }
+
+    /// The Header of the configured test as the board application announces it (the
+    /// sequencer's, at the board application's protocol version).
+    pub fn header(&self) -> Header {
+        let mut header = self.fc.header();
+        header.protocol = header.protocol.max(ProtocolVersion::BOARD_APPLICATION);
+        header
     }
 
     /// Whether the host link (hardware in the loop) may be obeyed: only while
@@ -344,10 +337,12 @@ impl BoardApp {
     /// (telemetry into `sink`), throttle and mixer. Bounded time, no allocation, no
     /// panic for any input.
     pub fn tick<S: FrameSink>(&mut self, input: &TickInput, sink: &mut S) -> TickOutput {
-        let mut sink = AbortTap {
+        let mut sink = BoardTap {
             inner: sink,
             reason: None,
         };
+        // The tick this step's Sample and Events carry.
+        let tick = self.fc.tick();
         let imu = self
             .imu
             .observe(&input.imu, self.stale_limit_ticks, self.recover_ticks);
@@ -412,6 +407,13 @@ impl BoardApp {
                 test_switch,
             },
         };
+        self.reporter.report(
+            tick,
+            reporting::imu_health(imu.health),
+            transition.refused,
+            self.mode,
+            sink.inner,
+        );
         let out = self.fc.step(&sensor, &mut sink);
         let reported_mode = self.mode;
         let command = if self.mode == Mode::Test {

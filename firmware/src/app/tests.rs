@@ -10,7 +10,7 @@ use super::modes::{next, Conditions, Transition};
 use super::pilot_mode::{Drive, LoopFactors, RateAxisGains, RateLoop};
 use super::*;
 use proptest::prelude::*;
-use sweephold_protocol::Decoder;
+use sweephold_protocol::{AbortReason, Decoder, Event, Frame};
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 const STICKS: [f32; 4] = [0.05, -0.1, 0.02, 0.3];
@@ -88,9 +88,51 @@ impl Rig {
             mix(&self.app.config().flight.mixer, &out.command)
         );
         assert_eq!(out.host_link_allowed, self.app.mode() == Mode::Disarmed);
+        self.check_board_events(sample.tick, &out);
         self.frames.extend(self.tick_frames.iter().copied());
         self.outputs.push(out);
         out
+    }
+
+    /// The tick's board events say what its output says: a ModeChange exactly when the
+    /// reported mode changed, a Refused exactly when a request was refused, and the IMU
+    /// health on the first tick.
+    fn check_board_events(&self, tick: u32, out: &TickOutput) {
+        let events = self.tick_events();
+        let previous = self.outputs.last().map_or(Mode::Disarmed, |o| o.mode);
+        let mode_changes: Vec<Event> = events
+            .iter()
+            .copied()
+            .filter(|e| matches!(e, Event::ModeChange { .. }))
+            .collect();
+        let expected: Vec<Event> = (out.mode != previous)
+            .then_some(Event::ModeChange {
+                tick,
+                from: reporting::flight_mode(previous),
+                to: reporting::flight_mode(out.mode),
+            })
+            .into_iter()
+            .collect();
+        assert_eq!(mode_changes, expected, "mode change events at tick {tick}");
+        let refusals: Vec<Event> = events
+            .iter()
+            .copied()
+            .filter(|e| matches!(e, Event::Refused { .. }))
+            .collect();
+        let expected: Vec<Event> = out
+            .refused
+            .map(|refusal| reporting::refusal_event(tick, refusal))
+            .into_iter()
+            .collect();
+        assert_eq!(refusals, expected, "refusal events at tick {tick}");
+        if self.outputs.is_empty() {
+            assert!(
+                events
+                    .iter()
+                    .any(|e| matches!(e, Event::ImuHealthChange { .. })),
+                "the first tick reports the IMU's health"
+            );
+        }
     }
 
     fn ticks(&mut self, n: usize) -> TickOutput {
@@ -1835,4 +1877,72 @@ fn the_loss_hold_profile() {
     assert!((hold(10_000).collective(&settings, 0.005) - 0.12).abs() < 1e-6);
     assert!(!hold(5999).expired(&settings, 0.005));
     assert!(hold(6000).expired(&settings, 0.005));
+}
+
+/// A board standing with its IMU missing says so on its first tick, and an arm request
+/// is refused with an Event naming the IMU; a healthy IMU is reported once, and the
+/// Header of a test announces the board application's protocol version.
+#[test]
+fn board_events_name_the_missing_imu_the_refusal_and_the_modes() {
+    use sweephold_protocol::{FlightMode, ImuHealth, ProtocolVersion, RefusedCheck, Request};
+    let mut rig = Rig::new(test_config());
+    rig.imu.status = ImuStatus::Fault(ImuFaultKind::Missing);
+    rig.tick();
+    assert_eq!(
+        rig.tick_events(),
+        [Event::ImuHealthChange {
+            tick: 0,
+            health: ImuHealth::Missing
+        }]
+    );
+    rig.rc.throttle = 0.0;
+    rig.rc.arm = false;
+    rig.rc.test_switch = false;
+    rig.ticks(5);
+    assert!(rig.tick_events().is_empty(), "a change is reported once");
+    rig.rc.arm = true;
+    let out = rig.tick();
+    assert_eq!(out.mode, Mode::Disarmed);
+    assert_eq!(
+        rig.tick_events(),
+        [Event::Refused {
+            tick: 6,
+            request: Request::Arm,
+            check: RefusedCheck::Imu(ImuHealth::Missing),
+        }]
+    );
+
+    let mut rig = Rig::armed(test_config());
+    let changes: Vec<Event> = rig
+        .frames
+        .iter()
+        .filter_map(|f| match f {
+            Frame::Event(e @ (Event::ModeChange { .. } | Event::ImuHealthChange { .. })) => {
+                Some(*e)
+            }
+            _ => None,
+        })
+        .collect();
+    assert!(matches!(
+        changes.as_slice(),
+        [
+            Event::ImuHealthChange {
+                tick: 0,
+                health: ImuHealth::Ok
+            },
+            Event::ModeChange {
+                from: FlightMode::Disarmed,
+                to: FlightMode::Pilot,
+                ..
+            }
+        ]
+    ));
+    assert_eq!(rig.app.header().protocol, ProtocolVersion::BOARD_APPLICATION);
+    rig.start_test();
+    rig.tick();
+    let announced = rig.frames.iter().rev().find_map(|f| match f {
+        Frame::Header(header) => Some(header.protocol),
+        _ => None,
+    });
+    assert_eq!(announced, Some(ProtocolVersion::BOARD_APPLICATION));
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use sweephold_protocol::{
-    tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, TickStep,
+    tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, RefusedCheck, TickStep,
 };
 
 use crate::output::{refuse_inputs_as_outputs, AtomicFile};
@@ -193,6 +193,26 @@ pub fn event_json(event: &Event) -> serde_json::Value {
         Event::Abort { tick, reason } => {
             json!({"type": "event", "event": "abort", "tick": tick, "reason": reason.name()})
         }
+        Event::ModeChange { tick, from, to } => {
+            json!({"type": "event", "event": "mode_change", "tick": tick, "from": from.name(), "to": to.name()})
+        }
+        Event::ImuHealthChange { tick, health } => {
+            json!({"type": "event", "event": "imu_health", "tick": tick, "health": health.name()})
+        }
+        Event::Refused {
+            tick,
+            request,
+            check,
+        } => {
+            let imu = match check {
+                RefusedCheck::Imu(health) => serde_json::Value::from(health.name()),
+                _ => serde_json::Value::Null,
+            };
+            json!({"type": "event", "event": "refused", "tick": tick, "request": request.name(), "check": check.name(), "imu": imu})
+        }
+        Event::HostLinkIgnored { tick, frame } => {
+            json!({"type": "event", "event": "host_link_ignored", "tick": tick, "frame": frame.name()})
+        }
     }
 }
 
@@ -214,6 +234,23 @@ pub fn event_text(event: &Event) -> String {
             theta.to_degrees()
         ),
         Event::Abort { tick, reason } => format!("tick {tick}: ABORT ({})", reason.name()),
+        Event::ModeChange { tick, from, to } => {
+            format!("tick {tick}: mode {} -> {}", from.name(), to.name())
+        }
+        Event::ImuHealthChange { tick, health } => format!("tick {tick}: IMU {}", health.name()),
+        Event::Refused {
+            tick,
+            request,
+            check,
+        } => match check {
+            RefusedCheck::Imu(health) => {
+                format!("tick {tick}: {} refused: IMU {}", request.name(), health.name())
+            }
+            _ => format!("tick {tick}: {} refused: {}", request.name(), check.name()),
+        },
+        Event::HostLinkIgnored { tick, frame } => {
+            format!("tick {tick}: host {} ignored while armed", frame.name())
+        }
     }
 }
 
