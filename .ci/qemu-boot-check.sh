@@ -10,14 +10,15 @@
 # Builds nothing. Boots ELF in `qemu-system-arm -M netduinoplus2` with USART1 (the first
 # -serial) captured to a file, and checks with `SWEEPHOLD decode` that the image sent a
 # Header (vehicle and protocol version known) and streamed Samples without tick gaps.
-# With no host in the loop the image runs the flight logic on its own at the timer rate
-# (idle phase, pilot pass-through), so the Samples also measure the tick rate: the
+# With no host in the loop the image runs the board application on its own at the control
+# rate (disarmed: no IMU under QEMU), so the Samples also measure the tick rate: the
 # script snapshots the capture after SETTLE_S and again MEASURE_S later, and reports
 # the Samples per second of wall time in between.
 #
 # Second stage, in the loop (needs python3; LOOP_STEPS=0 skips it): boots the image again
 # with USART1 on a unix socket, acts as the host (a small frame encoder/decoder in
-# Python, independent of the Rust codec): sends LOOP_STEPS SensorIn frames one at a time,
+# Python, independent of the Rust codec): checks the board application's first frames
+# (Header, the IMU reported missing), sends LOOP_STEPS SensorIn frames one at a time,
 # flipping the test switch on at the 10th, and checks that each gets exactly one
 # ActuatorOut answering its seq with consecutive ticks, that the test sequencer starts
 # (Armed, TrimCapture), and that when the host then falls silent the image steps on its
@@ -114,9 +115,13 @@ import os, socket, struct, subprocess, sys, time, zlib
 
 PHASES = ["idle", "armed", "trim_capture", "fade_in", "sweep", "fade_out", "done", "aborted"]
 ABORT_REASONS = ["attitude_limit", "rate_limit", "sensor_not_finite", "sensor_stale",
-                 "pilot_override", "switch_released"]
-EVENTS = ["phase_change", "hold_engaged", "hold_released", "trim_captured", "abort"]
-FRAME_KINDS = ["header", "sample", "event", "sensor_in", "actuator_out"]
+                 "pilot_override", "switch_released", "rc_lost", "imu_fault", "disarmed"]
+EVENTS = ["phase_change", "hold_engaged", "hold_released", "trim_captured", "abort",
+          "mode_change", "imu_health", "refused", "host_link_ignored"]
+IMU_HEALTH = ["ok", "calibrating", "missing", "stuck", "saturated", "not_ready", "not_finite",
+              "stale"]
+FRAME_KINDS = ["header", "sample", "event", "sensor_in", "actuator_out", "configure",
+               "configure_result"]
 
 
 def varint(n):
@@ -200,6 +205,8 @@ def parse(raw):
             return ("event", "phase_change", tick, PHASES[payload[i]], PHASES[payload[i + 1]])
         if EVENTS[variant] == "abort":
             return ("event", "abort", tick, ABORT_REASONS[payload[i]])
+        if EVENTS[variant] == "imu_health":
+            return ("event", "imu_health", tick, IMU_HEALTH[payload[i]])
         return ("event", EVENTS[variant], tick)
     return (FRAME_KINDS[kind],)
 
@@ -247,9 +254,13 @@ def check(elf, steps, workdir):
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         link = Link(socket_path)
-        standalone = [link.frame(5.0) for _ in range(10)]
+        # The board application: its Header, the IMU reported missing on its first
+        # tick (nothing on QEMU's SPI1), then one Sample per tick.
+        standalone = [link.frame(5.0) for _ in range(11)]
         kinds = [f[0] if f else None for f in standalone]
-        assert kinds[0] == "header" and kinds[1:] == ["sample"] * 9, f"standalone stream: {kinds}"
+        assert kinds[:2] == ["header", "event"] and kinds[2:] == ["sample"] * 9, f"standalone stream: {kinds}"
+        assert standalone[1][1:] == ("imu_health", 0, "missing"), f"first event: {standalone[1]}"
+        say("standalone: Header, IMU missing at tick 0, Samples")
 
         sticks = (0.1, -0.1, 0.05, 0.2)
         first_tick = last_tick = None

@@ -15,7 +15,11 @@
 use std::path::PathBuf;
 
 use sweephold::fly::link_qemu::{self, QemuLink, QemuTransport};
-use sweephold_protocol::{Decoder, Frame};
+use sweephold_firmware::receiver::{sbus, ChannelMap, RcInput};
+use sweephold_protocol::{
+    Controls, Decoder, Event, FlightMode, Frame, HostFrame, ImuHealth, Phase, ProtocolVersion,
+    RefusedCheck, Request, Sample, SensorIn,
+};
 use sweephold_tests::{fly, fly_args, Scratch};
 
 /// The image and QEMU, or why the test cannot run here.
@@ -364,4 +368,343 @@ fn qemu_log_uart_carries_the_same_frames_as_the_link() {
     let common = link_frames.len().min(log_frames.len());
     assert!(common + 2 >= link_frames.len().max(log_frames.len()));
     assert_eq!(link_frames[..common], log_frames[..common]);
+}
+
+/// The board image on its own in QEMU: USART1 (the host link) on a TCP connection the
+/// test accepts, USART2 (the SBUS receiver) on a second one, USART3 (the log) nowhere.
+struct Board {
+    qemu: std::process::Child,
+    link: std::net::TcpStream,
+    sbus: std::net::TcpStream,
+    decoder: Decoder,
+    /// Every frame read from the link so far.
+    frames: Vec<Frame>,
+}
+
+impl Board {
+    fn boot(image: &std::path::Path) -> Board {
+        use std::net::TcpListener;
+        let listen = || {
+            let listener = TcpListener::bind("127.0.0.1:0").expect("a local port");
+            let port = listener.local_addr().unwrap().port();
+            (listener, port)
+        };
+        let (link_listener, link_port) = listen();
+        let (sbus_listener, sbus_port) = listen();
+        let chardev =
+            |id: &str, port: u16| format!("socket,id={id},host=127.0.0.1,port={port},server=off");
+        let qemu = std::process::Command::new("qemu-system-arm")
+            .args([
+                "-M",
+                "netduinoplus2",
+                "-nographic",
+                "-monitor",
+                "none",
+                "-kernel",
+            ])
+            .arg(image)
+            .args(["-chardev", &chardev("usart1", link_port)])
+            .args(["-chardev", &chardev("usart2", sbus_port)])
+            .args(["-serial", "chardev:usart1", "-serial", "chardev:usart2"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("qemu-system-arm starts");
+        let (link, _) = link_listener.accept().expect("QEMU connects USART1");
+        let (sbus, _) = sbus_listener.accept().expect("QEMU connects USART2");
+        link.set_read_timeout(Some(std::time::Duration::from_millis(20)))
+            .unwrap();
+        Board {
+            qemu,
+            link,
+            sbus,
+            decoder: Decoder::new(),
+            frames: Vec::new(),
+        }
+    }
+
+    /// Read the link for `seconds`, sending the SBUS frame of `rc` every 10 ms (the
+    /// receiver's frame rate) when given.
+    fn run(&mut self, seconds: f64, rc: Option<&RcInput>) {
+        use std::io::{Read, Write};
+        let bytes = rc.map(|rc| sbus::encode(&ChannelMap::flybarless_default().encode(rc)));
+        let until = std::time::Instant::now() + std::time::Duration::from_secs_f64(seconds);
+        let mut chunk = [0u8; 4096];
+        while std::time::Instant::now() < until {
+            if let Some(bytes) = &bytes {
+                self.sbus.write_all(bytes).expect("SBUS bytes to QEMU");
+            }
+            let deadline = std::time::Instant::now() + std::time::Duration::from_millis(10);
+            while std::time::Instant::now() < deadline {
+                match self.link.read(&mut chunk) {
+                    Ok(0) => panic!("QEMU closed the link"),
+                    Ok(n) => {
+                        for frame in self.decoder.feed(&chunk[..n]) {
+                            self.frames.push(frame.expect("a clean stream"));
+                        }
+                    }
+                    Err(e)
+                        if matches!(
+                            e.kind(),
+                            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                        ) => {}
+                    Err(e) => panic!("link: {e}"),
+                }
+            }
+        }
+    }
+
+    /// Send one frame to the board over the link.
+    fn send(&mut self, frame: &Frame) {
+        use std::io::Write;
+        let mut wire = [0u8; sweephold_protocol::MAX_FRAME_LEN];
+        let n = sweephold_protocol::encode(frame, &mut wire).unwrap();
+        self.link.write_all(&wire[..n]).expect("a frame to QEMU");
+    }
+
+    fn events(&self) -> Vec<Event> {
+        self.frames
+            .iter()
+            .filter_map(|f| match f {
+                Frame::Event(e) => Some(*e),
+                _ => None,
+            })
+            .collect()
+    }
+}
+
+impl Drop for Board {
+    fn drop(&mut self) {
+        let _ = self.qemu.kill();
+        let _ = self.qemu.wait();
+    }
+}
+
+/// The IMU: with nothing on QEMU's SPI1 the image boots into the board application,
+/// streams its Header (protocol 1.4) and, on its first tick, an Event naming the missing
+/// IMU, then a Sample per tick with the safe, disarmed command.
+#[test]
+fn qemu_imu_missing_is_reported_at_boot() {
+    let Some(image) = image_or_skip("qemu_imu_missing_is_reported_at_boot") else {
+        return;
+    };
+    let mut board = Board::boot(&image);
+    board.run(1.0, None);
+    let Some(Frame::Header(header)) = board.frames.first() else {
+        panic!(
+            "the stream starts with a Header: {:?}",
+            board.frames.first()
+        );
+    };
+    assert_eq!(header.protocol, ProtocolVersion::BOARD_APPLICATION);
+    assert_eq!(
+        board.frames.get(1),
+        Some(&Frame::Event(Event::ImuHealthChange {
+            tick: 0,
+            health: ImuHealth::Missing
+        }))
+    );
+    let samples: Vec<&Sample> = board
+        .frames
+        .iter()
+        .filter_map(|f| match f {
+            Frame::Sample(s) => Some(s),
+            _ => None,
+        })
+        .collect();
+    assert!(samples.len() >= 50, "{} Samples in 1 s", samples.len());
+    assert!(samples
+        .iter()
+        .all(|s| s.command == Controls::default() && s.phase == Phase::Idle));
+    assert_eq!(board.events().len(), 1, "{:?}", board.events());
+}
+
+/// SBUS and arming: frames fed on the second `-serial` (USART2) reach the board
+/// application; the arm switch going on is refused, naming the missing IMU, and the
+/// board stays disarmed. A second flip is refused again.
+#[test]
+fn qemu_sbus_arm_switch_is_refused_without_an_imu() {
+    let Some(image) = image_or_skip("qemu_sbus_arm_switch_is_refused_without_an_imu") else {
+        return;
+    };
+    let mut board = Board::boot(&image);
+    let mut rc = RcInput::NEUTRAL;
+    board.run(0.5, Some(&rc));
+    assert!(
+        board
+            .events()
+            .iter()
+            .all(|e| !matches!(e, Event::Refused { .. })),
+        "nothing requested yet: {:?}",
+        board.events()
+    );
+    let refusal = Event::Refused {
+        tick: 0,
+        request: Request::Arm,
+        check: RefusedCheck::Imu(ImuHealth::Missing),
+    };
+    let refusals = |board: &Board| -> Vec<Event> {
+        board
+            .events()
+            .into_iter()
+            .filter_map(|e| match e {
+                Event::Refused { request, check, .. } => Some(Event::Refused {
+                    tick: 0,
+                    request,
+                    check,
+                }),
+                _ => None,
+            })
+            .collect()
+    };
+    rc.arm = true;
+    board.run(0.5, Some(&rc));
+    assert_eq!(refusals(&board), [refusal]);
+    rc.arm = false;
+    board.run(0.3, Some(&rc));
+    rc.arm = true;
+    board.run(0.3, Some(&rc));
+    assert_eq!(refusals(&board), [refusal, refusal]);
+    assert!(
+        board
+            .events()
+            .iter()
+            .all(|e| !matches!(e, Event::ModeChange { .. })),
+        "the board never left Disarmed: {:?}",
+        board.events()
+    );
+}
+
+/// The bench image (`sweephold-board` feature `bench-imu`: the IMU is the emulated chip at
+/// rest), from `SWEEPHOLD_FC_BENCH_ELF` or the workspace's `target/fw-bench`; `None` (after
+/// printing why) when the test cannot run here.
+fn bench_image_or_skip(test: &str) -> Option<PathBuf> {
+    // QEMU itself and the sources' age are checked as for the board image.
+    image_or_skip(test)?;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let path = std::env::var_os("SWEEPHOLD_FC_BENCH_ELF")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            root.join("target/fw-bench/thumbv7em-none-eabihf/firmware/sweephold-fc")
+        });
+    if path.is_file() {
+        return Some(path);
+    }
+    assert!(
+        std::env::var_os("SWEEPHOLD_REQUIRE_QEMU").is_none(),
+        "SWEEPHOLD_REQUIRE_QEMU is set but {test} has no bench image at {}",
+        path.display()
+    );
+    eprintln!(
+        "SKIPPED {test}: no bench image at {} (build it with `cargo fw --features bench-imu --target-dir target/fw-bench`)",
+        path.display()
+    );
+    None
+}
+
+/// Arming, and the host link while armed: on the bench image the gyro calibrates, the
+/// SBUS arm switch arms the board (Disarmed → Pilot), and a SensorIn from the host is then
+/// ignored (one `HostLinkIgnored` Event, no ActuatorOut, the Samples go on); disarmed
+/// again, the next SensorIn takes the board into the loop and is answered.
+#[test]
+fn qemu_arm_by_sbus_then_a_host_sensor_in_is_ignored() {
+    let Some(image) = bench_image_or_skip("qemu_arm_by_sbus_then_a_host_sensor_in_is_ignored")
+    else {
+        return;
+    };
+    let mut board = Board::boot(&image);
+    let mut rc = RcInput::NEUTRAL;
+    let calibrated = |board: &Board| {
+        board.events().iter().any(|e| {
+            matches!(
+                e,
+                Event::ImuHealthChange {
+                    health: ImuHealth::Ok,
+                    ..
+                }
+            )
+        })
+    };
+    for _ in 0..50 {
+        if calibrated(&board) {
+            break;
+        }
+        board.run(0.2, Some(&rc));
+    }
+    assert!(
+        calibrated(&board),
+        "the gyro never calibrated: {:?}",
+        board.events()
+    );
+    rc.arm = true;
+    board.run(0.3, Some(&rc));
+    let modes = |board: &Board| -> Vec<(FlightMode, FlightMode)> {
+        board
+            .events()
+            .into_iter()
+            .filter_map(|e| match e {
+                Event::ModeChange { from, to, .. } => Some((from, to)),
+                _ => None,
+            })
+            .collect()
+    };
+    assert_eq!(modes(&board), [(FlightMode::Disarmed, FlightMode::Pilot)]);
+
+    let sensor_in = |seq| {
+        Frame::SensorIn(SensorIn {
+            seq,
+            ..SensorIn::default()
+        })
+    };
+    let before = board.frames.len();
+    board.send(&sensor_in(1));
+    board.run(0.2, Some(&rc));
+    board.send(&sensor_in(2));
+    board.run(0.2, Some(&rc));
+    let after = &board.frames[before..];
+    assert!(
+        after.iter().all(|f| !matches!(f, Frame::ActuatorOut(_))),
+        "armed, the board answered the host"
+    );
+    let ignored: Vec<&Frame> = after
+        .iter()
+        .filter(|f| matches!(f, Frame::Event(Event::HostLinkIgnored { .. })))
+        .collect();
+    assert!(
+        matches!(
+            ignored.as_slice(),
+            [Frame::Event(Event::HostLinkIgnored {
+                frame: HostFrame::SensorIn,
+                ..
+            })]
+        ),
+        "one HostLinkIgnored per armed period: {ignored:?}"
+    );
+    let samples = after
+        .iter()
+        .filter(|f| matches!(f, Frame::Sample(_)))
+        .count();
+    assert!(
+        samples >= 20,
+        "the board application flew on: {samples} Samples"
+    );
+
+    rc.arm = false;
+    board.run(0.3, Some(&rc));
+    assert_eq!(
+        modes(&board),
+        [
+            (FlightMode::Disarmed, FlightMode::Pilot),
+            (FlightMode::Pilot, FlightMode::Disarmed)
+        ]
+    );
+    let before = board.frames.len();
+    board.send(&sensor_in(3));
+    board.run(0.3, Some(&rc));
+    assert!(
+        board.frames[before..]
+            .iter()
+            .any(|f| matches!(f, Frame::ActuatorOut(out) if out.seq == 3)),
+        "disarmed, the SensorIn is answered"
+    );
 }

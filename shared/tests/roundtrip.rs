@@ -78,7 +78,7 @@ fn adaptive_sweep_is_appended_and_announced_only_when_used() {
     assert_eq!(encoded(InputKind::Sweep), [0]);
     assert_eq!(encoded(InputKind::ThreeTwoOneOne), [2]);
     assert_eq!(encoded(InputKind::AdaptiveSweep), [3]);
-    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 3 });
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 4 });
     let mut test = sweephold_protocol::synthetic::header().test;
     for kind in [
         InputKind::Sweep,
@@ -93,6 +93,58 @@ fn adaptive_sweep_is_appended_and_announced_only_when_used() {
         assert!(kind.is_sweep() == (kind == InputKind::Sweep));
     }
     test.input = InputKind::AdaptiveSweep;
-    assert_eq!(ProtocolVersion::for_test(&test), PROTOCOL_VERSION);
+    assert_eq!(
+        ProtocolVersion::for_test(&test),
+        ProtocolVersion { major: 1, minor: 3 }
+    );
     assert!(test.input.is_sweep());
+}
+
+/// Protocol 1.4 appended the board application's events after `Abort` (variant 4): the
+/// older events keep their encoding, the new ones take indices 5–8, and a board
+/// application announces 1.4 whatever its test.
+#[test]
+fn board_events_are_appended_after_abort() {
+    use sweephold_protocol::{
+        AbortReason, Event, FlightMode, HostFrame, ImuHealth, ProtocolVersion, RefusedCheck,
+        Request,
+    };
+    let encoded = |event: Event| {
+        let mut buffer = [0u8; 32];
+        postcard::to_slice(&event, &mut buffer).unwrap().to_vec()
+    };
+    let abort = Event::Abort {
+        tick: 1,
+        reason: AbortReason::Disarmed,
+    };
+    assert_eq!(encoded(abort), [4, 1, 8]);
+    let mode = Event::ModeChange {
+        tick: 2,
+        from: FlightMode::Disarmed,
+        to: FlightMode::ImuFailsafe,
+    };
+    assert_eq!(encoded(mode), [5, 2, 0, 4]);
+    let health = Event::ImuHealthChange {
+        tick: 3,
+        health: ImuHealth::Stale,
+    };
+    assert_eq!(encoded(health), [6, 3, 7]);
+    let refused = Event::Refused {
+        tick: 4,
+        request: Request::Test,
+        check: RefusedCheck::Imu(ImuHealth::Missing),
+    };
+    assert_eq!(encoded(refused), [7, 4, 1, 0, 2]);
+    let ignored = Event::HostLinkIgnored {
+        tick: 5,
+        frame: HostFrame::Configure,
+    };
+    assert_eq!(encoded(ignored), [8, 5, 1]);
+    assert_eq!(
+        ProtocolVersion::BOARD_APPLICATION,
+        ProtocolVersion { major: 1, minor: 4 }
+    );
+    let v = |minor| ProtocolVersion { major: 1, minor };
+    assert_eq!(v(2).max(v(4)), v(4));
+    assert_eq!(v(4).max(v(3)), v(4));
 }

@@ -225,8 +225,12 @@ pub enum ClockGate {
     Tim8,
     /// USART1 (APB2ENR.USART1EN).
     Usart1,
+    /// USART2 (APB1ENR.USART2EN): the SBUS receiver.
+    Usart2,
     /// USART3 (APB1ENR.USART3EN).
     Usart3,
+    /// SPI1 (APB2ENR.SPI1EN): the IMU.
+    Spi1,
 }
 
 impl ClockGate {
@@ -244,7 +248,9 @@ impl ClockGate {
             ClockGate::Tim5 => rcc.apb1enr().modify(|_, w| w.tim5en().set_bit()),
             ClockGate::Tim8 => rcc.apb2enr().modify(|_, w| w.tim8en().set_bit()),
             ClockGate::Usart1 => rcc.apb2enr().modify(|_, w| w.usart1en().set_bit()),
+            ClockGate::Usart2 => rcc.apb1enr().modify(|_, w| w.usart2en().set_bit()),
             ClockGate::Usart3 => rcc.apb1enr().modify(|_, w| w.usart3en().set_bit()),
+            ClockGate::Spi1 => rcc.apb2enr().modify(|_, w| w.spi1en().set_bit()),
         };
         let _ = rcc.ahb1enr().read();
         let _ = rcc.apb1enr().read();

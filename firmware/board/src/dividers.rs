@@ -1,4 +1,4 @@
-//! Divider arithmetic for the tick timer, the servo PWM timer and the USART, from the
+//! Divider arithmetic for the tick timer, the servo PWM timer, the USARTs and the SPI, from the
 //! clock frequencies the clock tree actually runs at. Pure functions, tested on the host.
 
 /// Servo PWM counter frequency [Hz]: one count per microsecond, so a compare value is
@@ -73,6 +73,17 @@ pub fn usart_brr(pclk_hz: u32, baud: u32) -> Result<u32, DividerError> {
     Ok(brr)
 }
 
+/// SPI baud-rate field CR1.BR (RM0090 §28.5.1): the SPI clock is f_pclk / 2^(BR+1),
+/// BR in 0..=7. Returns the smallest divisor whose clock does not exceed `max_hz`.
+pub fn spi_baud_bits(pclk_hz: u32, max_hz: u32) -> Result<u8, DividerError> {
+    if max_hz == 0 {
+        return Err(DividerError::ZeroRate);
+    }
+    (0u8..=7)
+        .find(|&bits| pclk_hz >> (bits + 1) <= max_hz)
+        .ok_or(DividerError::OutOfRange)
+}
+
 /// Baud rate error of a BRR value [parts per million]: |f_pclk/BRR − baud| / baud.
 pub fn baud_error_ppm(pclk_hz: u32, baud: u32, brr: u32) -> u32 {
     let actual = u64::from(pclk_hz) * 1_000_000 / u64::from(brr.max(1));
@@ -121,6 +132,29 @@ mod tests {
             Err(DividerError::OutOfRange)
         );
         assert_eq!(servo_dividers(84_000_000, 0), Err(DividerError::ZeroRate));
+    }
+
+    #[test]
+    fn spi_clock_stays_at_or_below_the_imu_limit() {
+        // ICM-42688-P: 24 MHz at most. PLL tree: APB2 84 MHz → /4 = 21 MHz; HSI: /2 = 8 MHz.
+        assert_eq!(spi_baud_bits(84_000_000, 24_000_000), Ok(1));
+        assert_eq!(spi_baud_bits(16_000_000, 24_000_000), Ok(0));
+        assert_eq!(spi_baud_bits(48_000_000, 24_000_000), Ok(0));
+        assert_eq!(spi_baud_bits(84_000_000, 1_000_000), Ok(6));
+        // Even /256 is above 100 kHz at 84 MHz.
+        assert_eq!(
+            spi_baud_bits(84_000_000, 100_000),
+            Err(DividerError::OutOfRange)
+        );
+        assert_eq!(spi_baud_bits(84_000_000, 0), Err(DividerError::ZeroRate));
+    }
+
+    #[test]
+    fn sbus_baud_rate_is_exact_on_both_clock_trees() {
+        // SBUS: 100 000 Bd from APB1 (42 MHz on the PLL tree, 16 MHz on HSI).
+        assert_eq!(usart_brr(42_000_000, 100_000), Ok(420));
+        assert_eq!(usart_brr(16_000_000, 100_000), Ok(160));
+        assert_eq!(baud_error_ppm(42_000_000, 100_000, 420), 0);
     }
 
     #[test]

@@ -22,8 +22,10 @@ macro_rules! with_port {
         match $port {
             Port::A => {
                 // SAFETY: GPIOA's register block is always mapped; this module is the
-                // only writer of the port's mode, speed, pull and AF registers, and
-                // `modify` is used from thread mode only (boot), so no write is lost.
+                // only writer of the port's mode, type, speed, pull and AF registers,
+                // and `modify` is used from thread mode only (boot), so no write is
+                // lost; pin levels change through BSRR, a write-only register whose
+                // writes are atomic.
                 let $gpio = unsafe { &*pac::GPIOA::ptr() };
                 $body
             }
@@ -48,6 +50,32 @@ fn gate(port: Port) -> ClockGate {
         Port::B => ClockGate::GpioB,
         Port::C => ClockGate::GpioC,
     }
+}
+
+/// Make `pin` a push-pull output driving `high` (level set before the mode, so the pin
+/// never glitches to the other level), output speed "fast".
+pub fn output(pin: Pin, high: bool) {
+    gate(pin.port).enable();
+    let n = pin.number;
+    const MODE_OUTPUT: u8 = 0b01;
+    const SPEED_HIGH: u8 = 0b10;
+    set(pin, high);
+    with_port!(pin.port, |gpio| {
+        gpio.otyper().modify(|_, w| w.ot(n).push_pull());
+        gpio.ospeedr().modify(|_, w| w.ospeedr(n).set(SPEED_HIGH));
+        gpio.moder().modify(|_, w| w.moder(n).set(MODE_OUTPUT));
+    });
+}
+
+/// Drive output `pin` high or low: one write of the port's set/reset register, atomic
+/// by the hardware, so any context may call it.
+pub fn set(pin: Pin, high: bool) {
+    let n = pin.number;
+    with_port!(pin.port, |gpio| gpio.bsrr().write(|w| if high {
+        w.bs(n).set_bit()
+    } else {
+        w.br(n).set_bit()
+    }));
 }
 
 /// Put `pin` in its alternate function (RM0090 §8.3.7, Table 9 of the STM32F405

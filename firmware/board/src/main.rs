@@ -23,10 +23,18 @@
 
 #[cfg(target_os = "none")]
 mod clocks;
+#[cfg(target_os = "none")]
+mod delay;
 #[cfg(any(target_os = "none", test))]
 mod dividers;
 #[cfg(target_os = "none")]
 mod gpio;
+#[cfg(target_os = "none")]
+mod image_config;
+#[cfg(target_os = "none")]
+mod imu_device;
+#[cfg(target_os = "none")]
+mod imu_spi;
 #[cfg(target_os = "none")]
 mod link;
 #[cfg(target_os = "none")]
@@ -41,6 +49,8 @@ mod pins;
 mod ring;
 #[cfg(target_os = "none")]
 mod runner;
+#[cfg(target_os = "none")]
+mod sbus_uart;
 #[cfg(target_os = "none")]
 mod semihosting;
 #[cfg(target_os = "none")]
@@ -57,7 +67,7 @@ mod image {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use stm32f4::stm32f405::interrupt;
 
-    use crate::{log, logport, runner, servo, ticker, usart};
+    use crate::{log, logport, runner, sbus_uart, servo, ticker, usart};
 
     // Log lines carry the loop tick they were written in (the `tick` of the Sample).
     defmt::timestamp!("{=u32}", log::tick());
@@ -86,6 +96,12 @@ mod image {
         usart::on_interrupt();
     }
 
+    /// The SBUS receiver: a received byte.
+    #[interrupt]
+    fn USART2() {
+        sbus_uart::on_interrupt();
+    }
+
     /// The onboard log: room in its transmitter.
     #[interrupt]
     fn USART3() {
@@ -100,6 +116,7 @@ mod image {
         cortex_m::interrupt::disable();
         servo::force_failsafe();
         usart::silence();
+        sbus_uart::silence();
         logport::silence();
     }
 

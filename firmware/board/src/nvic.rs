@@ -16,15 +16,20 @@ pub enum Irq {
     Tim5,
     /// USART1 global interrupt: the host link (receive, and transmit on silicon).
     Usart1,
+    /// USART2 global interrupt: the SBUS receiver's bytes.
+    Usart2,
     /// USART3 global interrupt: the onboard log's transmitter.
     Usart3,
 }
 
-// 0x00 is the IMU's data-ready line and SPI transfer, 0x80 the receiver's UART: the
-// levels those drivers take when they join the image.
+// 0x00 is kept for the IMU's data-ready line and SPI transfer: the image reads the IMU
+// from thread mode on the 1 kHz tick, so no interrupt of its own takes it yet.
 
-/// Priority of the control tick.
+/// Priority of the loop tick (the IMU sample and the control tick are counted by it).
 pub const PRIORITY_TICK: u8 = 0x40;
+/// Priority of the receiver's UART: an SBUS byte every 120 µs must not wait behind the
+/// link or the log.
+pub const PRIORITY_RECEIVER: u8 = 0x80;
 /// Priority of the host link and the log.
 pub const PRIORITY_LINK: u8 = 0xC0;
 
@@ -34,6 +39,7 @@ impl Irq {
         match self {
             Irq::Tim5 => pac::Interrupt::TIM5,
             Irq::Usart1 => pac::Interrupt::USART1,
+            Irq::Usart2 => pac::Interrupt::USART2,
             Irq::Usart3 => pac::Interrupt::USART3,
         }
     }
@@ -42,6 +48,7 @@ impl Irq {
     pub fn priority(self) -> u8 {
         match self {
             Irq::Tim5 => PRIORITY_TICK,
+            Irq::Usart2 => PRIORITY_RECEIVER,
             Irq::Usart1 | Irq::Usart3 => PRIORITY_LINK,
         }
     }

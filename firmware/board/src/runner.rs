@@ -1,47 +1,70 @@
 //! The control loop: boot sequence, the two run modes, and the tick itself.
 //!
-//! **Standalone** (from boot): TIM5 paces the loop at the configured rate. There is no
-//! sensor or receiver driver on this board yet, so each tick runs the flight logic on a
-//! neutral [`SensorIn`] (all zeros, test switch off, `seq` 0): the sequencer stays Idle
-//! and passes the (centred) pilot through, and every tick still streams its Sample.
+//! **Board application** (from boot): TIM5 ticks at the IMU rate (1 kHz). Every tick
+//! reads the ICM-42688-P over SPI1 into the board stack (monitor, boot calibration,
+//! filters, attitude estimate); every fifth, at the flight logic's 200 Hz, the control
+//! tick takes the SBUS bytes USART2 received, runs the board application (Disarmed →
+//! stabilised pilot mode → Test → pilot mode, with the receiver and IMU failsafes), puts
+//! its pulses on the four servos and the ESC, and streams its telemetry: a Header at
+//! boot, one Sample per tick, the sequencer's Events and the board's own (mode changes,
+//! the IMU's health, refused requests; protocol 1.4). An image whose IMU does not answer
+//! (or under QEMU, where nothing is on the bus) reports it missing on its first tick and
+//! refuses to arm. The board's clock for the receiver's timeouts is the tick count.
 //!
-//! **In the loop** (from the first SensorIn frame the host sends, at run time): the host
-//! is the clock. Every SensorIn is exactly one tick: the flight logic steps on it, its
-//! Sample and Events go out, then an ActuatorOut answering the SensorIn's `seq` — the
-//! last frame of the tick, so the host knows the tick's telemetry is complete when it
-//! arrives. Lockstep keeps a simulation deterministic whatever the emulator's or the
-//! host's speed. A Header goes out when the mode is entered, so a dump recorded from
-//! that point on starts with one. TIM5 keeps running as the link watchdog: after
-//! [`LINK_TIMEOUT_S`] without a SensorIn the loop steps on its own again, on the last
-//! SensorIn, whose unchanging `seq` makes the flight logic's stale-sensor check abort
-//! any running test to pilot pass-through; the next SensorIn resumes lockstep.
+//! Each processed IMU sample feeds the independent watchdog ([`crate::watchdog`]),
+//! which the first one starts: a loop that stops processing fresh samples resets the
+//! board into Disarmed with the throttle cut (while the IMU failsafe flies, its control
+//! ticks feed it instead).
 //!
-//! Every SensorIn is also the fresh sample that feeds the independent watchdog
-//! ([`crate::watchdog`]), which the first one starts.
+//! **In the loop** (hardware in the loop, entered by the host's first SensorIn or
+//! Configure frame **while the board application is disarmed**): the host is the clock.
+//! Every SensorIn is exactly one tick of the in-the-loop flight logic (a sequencer of
+//! its own, separate from the board application's): its Sample and Events go out, then
+//! an ActuatorOut answering the SensorIn's `seq` — the last frame of the tick, so the
+//! host knows the tick's telemetry is complete when it arrives. Lockstep keeps a
+//! simulation deterministic whatever the emulator's or the host's speed. A Header goes
+//! out when the mode is entered, so a dump recorded from that point on starts with one.
+//! From then on the receiver is not read, the ESC stays at the throttle cut, and the
+//! servos follow the host's simulation until the next reset. TIM5 keeps running as the
+//! link watchdog: after [`LINK_TIMEOUT_S`] without a SensorIn the loop steps on its own
+//! again at the control rate, on the last SensorIn, whose unchanging `seq` makes the
+//! flight logic's stale-sensor check abort any running test to pilot pass-through; the
+//! next SensorIn resumes lockstep. Every SensorIn feeds the watchdog.
 //!
-//! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the compiled-in
+//! **Armed, a host frame is ignored.** A SensorIn or Configure arriving while the board
+//! application is armed (any mode but Disarmed) is dropped: hardware in the loop is
+//! chosen on the ground, never a takeover in flight. The first such frame of each armed
+//! period is reported with an Event (`HostLinkIgnored`), every one is counted.
+//!
+//! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the in-the-loop
 //! configuration at run time. The image builds the preset of the frame's vehicle for
 //! its test's primary axis, puts the frame's rate and test in, and restarts the flight
 //! logic on it (tick 0); a configuration the flight logic refuses leaves the running
 //! one in place. Either way a [`ConfigureResult`] answers, preceded by the new Header
 //! when accepted, and the loop is in the loop from then on (the Header is the mode
-//! entry's, so the first SensorIn does not send another). TIM5 keeps the boot rate: in
-//! the loop it is only the link watchdog, still [`LINK_TIMEOUT_S`] long.
+//! entry's, so the first SensorIn does not send another).
 
-use sweephold_firmware::{Config, FlightController};
+use embedded_hal::pwm::SetDutyCycle;
+use sweephold_firmware::app::Mode as AppMode;
+use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_HZ};
+use sweephold_firmware::FlightController;
 use sweephold_protocol::{
-    ActuatorOut, Axis, ConfigureResult, Controls, Frame, FrameError, LinkConfig, SensorIn,
-    VehicleId,
+    ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, HostFrame, LinkConfig,
+    SensorIn,
 };
 
 use crate::clocks::{self, ClockSource, Clocks};
+use crate::delay::BusyDelay;
 use crate::dividers;
+use crate::image_config::{image_config, link_config, stack_config};
+use crate::imu_device::{self, ImuDevice};
 use crate::link::{self, FrameScratch, Inbound, Telemetry};
 use crate::log;
 use crate::logport;
 use crate::nvic::{self, Irq};
+use crate::sbus_uart::{self, SbusRx};
 use crate::semihosting;
-use crate::servo::{self, ServoChannel, Servos};
+use crate::servo::{self, ServoChannel, Servos, ESC_CUT_US};
 use crate::ticker::Ticker;
 use crate::usart::{self, UsartTx};
 use crate::watchdog::Watchdog;
@@ -52,93 +75,25 @@ pub const LINK_TIMEOUT_S: u32 = 1;
 /// Seconds between two status lines in the defmt log.
 const STATUS_PERIOD_S: u32 = 10;
 
-/// Vehicle preset of the image, chosen when it is built: `SWEEPHOLD_VEHICLE=trex700l`
-/// (the default: the aircraft this board flies) or `bo105` (QEMU in the loop with the
-/// Bo-105 simulator).
-const VEHICLE: VehicleId = match option_env!("SWEEPHOLD_VEHICLE") {
-    None => VehicleId::Trex700l,
-    Some(name) => match parse_vehicle(name) {
-        Some(vehicle) => vehicle,
-        None => panic!("SWEEPHOLD_VEHICLE must be trex700l or bo105"),
-    },
-};
+/// The loop timer's rate: the IMU's sample rate [Hz].
+const TIMER_HZ: u32 = IMU_RATE_HZ as u32;
 
-/// Primary axis of the image's test, chosen when it is built: `SWEEPHOLD_AXIS=lat`
-/// (default), `lon`, `ped` or `col`.
-const PRIMARY_AXIS: Axis = match option_env!("SWEEPHOLD_AXIS") {
-    None => Axis::Lat,
-    Some(name) => match parse_axis(name) {
-        Some(axis) => axis,
-        None => panic!("SWEEPHOLD_AXIS must be lat, lon, ped or col"),
-    },
-};
+/// Microseconds per loop-timer tick: the board's clock advances by this much per tick.
+const US_PER_TIMER_TICK: u32 = 1_000_000 / TIMER_HZ;
 
-/// `a == b` for strings, usable in a constant.
-const fn same(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
+/// Loop-timer ticks per control tick: the flight logic's rate must divide the IMU's.
+fn timer_ticks_per_control(rate_hz: u32) -> Option<u32> {
+    (rate_hz > 0 && TIMER_HZ % rate_hz == 0).then(|| TIMER_HZ / rate_hz)
 }
 
-const fn parse_vehicle(name: &str) -> Option<VehicleId> {
-    if same(name, VehicleId::Trex700l.name()) {
-        Some(VehicleId::Trex700l)
-    } else if same(name, VehicleId::Bo105.name()) {
-        Some(VehicleId::Bo105)
-    } else {
-        None
-    }
-}
-
-const fn parse_axis(name: &str) -> Option<Axis> {
-    let mut i = 0;
-    while i < Axis::ALL.len() {
-        if same(name, Axis::ALL[i].name()) {
-            return Some(Axis::ALL[i]);
-        }
-        i += 1;
-    }
-    None
-}
-
-/// The preset of `vehicle` flying the paper's test on `axis`.
-fn preset(vehicle: VehicleId, axis: Axis) -> Config {
-    match vehicle {
-        VehicleId::Bo105 => Config::bo105_default(axis),
-        VehicleId::Trex700l => Config::trex700l_default(axis),
-    }
-}
-
-/// The flight-logic configuration the image boots with: the preset of [`VEHICLE`]
-/// flying the paper's test on [`PRIMARY_AXIS`]. A host changes it at run time with a
-/// Configure frame (protocol 1.1).
-fn image_config() -> Config {
-    preset(VEHICLE, PRIMARY_AXIS)
-}
-
-/// The configuration a Configure frame asks for: the vehicle's preset for the test's
-/// primary axis with the frame's rate and test.
-fn link_config(request: &LinkConfig) -> Config {
-    let mut config = preset(request.vehicle, request.test.primary);
-    config.rate_hz = request.rate_hz;
-    config.test = request.test;
-    config
-}
+/// The board's stack on its devices.
+type Stack = BoardStack<ImuDevice, BusyDelay>;
 
 /// How the loop is paced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
 pub enum Mode {
-    /// No host: TIM5 paces the loop on the neutral input.
-    Standalone,
+    /// The board application: TIM5 paces the IMU and the control tick.
+    BoardApplication,
     /// Host in the loop: one tick per SensorIn.
     InTheLoop {
         /// Timer ticks since the last SensorIn.
@@ -149,13 +104,13 @@ pub enum Mode {
 /// Counters for the status log.
 #[derive(Clone, Copy, Debug, Default, defmt::Format)]
 pub struct LoopStats {
-    /// Flight-logic steps run.
+    /// Flight-logic steps run (either mode).
     pub steps: u32,
     /// Timer ticks that came while the previous one was still being served.
     pub overruns: u32,
     /// Times the host went quiet for longer than the link timeout.
     pub link_timeouts: u32,
-    /// Good frames from the host that are not SensorIn (ignored).
+    /// Good frames from the host that are not obeyed (other kinds, or armed).
     pub ignored_frames: u32,
     /// Frames from the host that failed COBS, CRC or decoding.
     pub bad_frames: u32,
@@ -163,52 +118,98 @@ pub struct LoopStats {
     pub reconfigured: u32,
     /// Configure frames refused.
     pub refused: u32,
+    /// IMU polls that failed on the bus.
+    pub imu_errors: u32,
 }
 
 /// The flight logic and its outputs.
 pub struct Runner {
+    /// The board application on the IMU and the receiver.
+    stack: Stack,
+    sbus: SbusRx,
+    /// The in-the-loop flight logic.
     fc: FlightController,
     servos: Servos<ServoChannel>,
+    esc: ServoChannel,
     tx: UsartTx,
     mode: Mode,
-    /// The input of the last tick.
+    /// The in-the-loop input of the last tick.
     input: SensorIn,
+    /// Timer ticks per control tick.
+    control_period: u32,
+    /// Timer ticks since the last control tick.
+    since_control: u32,
+    /// The board's clock [µs] (wraps after 71 min; its users take differences).
+    now_us: u32,
     link_timeout_ticks: u32,
     status_period_ticks: u32,
     ticks_since_status: u32,
     stats: LoopStats,
+    /// A host frame was ignored and reported in this armed period.
+    host_ignored_reported: bool,
     /// Where frames are encoded before they go into the transmit ring.
     scratch: FrameScratch,
-    /// Fed by every fresh sample (in the loop: every SensorIn).
+    /// Fed by every fresh sample (board application: an IMU sample; in the loop: a
+    /// SensorIn).
     watchdog: Watchdog,
 }
 
 impl Runner {
-    fn new(fc: FlightController, servos: Servos<ServoChannel>, tx: UsartTx, rate_hz: u32) -> Self {
-        Runner {
-            fc,
-            servos,
-            tx,
-            mode: Mode::Standalone,
-            input: SensorIn::default(),
-            link_timeout_ticks: LINK_TIMEOUT_S * rate_hz,
-            status_period_ticks: STATUS_PERIOD_S * rate_hz,
-            ticks_since_status: 0,
-            stats: LoopStats::default(),
-            scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
-            watchdog: Watchdog::new(),
-        }
-    }
-
-    /// Send the Header of the configured test.
+    /// Send the Header of the mode's flight logic.
     fn announce(&mut self) {
-        let header = self.fc.header();
+        let header = match self.mode {
+            Mode::BoardApplication => self.stack.app().header(),
+            Mode::InTheLoop { .. } => self.fc.header(),
+        };
         if !link::send(&mut self.tx, &mut self.scratch, &Frame::Header(header)) {
             defmt::warn!("header frame dropped");
         }
     }
 
-    /// One flight-logic tick on the last input; answers the SensorIn `reply_to` with an
+    /// One timer tick's IMU sample for the board stack.
+    fn imu_tick(&mut self, due: u32) {
+        imu_device::before_poll(
+            self.stack.imu_spi_mut(),
+            due.saturating_mul(US_PER_TIMER_TICK),
+        );
+        match self.stack.imu_sample(self.now_us) {
+            ImuStep::Estimated(_) => self.watchdog.fed_by_fresh_sample(),
+            ImuStep::Error(_) => self.stats.imu_errors = self.stats.imu_errors.wrapping_add(1),
+            ImuStep::NotPolled | ImuStep::NotReady | ImuStep::Calibration(_) => {}
+        }
+    }
+
+    /// One control tick of the board application.
+    fn control_tick(&mut self) {
+        let mut received = [0u8; sbus_uart::RX_CAPACITY];
+        let count = self.sbus.take(&mut received);
+        let tick = self.stack.app().flight_controller().tick();
+        log::set_tick(tick);
+        let out = self.stack.control_tick(
+            self.now_us,
+            received.get(..count).unwrap_or(&[]),
+            &mut Telemetry::new(&mut self.tx, &mut self.scratch),
+        );
+        // Infallible: the channels write compare registers.
+        let _ = self.servos.apply(out.servo_us);
+        let _ = self.esc.set_duty_cycle(out.esc_us);
+        self.stats.steps = self.stats.steps.wrapping_add(1);
+        if !out.mode.is_armed() {
+            self.host_ignored_reported = false;
+        }
+        if out.mode == AppMode::ImuFailsafe {
+            // The IMU is gone and the failsafe flies without it: see `crate::watchdog`.
+            self.watchdog.fed_by_failsafe_tick();
+        }
+        if let Some(reason) = out.abort {
+            defmt::warn!("test aborted: {=str}", reason.name());
+        }
+        if out.refused.is_some() {
+            defmt::warn!("request refused in mode {=str}", out.mode.name());
+        }
+    }
+
+    /// One in-the-loop tick on the last input; answers the SensorIn `reply_to` with an
     /// ActuatorOut. Telemetry that finds the ring full is dropped, but the answer waits
     /// for room: in lockstep the host cannot go on without it.
     fn step(&mut self, reply_to: Option<u32>) {
@@ -237,8 +238,21 @@ impl Runner {
     /// `due` timer ticks have elapsed since the last call.
     fn on_timer(&mut self, due: u32) {
         self.stats.overruns = self.stats.overruns.wrapping_add(due.saturating_sub(1));
+        self.since_control = self.since_control.saturating_add(due);
+        let control_due = self.since_control >= self.control_period;
+        if control_due {
+            self.since_control = 0;
+        }
         match self.mode {
-            Mode::Standalone => self.step(None),
+            Mode::BoardApplication => {
+                self.now_us = self
+                    .now_us
+                    .wrapping_add(due.saturating_mul(US_PER_TIMER_TICK));
+                self.imu_tick(due);
+                if control_due {
+                    self.control_tick();
+                }
+            }
             Mode::InTheLoop { silent_ticks } => {
                 let silent = silent_ticks.saturating_add(due);
                 self.mode = Mode::InTheLoop {
@@ -252,27 +266,74 @@ impl Runner {
                             LINK_TIMEOUT_S
                         );
                     }
-                    self.step(None);
+                    if control_due {
+                        self.step(None);
+                    }
                 }
             }
         }
         self.ticks_since_status = self.ticks_since_status.saturating_add(due);
         if self.ticks_since_status >= self.status_period_ticks {
             self.ticks_since_status = 0;
-            defmt::info!(
-                "mode {} {} tx dropped {=u32} rx lost {=u32} log dropped {=u32}",
-                self.mode,
-                self.stats,
-                self.tx.dropped_frames(),
-                usart::rx_lost(),
-                logport::dropped()
-            );
+            self.log_status();
         }
     }
 
-    /// A Configure frame: restart the flight logic on the requested configuration, or
-    /// keep the running one if the flight logic refuses it, and answer.
+    /// The periodic status line of the defmt log.
+    fn log_status(&self) {
+        let app = self.stack.app();
+        defmt::info!(
+            "mode {} app {=str} imu samples {=u32} sbus frames {=u32} line errors {=u32} lost {=u32} {} tx dropped {=u32} rx lost {=u32} log dropped {=u32}",
+            self.mode,
+            app.mode().name(),
+            self.stack.samples(),
+            self.stack.sbus().stats().frames,
+            sbus_uart::line_errors(),
+            sbus_uart::lost(),
+            self.stats,
+            self.tx.dropped_frames(),
+            usart::rx_lost(),
+            logport::dropped()
+        );
+    }
+
+    /// Whether a host frame may be obeyed: always in the loop, and in the board
+    /// application only while it is disarmed. An ignored frame is counted, and the first
+    /// of an armed period reported.
+    fn host_frame_allowed(&mut self, frame: HostFrame) -> bool {
+        if self.mode != Mode::BoardApplication || self.stack.app().host_link_allowed() {
+            return true;
+        }
+        self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1);
+        if !self.host_ignored_reported {
+            self.host_ignored_reported = true;
+            defmt::warn!("host {=str} ignored: armed", frame.name());
+            let event = Event::HostLinkIgnored {
+                tick: self.stack.app().flight_controller().tick(),
+                frame,
+            };
+            link::send(&mut self.tx, &mut self.scratch, &Frame::Event(event));
+        }
+        false
+    }
+
+    /// Leave the board application for the loop: the ESC to the cut, the link timer's
+    /// silence count from zero.
+    fn enter_the_loop(&mut self) {
+        if self.mode == Mode::BoardApplication {
+            let _ = self.esc.set_duty_cycle(ESC_CUT_US);
+            defmt::info!("host in the loop: the board application stops");
+        }
+        self.mode = Mode::InTheLoop { silent_ticks: 0 };
+    }
+
+    /// A Configure frame: restart the in-the-loop flight logic on the requested
+    /// configuration, or keep the running one if the flight logic refuses it, and answer.
     fn configure(&mut self, request: &LinkConfig) {
+        if !self.host_frame_allowed(HostFrame::Configure) {
+            return;
+        }
+        self.enter_the_loop();
         let result = match FlightController::new(link_config(request)) {
             Ok(fc) => {
                 self.fc = fc;
@@ -303,7 +364,6 @@ impl Runner {
                 }
             }
         };
-        self.mode = Mode::InTheLoop { silent_ticks: 0 };
         link::send_waiting(
             &mut self.tx,
             &mut self.scratch,
@@ -315,8 +375,12 @@ impl Runner {
     fn on_frame(&mut self, frame: Result<Frame, FrameError>) {
         match frame {
             Ok(Frame::SensorIn(input)) => {
-                if self.mode == Mode::Standalone {
+                if !self.host_frame_allowed(HostFrame::SensorIn) {
+                    return;
+                }
+                if self.mode == Mode::BoardApplication {
                     defmt::info!("SensorIn from the host: in-the-loop mode");
+                    self.enter_the_loop();
                     self.announce();
                 }
                 self.mode = Mode::InTheLoop { silent_ticks: 0 };
@@ -338,9 +402,10 @@ pub fn run() -> ! {
     let clocks: Clocks = clocks::init();
     defmt::info!("clocks {}", clocks);
 
-    // Servos first: their failsafe pulses are on the pins before anything else runs.
-    let servos = match servo::init(&clocks) {
-        Ok(servos) => servos,
+    // Servos first: their failsafe pulses and the throttle cut are on the pins before
+    // anything else runs.
+    let (servos, esc) = match servo::init(&clocks) {
+        Ok(outputs) => outputs,
         Err(error) => defmt::panic!("servo timer: {}", error),
     };
     let (tx, rx) = match usart::init(&clocks) {
@@ -353,31 +418,76 @@ pub fn run() -> ! {
         tx.brr(),
         dividers::baud_error_ppm(clocks.pclk2_hz, usart::BAUD, tx.brr())
     );
-
     if let Err(error) = logport::init(&clocks) {
         defmt::panic!("USART3 (log): {}", error);
     }
+    let sbus = match sbus_uart::init(&clocks) {
+        Ok(sbus) => sbus,
+        Err(error) => defmt::panic!("USART2 (SBUS): {}", error),
+    };
+    let spi = match imu_device::init(&clocks) {
+        Ok(spi) => spi,
+        Err(error) => defmt::panic!("SPI1 (IMU): {}", error),
+    };
 
     let fc = match FlightController::new(image_config()) {
         Ok(fc) => fc,
         Err(error) => defmt::panic!("flight configuration refused: {=str}", error.message()),
     };
-    // From now on a panic or fault puts the servos where the mixer puts centred sticks.
+    let mut stack = match Stack::new(spi, BusyDelay::new(clocks.hclk_hz), stack_config()) {
+        Ok(stack) => stack,
+        Err(error) => defmt::panic!("board configuration refused: {=str}", error.message()),
+    };
+    // From now on a panic or fault puts the servos where the mixer puts centred sticks:
+    // the board application's disarmed output.
     let neutral = sweephold_firmware::mix(&fc.config().mixer, &Controls::default());
     servo::set_failsafe(neutral);
     defmt::info!("failsafe pulses {} us", neutral);
-    let rate_hz = u32::from(fc.header().rate_hz);
-    let mut runner = Runner::new(fc, servos, tx, rate_hz);
+    let rate_hz = u32::from(stack.app().header().rate_hz);
+    let Some(control_period) = timer_ticks_per_control(rate_hz) else {
+        defmt::panic!(
+            "control rate {=u32} Hz does not divide the IMU rate",
+            rate_hz
+        )
+    };
+    match stack.boot() {
+        Ok(()) => defmt::info!("IMU up: calibrating the gyro (keep the aircraft still)"),
+        Err(_) => defmt::error!("IMU does not answer: arming refused"),
+    }
+    if let BootState::InitFailed(_) = stack.boot_state() {
+        defmt::warn!("no IMU: the board streams telemetry but will not arm");
+    }
+    let mut runner = Runner {
+        stack,
+        sbus,
+        fc,
+        servos,
+        esc,
+        tx,
+        mode: Mode::BoardApplication,
+        input: SensorIn::default(),
+        control_period,
+        since_control: 0,
+        now_us: 0,
+        link_timeout_ticks: LINK_TIMEOUT_S * TIMER_HZ,
+        status_period_ticks: STATUS_PERIOD_S * TIMER_HZ,
+        ticks_since_status: 0,
+        stats: LoopStats::default(),
+        host_ignored_reported: false,
+        scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
+        watchdog: Watchdog::new(),
+    };
     runner.announce();
 
-    let ticker = match Ticker::start(&clocks, rate_hz) {
+    let ticker = match Ticker::start(&clocks, TIMER_HZ) {
         Ok(ticker) => ticker,
         Err(error) => defmt::panic!("tick timer: {}", error),
     };
     defmt::info!(
-        "loop at {=u32} Hz (timer gives {=u64} mHz)",
-        rate_hz,
-        ticker.achieved_millihz
+        "loop timer at {=u32} Hz (timer gives {=u64} mHz), control tick every {=u32}",
+        TIMER_HZ,
+        ticker.achieved_millihz,
+        control_period
     );
 
     if clocks.source == ClockSource::NoRcc && semihosting::requested() {
@@ -422,9 +532,11 @@ fn run_semihosting(mut runner: Runner) -> ! {
         defmt::warn!("no sweephold-log file on the host: defmt stays on RTT");
     }
     defmt::info!("frame link over semihosting");
-    // The boot Header went to the USART before the switch: this one tells the host the
-    // link is up.
+    // The boot Header went to the USART before the switch: this one, the in-the-loop
+    // flight logic's, tells the host the link is up.
+    runner.mode = Mode::InTheLoop { silent_ticks: 0 };
     runner.announce();
+    runner.mode = Mode::BoardApplication;
     let mut decoder = sweephold_protocol::Decoder::new();
     let mut received = [0u8; 256];
     loop {

@@ -140,10 +140,11 @@ impl<P: SetDutyCycle> Servos<P> {
 }
 
 /// Start every output timer at its group's frame rate with the failsafe pulses (servos)
-/// and the throttle cut (ESC) loaded before the outputs are enabled.
+/// and the throttle cut (ESC) loaded before the outputs are enabled. Returns the four
+/// servos and the ESC's channel (its duty value is the throttle pulse in µs).
 // One body serves the 32-bit TIM2 (u32 fields) and the 16-bit timers (u16 fields).
 #[allow(clippy::useless_conversion)]
-pub fn init(clocks: &Clocks) -> Result<Servos<ServoChannel>, DividerError> {
+pub fn init(clocks: &Clocks) -> Result<(Servos<ServoChannel>, ServoChannel), DividerError> {
     for timer in OutputTimer::ALL {
         let (gate, timer_hz) = clock_of(timer, clocks);
         let (prescaler, reload) = dividers::servo_dividers(timer_hz, timer.frame_hz())?;
@@ -189,15 +190,19 @@ pub fn init(clocks: &Clocks) -> Result<Servos<ServoChannel>, DividerError> {
     for output in outputs {
         gpio::alternate_function(output.pin, Pull::None);
     }
-    Ok(Servos {
-        channels: pins::SERVOS.map(|output| {
-            let frame_us = dividers::SERVO_COUNTER_HZ / output.timer.frame_hz();
-            ServoChannel {
-                output,
-                period_us: u16::try_from(frame_us).unwrap_or(u16::MAX),
-            }
-        }),
-    })
+    let channel = |output: Output| {
+        let frame_us = dividers::SERVO_COUNTER_HZ / output.timer.frame_hz();
+        ServoChannel {
+            output,
+            period_us: u16::try_from(frame_us).unwrap_or(u16::MAX),
+        }
+    };
+    Ok((
+        Servos {
+            channels: pins::SERVOS.map(channel),
+        },
+        channel(pins::ESC),
+    ))
 }
 
 /// Write the failsafe pulses and the throttle cut straight into the compare registers.

@@ -6,9 +6,15 @@
 //! loop processes and fed by every fresh sample after that ([`Watchdog::fed_by_fresh_sample`]):
 //! a loop that stops processing fresh samples (stuck in a handler, a lock-up, a host
 //! in the loop gone silent) resets the MCU, and the boot path starts Disarmed with the
-//! servos at their failsafe pulses and the ESC at the throttle cut. In the loop, the
-//! host's SensorIn is the fresh sample; standalone the image has no sensor driver yet, so
-//! there the watchdog is not started.
+//! servos at their failsafe pulses and the ESC at the throttle cut. In the board
+//! application the fresh sample is an IMU sample through the filters and the estimator;
+//! in the loop, the host's SensorIn. An image whose IMU never answered never starts it.
+//!
+//! One exception: while the board application flies its IMU failsafe (an IMU fault it
+//! detected and handles: trim plus reduced direct pilot inputs), each control tick feeds
+//! the watchdog ([`Watchdog::fed_by_failsafe_tick`]). The loop is demonstrably running
+//! then, and a reset would put an airborne helicopter into Disarmed with the throttle cut;
+//! a loop that hangs in the failsafe still stops feeding it.
 //!
 //! Timeout: LSI / 64 with a reload of 1000, nominally 2 s (LSI 32 kHz), 1.36 s at the
 //! LSI's fastest (47 kHz, datasheet): always longer than the link timeout, so a host
@@ -55,5 +61,13 @@ impl Watchdog {
             defmt::info!("watchdog started: fed by every fresh sample");
         }
         iwdg.kr().write(|w| w.key().feed());
+    }
+
+    /// A control tick of the IMU failsafe ran: feed the watchdog if it is running (never
+    /// start it: only a fresh sample does).
+    pub fn fed_by_failsafe_tick(&mut self) {
+        if self.started {
+            iwdg().kr().write(|w| w.key().feed());
+        }
     }
 }

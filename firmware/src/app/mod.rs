@@ -75,8 +75,8 @@ use crate::trim::Trim;
 
 use arming::{CheckInput, SwitchEdge};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
-use reporting::{BoardTap, Reporter};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
+use reporting::{BoardTap, Reporter};
 use throttle::{Throttle, ThrottleSettings};
 
 pub use arming::{CheckFailure, Refusal};

@@ -145,9 +145,7 @@ impl<S: FrameSink> FrameSink for BoardTap<'_, S> {
             }
             Frame::Header(header) => {
                 let mut header = *header;
-                header.protocol = header
-                    .protocol
-                    .max(ProtocolVersion::BOARD_APPLICATION);
+                header.protocol = header.protocol.max(ProtocolVersion::BOARD_APPLICATION);
                 self.inner.send_frame(&Frame::Header(header))
             }
             _ => self.inner.send_frame(frame),

@@ -1937,7 +1937,10 @@ fn board_events_name_the_missing_imu_the_refusal_and_the_modes() {
             }
         ]
     ));
-    assert_eq!(rig.app.header().protocol, ProtocolVersion::BOARD_APPLICATION);
+    assert_eq!(
+        rig.app.header().protocol,
+        ProtocolVersion::BOARD_APPLICATION
+    );
     rig.start_test();
     rig.tick();
     let announced = rig.frames.iter().rev().find_map(|f| match f {

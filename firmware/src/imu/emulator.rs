@@ -376,7 +376,7 @@ impl Icm42688Emulator {
         if !(dt_ns.is_finite() && dt_ns > 0.0) {
             return 0;
         }
-        self.advance_ns(dt_ns.round() as u64)
+        self.advance_ns(libm::round(dt_ns) as u64)
     }
 
     /// Let `dt_ns` nanoseconds pass, producing the samples that fall due. Returns how
@@ -666,13 +666,13 @@ fn at(v: [f32; 3], i: usize) -> f64 {
 
 /// sin(2π f t).
 fn sine(frequency_hz: f32, t: f64) -> f64 {
-    (2.0 * core::f64::consts::PI * f64::from(frequency_hz) * t).sin()
+    libm::sin(2.0 * core::f64::consts::PI * f64::from(frequency_hz) * t)
 }
 
 /// `value / lsb` rounded to the nearest count and clamped to ±32767 (−32768 stays the
 /// "no data" value); NaN reads 0.
 fn quantise(value: f64, lsb: f64) -> i16 {
-    let counts = (value / lsb).round();
+    let counts = libm::round(value / lsb);
     if counts.is_nan() {
         0
     } else {

@@ -25,7 +25,7 @@
 //! rest and needs [`Orientation::TOP_UP_X_FORWARD`] (body = (x, −y, −z)).
 
 pub mod calibration;
-#[cfg(any(test, feature = "std"))]
+#[cfg(any(test, feature = "std", feature = "imu-emulator"))]
 pub mod emulator;
 mod icm42688;
 pub mod registers;

@@ -1,0 +1,55 @@
+//! The IMU device the board stack reads: the ICM-42688-P on SPI1 ([`crate::imu_spi`]), or,
+//! in the bench image (feature `bench-imu`), the flight logic's register-level emulator
+//! of the same chip standing still, so that QEMU, which has nothing on SPI1, can
+//! calibrate, arm and fly the board application. The bench image is for tests only: the
+//! attitude it reports is a still board's, whatever the aircraft does.
+
+use crate::clocks::Clocks;
+use crate::dividers::DividerError;
+
+#[cfg(not(feature = "bench-imu"))]
+mod chip {
+    use super::{Clocks, DividerError};
+    use crate::imu_spi::{self, ImuSpi};
+
+    /// The chip on SPI1.
+    pub type ImuDevice = ImuSpi;
+
+    /// Configure SPI1.
+    pub fn init(clocks: &Clocks) -> Result<ImuDevice, DividerError> {
+        let (spi, hz) = imu_spi::init(clocks)?;
+        defmt::info!("IMU: ICM-42688-P on SPI1 at {=u32} Hz", hz);
+        Ok(spi)
+    }
+
+    /// Before each poll: the chip samples on its own.
+    pub fn before_poll(_device: &mut ImuDevice, _dt_us: u32) {}
+}
+
+#[cfg(feature = "bench-imu")]
+mod chip {
+    use super::{Clocks, DividerError};
+    use crate::imu_spi;
+    use sweephold_firmware::imu::emulator::{Icm42688Emulator, Imperfections};
+    use sweephold_firmware::imu::GRAVITY_M_S2;
+
+    /// The emulated chip.
+    pub type ImuDevice = Icm42688Emulator;
+
+    /// An emulated chip at rest, level, with a bench board's bias and noise. SPI1 is
+    /// set up as on the board image (chip select released), then left alone.
+    pub fn init(clocks: &Clocks) -> Result<ImuDevice, DividerError> {
+        imu_spi::init(clocks)?;
+        let mut device = Icm42688Emulator::new(Imperfections::BENCH);
+        device.set_truth([0.0; 3], [0.0, 0.0, -GRAVITY_M_S2]);
+        defmt::warn!("IMU: BENCH IMAGE, emulated ICM-42688-P at rest (never fly this image)");
+        Ok(device)
+    }
+
+    /// Before each poll: let `dt_us` of emulated time pass, so the chip samples.
+    pub fn before_poll(device: &mut ImuDevice, dt_us: u32) {
+        device.advance_ns(u64::from(dt_us) * 1000);
+    }
+}
+
+pub use chip::{before_poll, init, ImuDevice};
