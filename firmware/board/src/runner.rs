@@ -166,7 +166,9 @@ impl Runner {
         }
     }
 
-    /// One timer tick's IMU sample for the board stack.
+    /// One timer tick's IMU sample for the board stack. Never inlined: a symbol of its
+    /// own for `docs/board_tick_instructions.py`.
+    #[inline(never)]
     fn imu_tick(&mut self, due: u32) {
         imu_device::before_poll(
             self.stack.imu_spi_mut(),
@@ -179,7 +181,9 @@ impl Runner {
         }
     }
 
-    /// One control tick of the board application.
+    /// One control tick of the board application. Never inlined: a symbol of its own for
+    /// `docs/board_tick_instructions.py`.
+    #[inline(never)]
     fn control_tick(&mut self) {
         let mut received = [0u8; sbus_uart::RX_CAPACITY];
         let count = self.sbus.take(&mut received);
