@@ -382,3 +382,59 @@ fn quick_campaign_report_and_errors() {
 
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `campaign --fc board-sim`: every record flown by the board application on the emulated
+/// IMU and receiver; the summary names the link, nothing aborts, and since the board
+/// measures no air data neither the fits nor the verification use u, v or w.
+#[test]
+fn quick_board_sim_campaign_fits_without_air_data() {
+    let dir = scratch("board-sim");
+    let out = dir.join("campaign");
+    let output = sweephold(&[
+        "campaign",
+        "--quick",
+        "--quiet",
+        "--fc",
+        "board-sim",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", one_line_failure(&output));
+    let read = |file: &str| -> Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join(file)).unwrap()).unwrap()
+    };
+    let summary = read("summary.json");
+    assert_eq!(string(&summary["link"], "link"), "board-sim");
+    for mode in ["cah", "standard", "noise"] {
+        assert_eq!(
+            number(&summary["modes"][mode]["aborts"], "aborts"),
+            0.0,
+            "{mode}"
+        );
+    }
+    let air_data = |name: &str| ["u", "v", "w"].contains(&name);
+    for file in ["model6.json", "model9.json"] {
+        let pairs = read(file)["pairs"].as_array().unwrap().clone();
+        assert!(!pairs.is_empty(), "{file}");
+        assert!(
+            pairs
+                .iter()
+                .all(|pair| !air_data(pair["output"].as_str().unwrap())),
+            "{file} fits an air-data pair"
+        );
+    }
+    let verify = read("verify.json");
+    for record in verify["records"].as_array().unwrap() {
+        let names: Vec<&str> = record["outputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|o| o["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(names, ["p", "q", "r", "ax", "ay", "az"]);
+    }
+    // The fly stages' own summaries say which link flew them.
+    let fly = read("fly-cah/summary.json");
+    assert_eq!(string(&fly["link"], "fly link"), "board-sim");
+    let _ = std::fs::remove_dir_all(&dir);
+}

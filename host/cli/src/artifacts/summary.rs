@@ -238,11 +238,20 @@ pub struct StageFailure {
     pub message: String,
 }
 
+fn in_process() -> String {
+    "in-process".to_string()
+}
+
 /// The whole `summary.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CampaignSummary {
     /// Vehicle name (`bo105`, `trex700l`).
     pub vehicle: String,
+    /// The flight controller the records were flown with: `in-process` (the flight
+    /// logic on the simulator's exact states) or `board-sim` (the board application on
+    /// emulated IMU and receiver, no air data). A summary without it is `in-process`.
+    #[serde(default = "in_process")]
+    pub link: String,
     /// Campaign seed (the sweeps; the held-out doublets use `verification_seed`).
     pub seed: u64,
     /// Seed of the held-out doublet records.

@@ -10,7 +10,9 @@ use anyhow::anyhow;
 use sysid::document::FrfDocument;
 use sysid::fit::modes::{mode_records, poles_at_origin};
 use sysid::fit::trim::TrimPoints;
-use sysid::fit::{fit, fit_from_alternative_starts, start_from_quasi_steady, FitResult};
+use sysid::fit::{
+    fit, fit_from_alternative_starts, start_from_quasi_steady, FitResult, ModelStructure,
+};
 use sysid::models;
 
 use super::{verb_args, Campaign, TrimPointsArg};
@@ -27,6 +29,16 @@ use crate::structures;
 use truth::TrimAttitude;
 
 impl Campaign<'_> {
+    /// `structure` with the pairs the campaign's records measure: all of them in
+    /// process, none of the air-data outputs on the board (`--fc board-sim`).
+    fn measured(&self, structure: ModelStructure) -> ModelStructure {
+        if self.args.fc.measures_air_data() {
+            structure
+        } else {
+            structures::without_air_data(structure)
+        }
+    }
+
     /// `sweephold fit` for this campaign: the structure `model` on `frf.json`, with the
     /// campaign's seed, reduced or not, into `out` of the campaign folder.
     fn fit_args(&self, model: &str, out: &str, reduce: bool) -> anyhow::Result<FitArgs> {
@@ -74,7 +86,7 @@ impl Campaign<'_> {
         // Reducing it cost 3.9 s instead of 1.3 s on the default campaign for the same
         // 9-DOF J_ave (113.1 vs 113.3).
         let args = self.fit_args(models::BO105_6DOF.name, files::MODEL_6DOF, false)?;
-        let structure = structures::six_dof()?;
+        let structure = self.measured(structures::six_dof()?);
         // Nor does it take the trim points: its derivatives only start the hybrid, and on
         // most seeds it lands in a degenerate minimum (X_ped, Z_ped of 10⁶–10⁸ with long
         // delays) whose steady balance gives no usable Z_w.
@@ -103,7 +115,7 @@ impl Campaign<'_> {
         // As `sweephold fit --start-from model6.json --reduce`.
         let args = self.fit_args(models::BO105_9DOF_HYBRID.name, files::MODEL_9DOF, true)?;
         // Kinematics and gravity about the trim the flight controller captured.
-        let hybrid = structures::nine_dof_hybrid(self.args.vehicle.sim(), trim)?;
+        let hybrid = self.measured(structures::nine_dof_hybrid(self.args.vehicle.sim(), trim)?);
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
         let starts = [
             (files::MODEL_6DOF.to_string(), started),

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 use sysid::frf::Record;
 
-use super::{verb_args, Campaign};
+use super::{verb_args, Campaign, CampaignLink};
 use crate::artifacts::files;
 use crate::artifacts::flown::LATERAL;
 use crate::artifacts::summary::{ModeSummary, PeakAttitudeDeg};
@@ -101,6 +101,8 @@ impl Campaign<'_> {
             seed.to_string().into(),
             "--t-rec".into(),
             self.args.t_rec_s().to_string().into(),
+            "--fc".into(),
+            self.args.fc.name().into(),
             "--out".into(),
             self.dir().join(folder).into(),
             "--quiet".into(),
@@ -113,7 +115,7 @@ impl Campaign<'_> {
     pub(super) fn fly_sweeps(&mut self, mode: ModeArg) -> anyhow::Result<(FlownMode, String)> {
         let folder = files::fly_folder(mode.name());
         let outcome =
-            fly_in_process(&self.fly_args(mode, InputArg::Sweep, self.args.seed, &folder)?)?;
+            self.fly(&self.fly_args(mode, InputArg::Sweep, self.args.seed, &folder)?)?;
         let summary = mode_summary(&outcome.summary, &folder);
         let line = format!(
             "{} records, {} abort(s), lat–lon coherence {}",
@@ -167,7 +169,7 @@ impl Campaign<'_> {
             seed,
             files::VERIFICATION_FOLDER,
         )?;
-        let outcome = fly_in_process(&args)?;
+        let outcome = self.fly(&args)?;
         let doublets: Vec<String> = outcome
             .summary
             .runs
@@ -180,8 +182,14 @@ impl Campaign<'_> {
     }
 }
 
-fn fly_in_process(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
-    fly::fly(args, &|| Box::new(InProcessLink::new()))
+impl Campaign<'_> {
+    /// Fly `args` on the campaign's flight controller (`--fc`).
+    fn fly(&self, args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
+        match self.args.fc {
+            CampaignLink::InProcess => fly::fly(args, &|| Box::new(InProcessLink::new())),
+            CampaignLink::BoardSim => fly::fly_board_sim(args),
+        }
+    }
 }
 
 /// The mode's figures from `fly`'s summary of its records written into `folder`.
@@ -284,7 +292,7 @@ mod tests {
     /// campaign's dumps were flown with.
     #[test]
     fn the_fly_stages_take_the_verbs_defaults() {
-        use super::super::{CampaignArgs, TrimPointsArg, QUICK_T_REC_S};
+        use super::super::{CampaignArgs, CampaignLink, TrimPointsArg, QUICK_T_REC_S};
         use crate::fly::VehicleArg;
         use std::path::Path;
         let args = CampaignArgs {
@@ -294,6 +302,7 @@ mod tests {
             quick: true,
             trim_points: TrimPointsArg::Default,
             amplitude: AmplitudeArg::Adaptive,
+            fc: CampaignLink::InProcess,
             quiet: true,
         };
         let run = Campaign::new(&args);
@@ -319,6 +328,16 @@ mod tests {
             (0.0, 0.0, 0.0, 0.0)
         );
         assert!(sweeps.pilot_override_at_s.is_none() && sweeps.elf.is_none());
+        let board = CampaignArgs {
+            fc: CampaignLink::BoardSim,
+            ..args.clone()
+        };
+        let on_the_board = Campaign::new(&board)
+            .fly_args(ModeArg::Cah, InputArg::Sweep, 7, "fly-cah")
+            .unwrap();
+        assert_eq!(on_the_board.fc, crate::fly::FcArg::BoardSim);
+        // The board-sim link's own flags keep fly's defaults (vibration on, no faults).
+        assert!(on_the_board.vibration.is_none() && on_the_board.imu_fault.is_none());
         let doublets = run
             .fly_args(ModeArg::Cah, InputArg::Doublet, 8, "verify-doublet")
             .unwrap();

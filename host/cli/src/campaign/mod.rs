@@ -79,6 +79,13 @@ pub struct CampaignArgs {
     /// or `adaptive` (see `fly --amplitude`); the held-out doublets are never shaped.
     #[arg(long, value_enum, default_value_t = AmplitudeArg::Fixed)]
     pub amplitude: AmplitudeArg,
+    /// The flight controller that flies every record: `in-process` (the firmware's flight
+    /// logic on the simulator's exact states) or `board-sim` (the board application on an
+    /// emulated ICM-42688-P and SBUS receiver, as `fly --fc board-sim`). The board
+    /// measures no air data (u, v, w), so with `board-sim` the fits leave out the pairs of
+    /// those outputs and the verification scores the outputs the board measures.
+    #[arg(long, value_enum, default_value_t = CampaignLink::InProcess, value_name = "LINK")]
+    pub fc: CampaignLink,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -165,6 +172,31 @@ fn headline(summary: &CampaignSummary) -> String {
         text += &format!("total     {total:.1} s\n");
     }
     text
+}
+
+/// `campaign --fc`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CampaignLink {
+    /// The firmware's flight logic in process on the simulator's exact states.
+    InProcess,
+    /// The board application on the emulated IMU and receiver (`fly --fc board-sim`).
+    BoardSim,
+}
+
+impl CampaignLink {
+    /// The name `--fc` and `summary.json` know it by.
+    pub const fn name(self) -> &'static str {
+        match self {
+            CampaignLink::InProcess => "in-process",
+            CampaignLink::BoardSim => "board-sim",
+        }
+    }
+
+    /// Whether the records carry air data (u, v, w): only the simulator's exact states
+    /// do; the board measures rates, attitude and specific force.
+    pub const fn measures_air_data(self) -> bool {
+        matches!(self, CampaignLink::InProcess)
+    }
 }
 
 /// `campaign --trim-points`.
@@ -254,6 +286,7 @@ impl<'a> Campaign<'a> {
             args,
             summary: CampaignSummary {
                 vehicle: args.vehicle.name().to_string(),
+                link: args.fc.name().to_string(),
                 seed: args.seed,
                 verification_seed: args.verification_seed(),
                 t_rec_s: args.t_rec_s(),
@@ -377,6 +410,7 @@ mod tests {
             quick: true,
             trim_points: TrimPointsArg::Default,
             amplitude: AmplitudeArg::Fixed,
+            fc: CampaignLink::InProcess,
             quiet: true,
         };
         let mut run = Campaign::new(&args);

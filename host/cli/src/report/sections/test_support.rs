@@ -12,6 +12,7 @@ pub fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
         dir: std::path::PathBuf::from("campaign"),
         summary: CampaignSummary {
             vehicle: "bo105".into(),
+            link: "in-process".into(),
             seed: 1,
             verification_seed: 2,
             t_rec_s: 90.0,
