@@ -14,7 +14,7 @@ use sweephold_firmware::{Config, FlightController};
 use sweephold_protocol::codec::{encode_to_vec, DELIMITER};
 use sweephold_protocol::decoder::decode_frame;
 use sweephold_protocol::{
-    ActuatorOut, ConfigureResult, Frame, FrameError, LinkConfig, SensorIn, VehicleId,
+    ActuatorOut, ConfigureResult, Event, Frame, FrameError, LinkConfig, SensorIn, VehicleId,
 };
 
 /// A byte stream to a flight controller.
@@ -180,7 +180,8 @@ impl<W: ByteWire> FrameChannel<W> {
         }
     }
 
-    /// Send `request` and wait at most `timeout` for its answer.
+    /// Send `request` and wait at most `timeout` for its answer. A board that reports the
+    /// frame ignored (it is armed) ends the wait with an error saying so.
     pub fn configure(
         &mut self,
         request: LinkConfig,
@@ -193,11 +194,17 @@ impl<W: ByteWire> FrameChannel<W> {
         let answer = self.read_until(
             timeout,
             "ConfigureResult (firmware older than protocol 1.1? rebuild it with `cargo fw`)",
-            |frame| Some(matches!(frame, Frame::ConfigureResult(_))),
+            |frame| {
+                Some(matches!(
+                    frame,
+                    Frame::ConfigureResult(_) | Frame::Event(Event::HostLinkIgnored { .. })
+                ))
+            },
             &mut discarded,
         )?;
         match answer {
             Frame::ConfigureResult(result) => Ok(result),
+            Frame::Event(Event::HostLinkIgnored { .. }) => Err(armed()),
             other => bail!("unexpected answer to Configure: {other:?}"),
         }
     }
@@ -223,21 +230,85 @@ impl<W: ByteWire> FrameChannel<W> {
                     None
                 }
                 Frame::ConfigureResult(_) => None,
+                Frame::Event(Event::HostLinkIgnored { .. }) => Some(true),
                 _ => Some(false),
             },
             telemetry,
         )?;
         match answer {
             Frame::ActuatorOut(out) => Ok(out),
+            Frame::Event(Event::HostLinkIgnored { .. }) => Err(armed()),
             other => bail!("unexpected frame closing the tick: {other:?}"),
         }
     }
+}
+
+/// The error of a board that ignores the host because it is armed.
+fn armed() -> anyhow::Error {
+    anyhow!(
+        "the flight controller is armed and ignores the host: hardware in the loop is entered \
+         on the ground only (arm switch off)"
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use sweephold_protocol::Axis;
+
+    /// A wire that answers with the bytes it was given, whatever is sent.
+    struct Replay(Vec<u8>);
+
+    impl ByteWire for Replay {
+        fn send(&mut self, _bytes: &[u8]) -> std::io::Result<()> {
+            Ok(())
+        }
+
+        fn recv(&mut self, buf: &mut [u8], _timeout: Duration) -> std::io::Result<usize> {
+            let n = self.0.len().min(buf.len());
+            buf[..n].copy_from_slice(&self.0[..n]);
+            self.0.drain(..n);
+            if n == 0 {
+                return Err(ErrorKind::TimedOut.into());
+            }
+            Ok(n)
+        }
+
+        fn failure(&mut self, what: &str) -> anyhow::Error {
+            anyhow!("{what}")
+        }
+    }
+
+    #[test]
+    fn an_armed_board_that_ignores_the_host_is_named() {
+        use sweephold_protocol::HostFrame;
+        let ignored = |frame| {
+            let event = Frame::Event(Event::HostLinkIgnored { tick: 9, frame });
+            encode_to_vec(&event).unwrap().as_bytes().to_vec()
+        };
+        let request = link_config(&Config::bo105_default(Axis::Lat)).unwrap();
+        let mut channel = FrameChannel::new(Replay(ignored(HostFrame::Configure)));
+        let error = channel
+            .configure(request, Duration::from_millis(50))
+            .expect_err("ignored");
+        assert!(error.to_string().contains("armed"), "{error}");
+        let mut channel = FrameChannel::new(Replay(ignored(HostFrame::SensorIn)));
+        let error = channel
+            .exchange(
+                &SensorIn::default(),
+                &mut Vec::new(),
+                &mut 0,
+                Duration::from_millis(50),
+            )
+            .expect_err("ignored");
+        assert!(error.to_string().contains("armed"), "{error}");
+        // Without the event the wait ends at its timeout, naming what it waited for.
+        let mut channel = FrameChannel::new(Replay(Vec::new()));
+        let error = channel
+            .configure(request, Duration::from_millis(50))
+            .expect_err("silent");
+        assert!(error.to_string().contains("no ConfigureResult"), "{error}");
+    }
 
     #[test]
     fn a_preset_with_another_test_travels_in_a_configure_frame() {
