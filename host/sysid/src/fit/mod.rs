@@ -92,6 +92,8 @@ pub struct FitOptions {
     /// the steady-state balance at the points and held (status `trim`), re-derived as the
     /// fit moves the others ([`trim`]). Without them those parameters are fitted.
     pub trim_points: Option<trim::TrimPoints>,
+    /// How the trim points enter the fit ([`trim::TrimBalance`]).
+    pub trim_balance: trim::TrimBalance,
 }
 
 impl Default for FitOptions {
@@ -112,6 +114,9 @@ impl Default for FitOptions {
             correlation_limit: 0.9,
             min_auto_range_ratio: 3.0,
             trim_points: None,
+            trim_balance: trim::TrimBalance::Joint {
+                stick_sigma: trim::joint::DEFAULT_STICK_SIGMA,
+            },
         }
     }
 }
