@@ -6,11 +6,12 @@ use std::ffi::OsString;
 use anyhow::anyhow;
 use sysid::document::FrfDocument;
 use sysid::frf::analysis::CoherenceCurve;
-use sysid::frf::{analyse, group_by_primary, Record};
+use sysid::frf::{analyse, group_by_primary, RangeSource, Record};
 
 use super::{verb_args, Campaign};
 use crate::artifacts::files;
 use crate::artifacts::flown::LATERAL;
+use crate::fly::VehicleArg;
 use crate::frf::FrfArgs;
 use crate::output::write_json;
 
@@ -38,7 +39,13 @@ impl Campaign<'_> {
         ];
         argv.extend(records.iter().map(|r| OsString::from(&r.source)));
         let args: FrfArgs = verb_args("frf", argv)?;
-        let analysis = analyse(&group_by_primary(records)?, &args.options())?;
+        let mut options = args.options();
+        if self.args.vehicle == VehicleArg::Bo105 {
+            // The valid ranges leave out where the hold, not the sweep, drives the swept
+            // control (docs/decisions/2026-11-24-trim-joint-cost.md).
+            options.ranges = RangeSource::SweepReference;
+        }
+        let analysis = analyse(&group_by_primary(records)?, &options)?;
         write_json(&args.out, &analysis.document)?;
         let valid = analysis
             .document

@@ -134,9 +134,11 @@ fn settle_and_release(
     let mut result = settle_trim(result, grids, &hold)?;
     result = release_trim(result, original, grids, options)?;
     if options.reduce {
+        let outcome = result.trim.clone();
         result = reduce::reduce(result, grids, options)?;
         if matches!(options.trim_balance, trim::TrimBalance::Joint { .. }) {
             // The reduction refitted under the joint cost: report where it left them.
+            result.trim = outcome;
             report_trim_values(&mut result);
         } else {
             result = settle_trim(result, grids, &hold)?;
