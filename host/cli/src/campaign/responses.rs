@@ -1,5 +1,6 @@
 //! The frequency-response stage: `sweephold frf` on the `cah` sweeps (its arguments, on
-//! the records the fly stage decoded), `frf.json`.
+//! the records the fly stage decoded), `frf.json`. For the Bo-105 the valid ranges come
+//! from the sweep-reference estimate's random error ([`RangeSource::SweepReference`]).
 
 use std::ffi::OsString;
 
@@ -42,7 +43,7 @@ impl Campaign<'_> {
         let mut options = args.options();
         if self.args.vehicle == VehicleArg::Bo105 {
             // The valid ranges leave out where the hold, not the sweep, drives the swept
-            // control (docs/decisions/2026-11-24-trim-joint-cost.md).
+            // control (docs/decisions/2026-11-24-joint-trim-cost-and-reference-ranges.md).
             options.ranges = RangeSource::SweepReference;
         }
         let analysis = analyse(&group_by_primary(records)?, &options)?;

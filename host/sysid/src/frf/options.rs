@@ -105,9 +105,9 @@ pub enum ResponseEstimator {
     CrossSpectral,
     /// H = G_zu⁻¹·G_zy with the swept control's recorded excitation (the sweep) as its
     /// instrument and the other controls as their own ([`reference`](super::reference)).
-    /// Needs records with reference channels (telemetry dumps). Coherences and valid
-    /// ranges stay those of the cross-spectral estimate; the random error grows by the
-    /// estimator's variance ratio. Less biased, more scattered: the measured trade is
+    /// Needs records with reference channels (telemetry dumps). Coherences stay those of
+    /// the cross-spectral estimate; the random error grows by the estimator's variance
+    /// ratio, and the valid ranges with it. Less biased, more scattered: the measured trade is
     /// in docs/decisions/2026-11-21-sweep-reference-estimator.md.
     SweepReference,
 }
