@@ -1,16 +1,18 @@
 //! The frequency-response stage: `sweephold frf` on the `cah` sweeps (its arguments, on
-//! the records the fly stage decoded), `frf.json`.
+//! the records the fly stage decoded), `frf.json`. For the Bo-105 the valid ranges come
+//! from the sweep-reference estimate's random error ([`RangeSource::SweepReference`]).
 
 use std::ffi::OsString;
 
 use anyhow::anyhow;
 use sysid::document::FrfDocument;
 use sysid::frf::analysis::CoherenceCurve;
-use sysid::frf::{analyse, group_by_primary, Record};
+use sysid::frf::{analyse, group_by_primary, RangeSource, Record};
 
 use super::{verb_args, Campaign};
 use crate::artifacts::files;
 use crate::artifacts::flown::LATERAL;
+use crate::fly::VehicleArg;
 use crate::frf::FrfArgs;
 use crate::output::write_json;
 
@@ -38,7 +40,13 @@ impl Campaign<'_> {
         ];
         argv.extend(records.iter().map(|r| OsString::from(&r.source)));
         let args: FrfArgs = verb_args("frf", argv)?;
-        let analysis = analyse(&group_by_primary(records)?, &args.options())?;
+        let mut options = args.options();
+        if self.args.vehicle == VehicleArg::Bo105 {
+            // The valid ranges leave out where the hold, not the sweep, drives the swept
+            // control (docs/decisions/2026-11-24-joint-trim-cost-and-reference-ranges.md).
+            options.ranges = RangeSource::SweepReference;
+        }
+        let analysis = analyse(&group_by_primary(records)?, &options)?;
         write_json(&args.out, &analysis.document)?;
         let valid = analysis
             .document

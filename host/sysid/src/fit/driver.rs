@@ -21,12 +21,8 @@ pub fn fit(
         });
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
-    let mut result = fit_on_grids(&usable, &grids, options)?;
-    result = settle_trim(result, &grids, options)?;
-    if options.reduce {
-        result = reduce::reduce(result, &grids, options)?;
-        result = settle_trim(result, &grids, options)?;
-    }
+    let mut result = fit_on_grids(&usable, &grids, &without_balances(options))?;
+    result = settle_and_release(result, &usable, &grids, options)?;
     result.skipped_pairs = skipped;
     Ok(result)
 }
@@ -61,7 +57,7 @@ pub fn fit_from_alternative_starts(
     // gets the whole budget afterwards if its minimum was not found twice.
     let per_set = FitOptions {
         max_starts: (options.max_starts / starts.len()).max(2),
-        ..options.clone()
+        ..without_balances(options)
     };
     // The best set so far: its index, result, search state and usable structure.
     let mut best: Option<(usize, FitResult, StartSearch, ModelStructure)> = None;
@@ -80,7 +76,7 @@ pub fn fit_from_alternative_starts(
                 });
                 if best
                     .as_ref()
-                    .is_none_or(|(_, b, _, _)| result.average_cost < b.average_cost)
+                    .is_none_or(|(_, b, _, _)| result.objective() < b.objective())
                 {
                     best = Some((set, result, search, usable));
                 }
@@ -104,19 +100,124 @@ pub fn fit_from_alternative_starts(
     // and 190); the file's set, given all eight, found J_ave 25 twice. Its search goes on
     // where it stopped, so it keeps the minima it has and reaches at least the same one.
     if !result.minimum_confirmed && per_set.max_starts < options.max_starts {
-        search_minima(&usable, &grids, options, options.max_starts, &mut search)?;
-        result = finish_fit(&usable, &grids, options, search)?;
+        let options = without_balances(options);
+        search_minima(&usable, &grids, &options, options.max_starts, &mut search)?;
+        result = finish_fit(&usable, &grids, &options, search)?;
         if let Some(outcome) = outcomes.get_mut(best_set) {
             outcome.average_cost = Ok(result.average_cost);
         }
     }
-    result = settle_trim(result, &grids, options)?;
-    if options.reduce {
-        result = reduce::reduce(result, &grids, options)?;
-        result = settle_trim(result, &grids, options)?;
-    }
+    result = settle_and_release(result, &usable, &grids, options)?;
     result.skipped_pairs = skipped;
     Ok((result, outcomes))
+}
+
+/// `options` with the trim balances out of the cost (the search before the trim points
+/// come in).
+fn without_balances(options: &FitOptions) -> FitOptions {
+    FitOptions {
+        trim_balance: trim::TrimBalance::Hold,
+        ..options.clone()
+    }
+}
+
+/// After the search: hold the trim-derived parameters until they settle
+/// ([`settle_trim`]); with [`trim::TrimBalance::Joint`] release them into the joint cost
+/// ([`release_trim`]); then the reduction, if asked for, and the trim step again.
+fn settle_and_release(
+    result: FitResult,
+    original: &ModelStructure,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let hold = without_balances(options);
+    let mut result = settle_trim(result, grids, &hold)?;
+    result = release_trim(result, original, grids, options)?;
+    if options.reduce {
+        let outcome = result.trim.clone();
+        result = reduce::reduce(result, grids, options)?;
+        if matches!(options.trim_balance, trim::TrimBalance::Joint { .. }) {
+            // The reduction refitted under the joint cost: report where it left them.
+            result.trim = outcome;
+            report_trim_values(&mut result);
+        } else {
+            result = settle_trim(result, grids, &hold)?;
+        }
+    }
+    Ok(result)
+}
+
+/// The trim outcome's parameters at the values of `result`.
+fn report_trim_values(result: &mut FitResult) {
+    let values: Vec<Option<f64>> = result
+        .trim
+        .iter()
+        .flat_map(|outcome| &outcome.parameters)
+        .map(|d| result.parameter(&d.name))
+        .collect();
+    if let Some(outcome) = &mut result.trim {
+        for (d, value) in outcome.parameters.iter_mut().zip(values) {
+            if let Some(value) = value {
+                d.value = value;
+            }
+        }
+    }
+}
+
+/// With [`trim::TrimBalance::Joint`] and trim points: the held trim-derived parameters
+/// of `current` (status `trim`) free again, within `original`'s bounds, and refitted with
+/// the others under the joint cost ([`trim::joint`]), from `current`'s values (one start
+/// and one perturbed restart, as in the reduction). The trim outcome then reports the
+/// values the joint fit gave them. Otherwise `current` as it is.
+fn release_trim(
+    current: FitResult,
+    original: &ModelStructure,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let (Some(_), trim::TrimBalance::Joint { .. }) = (&options.trim_points, options.trim_balance)
+    else {
+        return Ok(current);
+    };
+    let names = current.structure.trim_derived.clone();
+    let mut structure = current.structure.clone();
+    let mut released = false;
+    for name in &names {
+        let (Some(index), Some(source)) = (
+            structure.parameter_index(name),
+            original.parameter_index(name),
+        ) else {
+            continue;
+        };
+        let parameter = &mut structure.parameters[index];
+        if parameter.kind != ParameterKind::Trim {
+            continue;
+        }
+        let bounds = &original.parameters[source];
+        parameter.kind = ParameterKind::Free;
+        parameter.lower = bounds.lower;
+        parameter.upper = bounds.upper;
+        if let Some(lower) = bounds.lower {
+            parameter.value = parameter.value.max(lower);
+        }
+        if let Some(upper) = bounds.upper {
+            parameter.value = parameter.value.min(upper);
+        }
+        released = true;
+    }
+    if !released {
+        return Ok(current);
+    }
+    let refit_options = FitOptions {
+        max_starts: options.max_starts.min(2),
+        ..options.clone()
+    };
+    let mut refit = fit_on_grids(&structure, grids, &refit_options)?;
+    refit.reduction = current.reduction;
+    reduce::flag_needed(&mut refit);
+    refit.trim = current.trim;
+    report_trim_values(&mut refit);
+    Ok(refit)
 }
 
 /// Derive the structure's `trim_derived` parameters from the trim points, hold them

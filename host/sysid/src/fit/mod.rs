@@ -90,8 +90,13 @@ pub struct FitOptions {
     pub min_auto_range_ratio: f64,
     /// Trim points: with them the structure's `trim_derived` parameters are derived from
     /// the steady-state balance at the points and held (status `trim`), re-derived as the
-    /// fit moves the others ([`trim`]). Without them those parameters are fitted.
+    /// fit moves the others ([`trim`]), then, with [`trim::TrimBalance::Joint`], fitted
+    /// with the others under the balances ([`trim::joint`]). Without them those parameters
+    /// are fitted like the rest.
     pub trim_points: Option<trim::TrimPoints>,
+    /// How the trim points enter the fit ([`trim::TrimBalance`]; default: held, then
+    /// the joint cost with the stick uncertainty [`trim::joint::DEFAULT_STICK_SIGMA`]).
+    pub trim_balance: trim::TrimBalance,
 }
 
 impl Default for FitOptions {
@@ -112,6 +117,9 @@ impl Default for FitOptions {
             correlation_limit: 0.9,
             min_auto_range_ratio: 3.0,
             trim_points: None,
+            trim_balance: trim::TrimBalance::Joint {
+                stick_sigma: trim::joint::DEFAULT_STICK_SIGMA,
+            },
         }
     }
 }

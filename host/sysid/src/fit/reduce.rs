@@ -30,6 +30,7 @@ use super::modes::{eigenvalue_text, modes, pair_modes, relative_error_percent, M
 pub use super::result::ReductionStep;
 use super::search::fit_on_grids;
 use super::structure::ParameterKind;
+use super::trim::TrimBalance;
 use super::{AccuracyFlag, FitOptions, FitResult, ParameterReport, ParameterStatus};
 
 /// How the refit `after` changed the hover modes of `before` (module documentation), in
@@ -120,11 +121,18 @@ fn worst_parameter(
     options: &FitOptions,
     needed: &[String],
 ) -> Option<(String, String)> {
+    // With the trim balances in the cost the derived parameters are the balances'
+    // unknowns, informed by the points: not candidates for dropping.
+    let balanced: &[String] = match (&options.trim_points, options.trim_balance) {
+        (Some(_), TrimBalance::Joint { .. }) => &result.structure.trim_derived,
+        _ => &[],
+    };
     let free = || {
-        result
-            .parameters
-            .iter()
-            .filter(|p| p.status == ParameterStatus::Free && !needed.contains(&p.name))
+        result.parameters.iter().filter(|p| {
+            p.status == ParameterStatus::Free
+                && !needed.contains(&p.name)
+                && !balanced.contains(&p.name)
+        })
     };
     let worst_by = |key: fn(&super::ParameterReport) -> f64| {
         free()
@@ -227,7 +235,7 @@ pub fn reduce(
             steps.push(ReductionStep {
                 dropped: name.clone(),
                 reason: format!("{reason}; at zero M would be singular"),
-                average_cost_before: current.average_cost,
+                average_cost_before: current.objective(),
                 average_cost_after: f64::INFINITY,
                 accepted: false,
                 left_the_minimum: false,
@@ -236,7 +244,7 @@ pub fn reduce(
             needed.push((name, accepted_drops));
             continue;
         }
-        let before = current.average_cost;
+        let before = current.objective();
         let refit = match fit_on_grids(&smaller, grids, &refit_options) {
             Ok(refit) => Some(refit),
             // A smaller model that cannot be evaluated (e.g. a pole moved onto the jω
@@ -244,7 +252,7 @@ pub fn reduce(
             Err(FitError::SingularSystem { .. }) => None,
             Err(other) => return Err(other),
         };
-        let after = refit.as_ref().map_or(f64::INFINITY, |r| r.average_cost);
+        let after = refit.as_ref().map_or(f64::INFINITY, |r| r.objective());
         let shift = refit
             .as_ref()
             .and_then(|r| largest_shift(&current.parameters, &r.parameters, &name));

@@ -197,9 +197,22 @@ pub struct FitResult {
     pub skipped_pairs: Vec<SkippedPair>,
     /// What the trim points gave (None without trim points or `trim_derived`).
     pub trim: Option<trim::TrimOutcome>,
+    /// The trim balances' share of the cost, Σ e² ([`trim::joint`]; 0 when the cost does
+    /// not carry them).
+    pub balance_cost: f64,
 }
 
 impl FitResult {
+    /// What the fit minimised, per pair: J_ave plus the trim balances' share
+    /// ([`Self::balance_cost`] over the number of pairs). J_ave without the balances.
+    pub fn objective(&self) -> f64 {
+        if self.balance_cost == 0.0 || self.pairs.is_empty() {
+            self.average_cost
+        } else {
+            self.average_cost + self.balance_cost / self.pairs.len() as f64
+        }
+    }
+
     /// Value of a parameter (base or constrained) by name.
     pub fn parameter(&self, name: &str) -> Option<f64> {
         self.parameters

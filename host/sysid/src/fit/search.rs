@@ -2,13 +2,14 @@
 //! from perturbed ones, until the same minimum is found twice ([`super::optimizer`]);
 //! then the accuracy analysis and the report at the best minimum.
 
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 use super::cost::{self, PairGrid};
 use super::error::FitError;
 use super::optimizer;
 use super::result::parameter_reports;
 use super::structure::ModelStructure;
+use super::trim::{joint::JointBalance, TrimBalance, TrimError};
 use super::{accuracy, FitOptions, FitResult, PairFit, StartOutcome};
 
 /// What a free parameter starting at exactly zero starts at instead (the first start;
@@ -89,14 +90,24 @@ pub(super) fn search_minima(
         max_iterations: options.max_iterations,
         ..optimizer::StoppingRules::default()
     };
+    let balance = joint_balance(structure, options)?;
     let evaluate = |x: &DVector<f64>, with_jacobian: bool| {
         let values = merge(&base, &free, x);
         if with_jacobian {
-            let (r, j) = cost::residuals_and_jacobian(structure, &values, &free, grids)?;
+            let (r, j) = residuals_and_jacobian(structure, &values, &free, grids, &balance)?;
             Ok((r, Some(j)))
         } else {
             let model = structure.model(&values)?;
-            Ok((DVector::from_vec(cost::residuals(&model, grids)?), None))
+            let r = DVector::from_vec(cost::residuals(&model, grids)?);
+            match &balance {
+                None => Ok((r, None)),
+                Some(balance) => {
+                    let e = balance
+                        .residuals(structure, &values)
+                        .map_err(balance_error)?;
+                    Ok((stack(&r, &e), None))
+                }
+            }
         }
     };
 
@@ -191,8 +202,14 @@ pub(super) fn finish_fit(
         return Err(last_error.unwrap_or(FitError::NoPairs));
     };
     let values = merge(&base, &free, &best);
-    let (residual, jacobian) = cost::residuals_and_jacobian(structure, &values, &free, grids)?;
+    let balance = joint_balance(structure, options)?;
+    let (residual, jacobian) = residuals_and_jacobian(structure, &values, &free, grids, &balance)?;
+    // The pairs' residuals come first; the balances' (if any) after them.
     let costs = cost::pair_costs_from_residuals(grids, residual.as_slice());
+    let pair_rows: usize = grids.iter().map(|g| 2 * g.omega.len()).sum();
+    let balance_cost = residual
+        .rows(pair_rows, residual.len() - pair_rows)
+        .norm_squared();
     let analysis = accuracy::analyse(&jacobian);
     let fitted_structure = structure.with_values(&values)?;
     let model = structure.model(&values)?;
@@ -224,5 +241,63 @@ pub(super) fn finish_fit(
         reduction: Vec::new(),
         skipped_pairs: Vec::new(),
         trim: None,
+        balance_cost,
     })
+}
+
+/// The trim balances the cost carries ([`trim::joint`]): with trim points, a structure
+/// that derives parameters from them, and [`TrimBalance::Joint`].
+fn joint_balance(
+    structure: &ModelStructure,
+    options: &FitOptions,
+) -> Result<Option<JointBalance>, FitError> {
+    let (Some(points), TrimBalance::Joint { stick_sigma }) =
+        (&options.trim_points, options.trim_balance)
+    else {
+        return Ok(None);
+    };
+    if structure.trim_derived.is_empty() {
+        return Ok(None);
+    }
+    JointBalance::new(structure, points, &structure.trim_derived, stick_sigma)
+        .map(Some)
+        .map_err(|e| FitError::TrimPoints(e.to_string()))
+}
+
+/// A balance that cannot be evaluated at a trial point (its flapping rows singular) is a
+/// rejected step, like a singular frequency response.
+fn balance_error(error: TrimError) -> FitError {
+    match error {
+        TrimError::HiddenStatesSingular | TrimError::Model(_) => {
+            FitError::SingularSystem { omega: 0.0 }
+        }
+        other => FitError::TrimPoints(other.to_string()),
+    }
+}
+
+/// `a` over `b`.
+fn stack(a: &DVector<f64>, b: &DVector<f64>) -> DVector<f64> {
+    DVector::from_iterator(a.len() + b.len(), a.iter().chain(b.iter()).copied())
+}
+
+/// The pairs' residuals and Jacobian ([`cost::residuals_and_jacobian`]) with the
+/// balances' below them when the cost carries them.
+fn residuals_and_jacobian(
+    structure: &ModelStructure,
+    values: &[f64],
+    free: &[usize],
+    grids: &[PairGrid],
+    balance: &Option<JointBalance>,
+) -> Result<(DVector<f64>, DMatrix<f64>), FitError> {
+    let (r, j) = cost::residuals_and_jacobian(structure, values, free, grids)?;
+    let Some(balance) = balance else {
+        return Ok((r, j));
+    };
+    let (e, je) = balance
+        .residuals_and_jacobian(structure, values, free)
+        .map_err(balance_error)?;
+    let mut jacobian = DMatrix::zeros(j.nrows() + je.nrows(), free.len());
+    jacobian.rows_mut(0, j.nrows()).copy_from(&j);
+    jacobian.rows_mut(j.nrows(), je.nrows()).copy_from(&je);
+    Ok((stack(&r, &e), jacobian))
 }

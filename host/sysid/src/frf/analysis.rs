@@ -37,7 +37,7 @@
 
 use crate::document::{FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
 
-use super::options::FrfOptions;
+use super::options::{FrfOptions, RangeSource, ResponseEstimator};
 use super::records::RecordGroup;
 use super::FrfError;
 
@@ -113,6 +113,24 @@ pub fn compute_frequency_responses(
 /// [`compute_frequency_responses`] with the coherence curves and group summaries.
 pub fn analyse(groups: &[RecordGroup], opts: &FrfOptions) -> Result<FrfAnalysis, FrfError> {
     opts.validate()?;
+    if opts.ranges == RangeSource::SweepReference
+        && opts.estimator != ResponseEstimator::SweepReference
+    {
+        let own = FrfOptions {
+            ranges: RangeSource::Estimate,
+            ..opts.clone()
+        };
+        let mut analysis = analyse(groups, &own)?;
+        let reference = analyse(
+            groups,
+            &FrfOptions {
+                estimator: ResponseEstimator::SweepReference,
+                ..own
+            },
+        )?;
+        take_reference_ranges(&mut analysis.document, &reference.document);
+        return Ok(analysis);
+    }
     if groups.is_empty() {
         return Err(FrfError::NoRecords);
     }
@@ -144,6 +162,22 @@ pub fn analyse(groups: &[RecordGroup], opts: &FrfOptions) -> Result<FrfAnalysis,
     }
     keep_one_estimate_per_pair(&mut analysis);
     Ok(analysis)
+}
+
+/// [`RangeSource::SweepReference`]: each pair of `document` gets the valid range of the
+/// same pair in `reference` (none when it has none or is missing), and its phase branch
+/// anchored at the new range's low end.
+fn take_reference_ranges(document: &mut FrfDocument, reference: &FrfDocument) {
+    for pair in &mut document.pairs {
+        pair.valid_range = reference
+            .pair(&pair.input, &pair.output)
+            .and_then(|r| r.valid_range);
+        responses::anchor_phase_branch(pair);
+    }
+    document.notes.push(
+        "valid ranges from the sweep-reference estimate's random error (frequencies where the hold, not the sweep, drives the swept control left out); responses, coherences and random errors from the cross-spectral estimate"
+            .to_string(),
+    );
 }
 
 /// `true` when `pair` came from the group that sweeps its input.

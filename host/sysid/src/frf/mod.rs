@@ -62,7 +62,7 @@ pub use csv::{load_csv, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };
-pub use options::{FrfOptions, ResponseEstimator, ResponseInputs};
+pub use options::{FrfOptions, RangeSource, ResponseEstimator, ResponseInputs};
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
 pub use spectra::welch_independent_averages;
 

@@ -49,6 +49,23 @@ pub struct FrfOptions {
     /// degrees, …). An input below it still conditions the others when it reaches
     /// [`excitation_ratio`](Self::excitation_ratio) of the swept one's RMS.
     pub response_ratio: f64,
+    /// Where the valid ranges come from (default [`RangeSource::Estimate`]).
+    pub ranges: RangeSource,
+}
+
+/// Whose random error sets the pairs' valid ranges.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RangeSource {
+    /// The estimate's own (coherence and random error of the responses written).
+    #[default]
+    Estimate,
+    /// The sweep-reference estimate's ([`ResponseEstimator::SweepReference`]): its random
+    /// error is the cross-spectral one times the square root of its variance ratio, which
+    /// grows where the recorded sweep does not drive the swept control (the hold does), so
+    /// the ranges leave out the frequencies an engaged hold biases. The responses,
+    /// coherences and random errors written stay those of [`FrfOptions::estimator`].
+    /// Needs records with reference channels (telemetry dumps).
+    SweepReference,
 }
 
 /// Which inputs of a record group get MISO-conditioned responses.
@@ -88,9 +105,9 @@ pub enum ResponseEstimator {
     CrossSpectral,
     /// H = G_zu⁻¹·G_zy with the swept control's recorded excitation (the sweep) as its
     /// instrument and the other controls as their own ([`reference`](super::reference)).
-    /// Needs records with reference channels (telemetry dumps). Coherences and valid
-    /// ranges stay those of the cross-spectral estimate; the random error grows by the
-    /// estimator's variance ratio. Less biased, more scattered: the measured trade is
+    /// Needs records with reference channels (telemetry dumps). Coherences stay those of
+    /// the cross-spectral estimate; the random error grows by the estimator's variance
+    /// ratio, and the valid ranges with it. Less biased, more scattered: the measured trade is
     /// in docs/decisions/2026-11-21-sweep-reference-estimator.md.
     SweepReference,
 }
@@ -110,6 +127,7 @@ impl Default for FrfOptions {
             estimator: ResponseEstimator::CrossSpectral,
             responses: ResponseInputs::Auto,
             response_ratio: 0.1,
+            ranges: RangeSource::Estimate,
         }
     }
 }
@@ -162,7 +180,8 @@ impl FrfOptions {
             ));
         }
         if self.responses == ResponseInputs::Excited
-            && self.estimator == ResponseEstimator::SweepReference
+            && (self.estimator == ResponseEstimator::SweepReference
+                || self.ranges == RangeSource::SweepReference)
         {
             return bad(
                 "the sweep-reference estimator gives only the swept input's response: responses to every excited input need the cross-spectral estimator"

@@ -37,7 +37,9 @@
 //! A derived parameter multiplies a state that must vary over the points (no climb, no
 //! Z_w): a column of c that is (numerically) zero is refused with the state named. The
 //! fit iterates: fit with θ_T free, derive θ_T, hold it (status `trim`) and refit from
-//! there, re-derive, until θ_T moves less than [`SETTLED_RELATIVE_CHANGE`].
+//! there, re-derive, until θ_T moves less than [`SETTLED_RELATIVE_CHANGE`]. With
+//! [`TrimBalance::Joint`] (the default) it then releases θ_T and refits with the balances
+//! as residuals of the cost ([`joint`]).
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -55,6 +57,21 @@ pub const CONTROL_COLUMNS: [&str; 4] = ["lat", "lon", "ped", "col"];
 pub const SETTLED_RELATIVE_CHANGE: f64 = 0.01;
 /// Most derive-and-refit rounds.
 pub const MAX_ROUNDS: usize = 6;
+
+/// How a fit uses its trim points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TrimBalance {
+    /// Derive the structure's `trim_derived` parameters from the balance, hold them and
+    /// refit the others; repeat until they settle ([`derive`]).
+    Hold,
+    /// Fit the derived parameters with the others, the balances of the points weighted
+    /// residuals of the cost ([`joint`]); `stick_sigma` is the points' stick uncertainty
+    /// (fraction of travel).
+    Joint {
+        /// Stick uncertainty of the trim points (fraction of travel).
+        stick_sigma: f64,
+    },
+}
 
 /// One steady flight condition.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -256,6 +273,18 @@ fn residuals(
     values: &[f64],
     points: &TrimPoints,
 ) -> Result<Vec<DVector<f64>>, TrimError> {
+    Ok(balance(structure, values, points)?.0)
+}
+
+/// The residuals of [`residuals`] and the quasi-static control derivatives of the
+/// measured rows, `G_m − F_mh F_hh⁻¹ G_h` (`n_measured × n_controls`): what one stick
+/// fraction does to each measured row's acceleration with the hidden states at their
+/// steady values.
+fn balance(
+    structure: &ModelStructure,
+    values: &[f64],
+    points: &TrimPoints,
+) -> Result<(Vec<DVector<f64>>, DMatrix<f64>), TrimError> {
     let model = structure
         .model(values)
         .map_err(|e| TrimError::Model(e.to_string()))?;
@@ -313,20 +342,39 @@ fn residuals(
             measured.iter().map(|&(i, _)| full[i]),
         ));
     }
-    Ok(out)
+    let n_controls = model.controls.len();
+    let mut control = DMatrix::from_fn(measured.len(), n_controls, |a, c| {
+        model.g[(measured[a].0, c)]
+    });
+    if !hidden.is_empty() {
+        let g_h = DMatrix::from_fn(hidden.len(), n_controls, |a, c| model.g[(hidden[a], c)]);
+        let steady = f_hh_lu.solve(&g_h).ok_or(TrimError::HiddenStatesSingular)?;
+        let f_mh = DMatrix::from_fn(measured.len(), hidden.len(), |a, b| {
+            model.f[(measured[a].0, hidden[b])]
+        });
+        control -= f_mh * steady;
+    }
+    Ok((out, control))
 }
 
-/// Derive the parameters named in `names` from `points`, the other parameters at
-/// `values` (module documentation). Returns their values in the order of `names`.
-pub fn derive(
+/// The derived parameters' indices, `values` with them at zero, and the positions among
+/// the measured states of the rows the balance uses ([`balance_rows`]).
+struct BalanceRows {
+    indices: Vec<usize>,
+    base: Vec<f64>,
+    rows: Vec<usize>,
+}
+
+/// Which rows the balance of `names` uses: the moment rows (p, q, r: the paper's
+/// equations) and every measured row a derived parameter enters directly (w for Z_w).
+/// The balance must stay affine in the derived parameters: none may enter M or the
+/// hidden states' own block F_hh (through which x_h depends on them non-linearly).
+/// Checked by setting each to 1 and comparing the matrices with all at 0.
+fn balance_rows(
     structure: &ModelStructure,
     values: &[f64],
-    points: &TrimPoints,
     names: &[String],
-) -> Result<Vec<TrimDerivation>, TrimError> {
-    if points.points.len() < 2 {
-        return Err(TrimError::TooFewPoints(points.points.len()));
-    }
+) -> Result<BalanceRows, TrimError> {
     let indices: Vec<usize> = names
         .iter()
         .map(|name| {
@@ -335,11 +383,6 @@ pub fn derive(
                 .ok_or_else(|| TrimError::Model(format!("no parameter `{name}`")))
         })
         .collect::<Result<_, _>>()?;
-    // The balance must stay affine in the derived parameters: none may enter M or the
-    // hidden states' own block F_hh (through which x_h depends on them non-linearly).
-    // Checked by setting each to 1 and comparing the matrices with all at 0. The rows
-    // used are the moment rows (p, q, r: the paper's equations) and every measured row a
-    // derived parameter enters directly (w for Z_w).
     let mut base = values.to_vec();
     for &k in &indices {
         base[k] = 0.0;
@@ -382,6 +425,29 @@ pub fn derive(
         .filter(|&(_, &i)| direct_rows[i] || ["p", "q", "r"].contains(&states[i].as_str()))
         .map(|(position, _)| position)
         .collect();
+    Ok(BalanceRows {
+        indices,
+        base,
+        rows,
+    })
+}
+
+/// Derive the parameters named in `names` from `points`, the other parameters at
+/// `values` (module documentation). Returns their values in the order of `names`.
+pub fn derive(
+    structure: &ModelStructure,
+    values: &[f64],
+    points: &TrimPoints,
+    names: &[String],
+) -> Result<Vec<TrimDerivation>, TrimError> {
+    if points.points.len() < 2 {
+        return Err(TrimError::TooFewPoints(points.points.len()));
+    }
+    let BalanceRows {
+        indices,
+        base,
+        rows,
+    } = balance_rows(structure, values, names)?;
     let r0 = residuals(structure, &base, points)?;
     let mut columns: Vec<Vec<DVector<f64>>> = Vec::with_capacity(indices.len());
     for &k in &indices {
@@ -457,3 +523,5 @@ pub fn quasi_static_derivative(
     let a_mh = DVector::from_fn(hidden.len(), |x, _| a[(i, hidden[x])]);
     Some(a[(i, j)] - a_mh.dot(&steady))
 }
+
+pub mod joint;

@@ -7,7 +7,11 @@ use crate::fit::test_support::{hybrid_structure, hybrid_truth_values};
 /// Trim points of the linear model `structure` at `values`: at each point the given
 /// u, v, w, r (columns of `set`), every other state and the four sticks solved from
 /// `0 = F x + G u` (as many unknowns as states).
-fn linear_trim_points(structure: &ModelStructure, values: &[f64], set: &[[f64; 4]]) -> TrimPoints {
+pub(super) fn linear_trim_points(
+    structure: &ModelStructure,
+    values: &[f64],
+    set: &[[f64; 4]],
+) -> TrimPoints {
     let model = structure.model(values).unwrap();
     let n = model.states.len();
     let given = ["u", "v", "w", "r"];
@@ -65,7 +69,7 @@ fn linear_trim_points(structure: &ModelStructure, values: &[f64], set: &[[f64; 4
 }
 
 /// Hover, ±u, ±v, ±w, ±r.
-const STEPS: [[f64; 4]; 9] = [
+pub(super) const STEPS: [[f64; 4]; 9] = [
     [0.0, 0.0, 0.0, 0.0],
     [1.0, 0.0, 0.0, 0.0],
     [-1.0, 0.0, 0.0, 0.0],
@@ -77,7 +81,7 @@ const STEPS: [[f64; 4]; 9] = [
     [0.0, 0.0, 0.0, -0.1],
 ];
 
-fn names(list: &[&str]) -> Vec<String> {
+pub(super) fn names(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()
 }
 

@@ -790,3 +790,93 @@ fn a_sweep_whose_amplitude_changes_at_its_zero_crossings_is_estimated_as_well() 
     let [lo, hi] = pair.valid_range.unwrap();
     assert!(lo < 1.0 && hi > 20.0, "valid range {lo}..{hi}");
 }
+
+/// `ranges: SweepReference` writes the cross-spectral responses with the valid ranges of
+/// the sweep-reference estimate (a closed loop, as in the test above, gives them different
+/// random errors), and a note saying so; records without references are refused.
+#[test]
+fn reference_ranges_keep_the_cross_spectral_responses() {
+    let (gain, time_constant, feedback) = (2.0, 0.5, 1.5);
+    let sweep = Sweep {
+        omega_min: 0.5,
+        omega_max: 20.0,
+        duration: 120.0,
+        amplitude: 0.2,
+    };
+    let len = (sweep.duration * RATE) as usize;
+    let dt = 1.0 / RATE;
+    let decay = (-dt / time_constant).exp();
+    let filter = (-5.0 * dt).exp();
+    let mut noise = Noise::new(11);
+    let (mut state, mut measured, mut disturbance) = (0.0, 0.0, 0.0);
+    let (mut control, mut output, mut excitation) = (Vec::new(), Vec::new(), Vec::new());
+    for n in 0..len {
+        let r = sweep.value(n as f64 * dt);
+        let u = r - feedback * measured;
+        state = decay * state + (1.0 - decay) * gain * u;
+        disturbance = filter * disturbance + (1.0 - filter) * 0.5 * noise.gaussian();
+        measured = state + disturbance;
+        control.push(u);
+        output.push(measured);
+        excitation.push(r);
+    }
+    let mut rec = record(
+        RATE,
+        [0.5, 20.0],
+        vec![("lat", control)],
+        vec![("p", output)],
+    );
+    let bare = RecordGroup::new(vec![rec.clone()]).unwrap();
+    rec.references = vec![Channel::new("lat", excitation)];
+    let groups = [RecordGroup::new(vec![rec]).unwrap()];
+    let with = |estimator, ranges| FrfOptions {
+        estimator,
+        ranges,
+        ..FrfOptions::default()
+    };
+    let analyse_with = |estimator, ranges| {
+        super::analyse(&groups, &with(estimator, ranges))
+            .unwrap()
+            .document
+    };
+    let cross = analyse_with(ResponseEstimator::CrossSpectral, RangeSource::Estimate);
+    let reference = analyse_with(ResponseEstimator::SweepReference, RangeSource::Estimate);
+    let combined = analyse_with(
+        ResponseEstimator::CrossSpectral,
+        RangeSource::SweepReference,
+    );
+    let (c, r, m) = (
+        cross.pair("lat", "p").unwrap(),
+        reference.pair("lat", "p").unwrap(),
+        combined.pair("lat", "p").unwrap(),
+    );
+    assert_ne!(
+        c.valid_range, r.valid_range,
+        "the test needs different ranges"
+    );
+    assert_eq!(m.valid_range, r.valid_range);
+    assert_eq!((&m.omega, &m.mag_db), (&c.omega, &c.mag_db));
+    assert_eq!(
+        (&m.coherence, &m.random_error),
+        (&c.coherence, &c.random_error)
+    );
+    for (a, b) in m.phase_deg.iter().zip(&c.phase_deg) {
+        let turns = (a - b) / 360.0;
+        assert!((turns - turns.round()).abs() < 1e-9, "{a} vs {b}");
+    }
+    assert!(combined
+        .notes
+        .iter()
+        .any(|n| n.contains("valid ranges from the sweep-reference estimate")));
+    let error = super::analyse(
+        &[bare],
+        &with(
+            ResponseEstimator::CrossSpectral,
+            RangeSource::SweepReference,
+        ),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(error.contains("sweep-reference estimator needs"), "{error}");
+}
