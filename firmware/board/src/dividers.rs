@@ -73,6 +73,13 @@ pub fn usart_brr(pclk_hz: u32, baud: u32) -> Result<u32, DividerError> {
     Ok(brr)
 }
 
+/// Loop-timer ticks per control tick when the timer runs at `timer_hz` (the IMU's rate)
+/// and the flight logic at `rate_hz`: None unless `rate_hz` divides `timer_hz`, since
+/// the control tick must fall on an IMU sample every time.
+pub fn ticks_per_control(timer_hz: u32, rate_hz: u32) -> Option<u32> {
+    (rate_hz > 0 && timer_hz % rate_hz == 0).then(|| timer_hz / rate_hz)
+}
+
 /// SPI baud-rate field CR1.BR (RM0090 §28.5.1): the SPI clock is f_pclk / 2^(BR+1),
 /// BR in 0..=7. Returns the smallest divisor whose clock does not exceed `max_hz`.
 pub fn spi_baud_bits(pclk_hz: u32, max_hz: u32) -> Result<u8, DividerError> {
@@ -132,6 +139,21 @@ mod tests {
             Err(DividerError::OutOfRange)
         );
         assert_eq!(servo_dividers(84_000_000, 0), Err(DividerError::ZeroRate));
+    }
+
+    #[test]
+    fn the_control_tick_falls_on_an_imu_sample() {
+        assert_eq!(ticks_per_control(1000, 200), Some(5));
+        assert_eq!(ticks_per_control(1000, 1000), Some(1));
+        assert_eq!(ticks_per_control(1000, 300), None);
+        assert_eq!(ticks_per_control(1000, 0), None);
+        // Both presets fly at a rate the 1 kHz IMU divides.
+        for rate in [
+            sweephold_firmware::Config::bo105_default(sweephold_protocol::Axis::Lat).rate_hz,
+            sweephold_firmware::Config::trex700l_default(sweephold_protocol::Axis::Lat).rate_hz,
+        ] {
+            assert!(ticks_per_control(1000, u32::from(rate)).is_some(), "{rate}");
+        }
     }
 
     #[test]

@@ -49,8 +49,8 @@ use sweephold_firmware::app::Mode as AppMode;
 use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_HZ};
 use sweephold_firmware::FlightController;
 use sweephold_protocol::{
-    ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, HostFrame, LinkConfig,
-    SensorIn,
+    ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, Header, HostFrame,
+    LinkConfig, SensorIn,
 };
 
 use crate::clocks::{self, ClockSource, Clocks};
@@ -80,11 +80,6 @@ const TIMER_HZ: u32 = IMU_RATE_HZ as u32;
 
 /// Microseconds per loop-timer tick: the board's clock advances by this much per tick.
 const US_PER_TIMER_TICK: u32 = 1_000_000 / TIMER_HZ;
-
-/// Loop-timer ticks per control tick: the flight logic's rate must divide the IMU's.
-fn timer_ticks_per_control(rate_hz: u32) -> Option<u32> {
-    (rate_hz > 0 && TIMER_HZ % rate_hz == 0).then(|| TIMER_HZ / rate_hz)
-}
 
 /// The board's stack on its devices.
 type Stack = BoardStack<ImuDevice, BusyDelay>;
@@ -157,10 +152,18 @@ pub struct Runner {
 impl Runner {
     /// Send the Header of the mode's flight logic.
     fn announce(&mut self) {
-        let header = match self.mode {
-            Mode::BoardApplication => self.stack.app().header(),
-            Mode::InTheLoop { .. } => self.fc.header(),
-        };
+        match self.mode {
+            Mode::BoardApplication => self.send_header(self.stack.app().header()),
+            Mode::InTheLoop { .. } => self.announce_in_the_loop(),
+        }
+    }
+
+    /// Send the Header of the in-the-loop flight logic.
+    fn announce_in_the_loop(&mut self) {
+        self.send_header(self.fc.header());
+    }
+
+    fn send_header(&mut self, header: Header) {
         if !link::send(&mut self.tx, &mut self.scratch, &Frame::Header(header)) {
             defmt::warn!("header frame dropped");
         }
@@ -448,7 +451,7 @@ pub fn run() -> ! {
     servo::set_failsafe(neutral);
     defmt::info!("failsafe pulses {} us", neutral);
     let rate_hz = u32::from(stack.app().header().rate_hz);
-    let Some(control_period) = timer_ticks_per_control(rate_hz) else {
+    let Some(control_period) = dividers::ticks_per_control(TIMER_HZ, rate_hz) else {
         defmt::panic!(
             "control rate {=u32} Hz does not divide the IMU rate",
             rate_hz
@@ -538,9 +541,7 @@ fn run_semihosting(mut runner: Runner) -> ! {
     defmt::info!("frame link over semihosting");
     // The boot Header went to the USART before the switch: this one, the in-the-loop
     // flight logic's, tells the host the link is up.
-    runner.mode = Mode::InTheLoop { silent_ticks: 0 };
-    runner.announce();
-    runner.mode = Mode::BoardApplication;
+    runner.announce_in_the_loop();
     let mut decoder = sweephold_protocol::Decoder::new();
     let mut received = [0u8; 256];
     loop {
