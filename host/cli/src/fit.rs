@@ -74,8 +74,9 @@ pub struct FitArgs {
     pub constants: Vec<(String, f64)>,
     /// Trim points (CSV: label, u v w p q r phi theta, lat lon ped col per steady flight;
     /// `sweephold sim trim-points` writes the simulator's): the structure's `trim_derived`
-    /// parameters (the shipped files: Lv Mu Nv Zw Nr) are derived from the steady-state
-    /// balance at the points and held, status `trim`, instead of fitted.
+    /// parameters (the shipped 6-DOF: Lv Mu Nv Zw Nr; the hybrid: Mfu Lfu Nv Zw Nr) are
+    /// derived from the steady-state balance at the points and held (status `trim`) until
+    /// they settle, then released (status `free`) into one cost with the balances.
     #[arg(long, value_name = "FILE")]
     pub trim_points: Option<PathBuf>,
 }
