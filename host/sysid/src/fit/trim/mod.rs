@@ -62,7 +62,7 @@ pub const MAX_ROUNDS: usize = 6;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TrimBalance {
     /// Derive the structure's `trim_derived` parameters from the balance, hold them and
-    /// refit the others; repeat until they settle ([`derive`]).
+    /// refit the others; repeat until they settle ([`derive()`]).
     Hold,
     /// Fit the derived parameters with the others, the balances of the points weighted
     /// residuals of the cost ([`joint`]); `stick_sigma` is the points' stick uncertainty
