@@ -57,8 +57,16 @@ pub struct FitOptions {
     /// Most starts (the first from the structure's start values, exact zeros nudged to
     /// 1e−3; the rest perturbed).
     pub max_starts: usize,
-    /// Perturbation of restarts: each free value × (1 + spread·U(−1, 1)).
+    /// Perturbation of the exploring restarts: each free value × (1 + spread·U(−1, 1)).
     pub start_spread: f64,
+    /// Starts that explore: the structure's start values and perturbations of them by
+    /// `start_spread`. Every later start perturbs the best minimum found so far by
+    /// `polish_spread` instead, so that a minimum in a long, flat valley (the 6-DOF's,
+    /// where runs stop at the iteration limit) is reached again rather than each start
+    /// ending somewhere else along it.
+    pub explore_starts: usize,
+    /// Perturbation of the starts after `explore_starts`, about the best minimum so far.
+    pub polish_spread: f64,
     /// Seed of the restart perturbations.
     pub seed: u64,
     /// Two starts found the same minimum when their J_ave differ by at most
@@ -106,6 +114,8 @@ impl Default for FitOptions {
             max_iterations: 200,
             max_starts: 8,
             start_spread: 0.3,
+            explore_starts: 3,
+            polish_spread: 0.1,
             seed: 1,
             same_minimum_tolerance: 1e-4,
             reduce: false,

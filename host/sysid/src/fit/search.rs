@@ -64,8 +64,10 @@ impl StartSearch {
     }
 }
 
-/// Levenberg–Marquardt from the structure's start values, then from perturbed ones, until
-/// the best minimum has been reached twice or `max_starts` starts have been made in all.
+/// Levenberg–Marquardt from the structure's start values, then from perturbed ones (about
+/// the start values for the first `explore_starts`, about the best minimum so far after
+/// them), until the best minimum has been reached twice or `max_starts` starts have been
+/// made in all.
 pub(super) fn search_minima(
     structure: &ModelStructure,
     grids: &[PairGrid],
@@ -130,13 +132,20 @@ pub(super) fn search_minima(
             bounds.project(&mut x);
             x
         } else {
-            optimizer::perturbed_start(
-                &first_start,
-                options.start_spread,
-                0.1,
-                &bounds,
-                &mut search.random,
-            )
+            // Explore about the structure's start values first, then perturb the best
+            // minimum so far (`FitOptions::explore_starts`).
+            let best_so_far = search
+                .finals
+                .iter()
+                .filter(|(_, j)| j.is_finite())
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let (centre, spread) = match best_so_far {
+                Some((x, _)) if start_number >= options.explore_starts => {
+                    (x, options.polish_spread)
+                }
+                _ => (&first_start, options.start_spread),
+            };
+            optimizer::perturbed_start(centre, spread, 0.1, &bounds, &mut search.random)
         };
         if free.is_empty() {
             search.finals.push((start, f64::NAN));

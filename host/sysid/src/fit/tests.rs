@@ -155,6 +155,37 @@ fn an_unconfirmed_best_set_gets_the_whole_budget() {
     assert!(result.starts.len() <= 3, "{:?}", result.starts);
 }
 
+/// After `explore_starts`, a restart perturbs the best minimum so far, not the structure's
+/// start values: with no perturbation it starts on that minimum and stops at once.
+#[test]
+fn restarts_after_the_exploring_ones_start_from_the_best_minimum() {
+    let structure = first_order_structure();
+    let truth = structure.values();
+    let document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 20);
+    let start: Vec<f64> = truth.iter().map(|v| v * 1.4).collect();
+    let perturbed = structure.with_values(&start).unwrap();
+    let polishing = FitOptions {
+        max_starts: 2,
+        explore_starts: 1,
+        polish_spread: 0.0,
+        // Keep the exact fit from stopping the first run before a restart is needed.
+        same_minimum_tolerance: 0.0,
+        ..FitOptions::default()
+    };
+    let result = fit(&perturbed, &document, &polishing).unwrap();
+    assert_eq!(result.starts.len(), 2, "{:?}", result.starts);
+    assert!(result.starts[0].iterations > 2, "{:?}", result.starts);
+    assert!(result.starts[1].iterations <= 1, "{:?}", result.starts);
+    // Exploring instead, the second start begins 40 % off again (spread 0: the same start).
+    let exploring = FitOptions {
+        explore_starts: 2,
+        start_spread: 0.0,
+        ..polishing
+    };
+    let result = fit(&perturbed, &document, &exploring).unwrap();
+    assert_eq!(result.starts[1].iterations, result.starts[0].iterations);
+}
+
 #[test]
 fn fit_is_deterministic_for_a_seed() {
     let structure = first_order_structure();
