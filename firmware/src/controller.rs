@@ -23,7 +23,8 @@
 //! * The excitation phases FadeIn / Sweep / FadeOut follow the excitation's segments (see
 //!   [`SweepSignal`](crate::sweep::SweepSignal) and
 //!   [`PulseSignal`](crate::pulse::PulseSignal)); every command there is
-//!   `trim + perturbation`, clamped to [−1, 1].
+//!   `trim + perturbation`, clamped to [−1, 1] and, with a slew limit configured
+//!   ([`Config::slew`]), moved from the tick before's command by at most its axis' step.
 //!
 //! # Sample fields
 //!
@@ -31,7 +32,8 @@
 //! Sweep phase, ω_min in FadeIn (the fade and the ω_min hold run at ω_min) and ω_max in
 //! FadeOut; 0 in every other phase and for pulse inputs. `sweep` and `noise` are the
 //! parts actually applied (0 on an axis whose hold is Engaged or Frozen in conditional
-//! attitude hold), so `command − trim − sweep − noise` is the hold controller's share.
+//! attitude hold), so `command − trim − sweep − noise` is the hold controller's share
+//! (and, with a slew limit, what the limit held back).
 //! `pilot` and `meas` are the raw inputs of the tick (a NaN that caused an abort is
 //! logged as such).
 //!
@@ -60,6 +62,7 @@ use crate::mixer::mix;
 use crate::noise::OffAxisNoise;
 use crate::safety::{self, SafetyInput, StaleTracker};
 use crate::sink::FrameSink;
+use crate::slew;
 use crate::trim::{Trim, TrimAccumulator};
 
 /// What the flight controller commands in one tick.
@@ -201,6 +204,10 @@ pub struct FlightController {
     dt_s: f32,
     /// Per-tick decay factors of lat, lon, ped.
     decays: [AxisDecay; 3],
+    /// Largest command step per tick of lat, lon, ped, col (infinite: no slew limit).
+    slew_steps: [f32; 4],
+    /// The commands of the tick before (the slew limit's starting point).
+    last_command: [f32; 4],
     trim_capture_ticks: u32,
     phase: Phase,
     tick: u32,
@@ -260,6 +267,8 @@ impl FlightController {
                 AxisDecay::new(&config.gains.lon, dt_s),
                 AxisDecay::new(&config.gains.ped, dt_s),
             ],
+            slew_steps: config.slew.steps(dt_s),
+            last_command: [0.0; 4],
             trim_capture_ticks,
             phase: Phase::Idle,
             tick: 0,
@@ -366,6 +375,7 @@ impl FlightController {
             TickParts::pass_through(pilot)
         };
 
+        self.last_command = parts.command;
         let command = Controls::from_array(parts.command);
         let sample = Sample {
             tick,
@@ -550,9 +560,12 @@ impl FlightController {
             .iter_mut()
             .zip(parts.sweep.iter_mut())
             .zip(parts.noise.iter_mut())
-            .zip(trim.sticks);
-        for ((((command, sweep_part), noise_part), trim_stick), (held, input)) in
-            held_parts.zip(self.axes.iter_mut().zip(inputs))
+            .zip(trim.sticks.iter().zip(self.last_command))
+            .zip(self.slew_steps);
+        for (
+            ((((command, sweep_part), noise_part), (&trim_stick, last)), max_step),
+            (held, input),
+        ) in held_parts.zip(self.axes.iter_mut().zip(inputs))
         {
             let step = step_axis(
                 held,
@@ -563,7 +576,11 @@ impl FlightController {
                 &self.thresholds,
                 self.dt_s,
             );
-            *command = clamp_unit(trim_stick + step.perturbation);
+            *command = clamp_unit(slew::limit(
+                last,
+                clamp_unit(trim_stick + step.perturbation),
+                max_step,
+            ));
             held.last_perturbation = *command - trim_stick;
             *sweep_part = step.sweep;
             *noise_part = step.noise;
@@ -593,7 +610,10 @@ impl FlightController {
         let [lat, lon, ped, _] = parts.command;
         let [sweep_lat, sweep_lon, sweep_ped, _] = parts.sweep;
         let [_, _, _, trim_col] = trim.sticks;
-        parts.command = [lat, lon, ped, clamp_unit(trim_col + collective_sweep)];
+        let [_, _, _, last_col] = self.last_command;
+        let [_, _, _, col_step] = self.slew_steps;
+        let col = slew::limit(last_col, clamp_unit(trim_col + collective_sweep), col_step);
+        parts.command = [lat, lon, ped, clamp_unit(col)];
         parts.sweep = [sweep_lat, sweep_lon, sweep_ped, collective_sweep];
         parts
     }

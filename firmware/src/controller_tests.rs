@@ -2,6 +2,7 @@
 //! public API and decoded with the protocol's own decoder.
 
 use super::*;
+use crate::slew::CommandSlew;
 use proptest::prelude::*;
 use sweephold_protocol::{Decoder, InputKind, PilotInput, WARN_RECORD_SHORT};
 
@@ -250,6 +251,109 @@ fn commands_are_trim_plus_sweep_plus_noise_and_the_collective_is_untouched() {
         noise_seen[2] |= s.noise.ped != 0.0;
     }
     assert_eq!(noise_seen, [false, true, true]);
+}
+
+/// The largest tick-to-tick move of each command over the excitation, with the heading
+/// 20° and the roll 8° off trim from the start (both holds engage) and the measured roll
+/// rate flipping between ±0.5 rad/s every half second (the roll hold's damping term steps).
+fn largest_steps(config: Config) -> [f32; 4] {
+    let mut rig = Rig::into_sweep(config);
+    let trim = rig.fc.trim();
+    rig.input.meas.psi = trim.psi + 20.0 * DEG;
+    rig.input.meas.phi = trim.phi + 8.0 * DEG;
+    rig.input.meas.r = 1.0;
+    let mut last = rig.sample().command.to_array();
+    let mut largest = [0.0f32; 4];
+    let mut tick = 0;
+    while rig.fc.phase() != Phase::Done {
+        tick += 1;
+        rig.input.meas.p = if (tick / 100) % 2 == 0 { 0.5 } else { -0.5 };
+        rig.step();
+        assert_ne!(rig.fc.phase(), Phase::Aborted);
+        let command = rig.sample().command.to_array();
+        if rig.fc.phase() != Phase::Done {
+            for ((big, now), before) in largest.iter_mut().zip(command).zip(last) {
+                *big = big.max((now - before).abs());
+            }
+        }
+        last = command;
+    }
+    largest
+}
+
+#[test]
+fn a_slew_limit_bounds_every_step_of_the_commands_it_limits() {
+    let mut config = short_config();
+    config.hold_reference = HoldReference::Trim;
+    config.test.primary = Axis::Col;
+    config.test.sweep.amplitude = 0.5;
+    let free = largest_steps(config);
+    let step = 4.0 * config.dt_s();
+    // Without a limit the holds (lat, ped) and the collective sweep move faster than 4 /s.
+    assert!(
+        free[0] > step && free[2] > step && free[3] > step,
+        "{free:?}"
+    );
+    config.slew = CommandSlew {
+        per_s: [4.0, f32::INFINITY, 4.0, 4.0],
+    };
+    let limited = largest_steps(config);
+    for axis in [0, 2, 3] {
+        assert!(limited[axis] <= step * (1.0 + 1e-5), "{limited:?}");
+    }
+    // The limit is per axis: the unlimited one is left as it was.
+    assert_eq!(limited[1], free[1]);
+}
+
+#[test]
+fn a_pedal_slew_limit_leaves_the_other_axes_bit_for_bit() {
+    let mut config = short_config();
+    config.hold_reference = HoldReference::Trim;
+    let run = |config: Config| {
+        let mut rig = Rig::into_sweep(config);
+        let trim = rig.fc.trim();
+        rig.input.meas.psi = trim.psi + 20.0 * DEG;
+        (0..300)
+            .map(|_| {
+                rig.step();
+                rig.sample()
+            })
+            .collect::<Vec<_>>()
+    };
+    let free = run(config);
+    config.slew = CommandSlew::pedal(4.0);
+    let limited = run(config);
+    let step = 4.0 * config.dt_s();
+    assert!(free
+        .windows(2)
+        .any(|w| (w[1].command.ped - w[0].command.ped).abs() > step));
+    for (a, b) in free.iter().zip(&limited) {
+        assert_eq!(
+            (a.command.lat, a.command.lon, a.command.col),
+            (b.command.lat, b.command.lon, b.command.col)
+        );
+    }
+    assert!(limited
+        .windows(2)
+        .all(|w| (w[1].command.ped - w[0].command.ped).abs() <= step * (1.0 + 1e-5)));
+    // The held pedal still gets where the hold drives it, at the limit's pace.
+    assert!((limited[299].command.ped - free[299].command.ped).abs() < 1e-3);
+}
+
+#[test]
+fn slew_limits_must_be_positive() {
+    for bad in [0.0, -4.0, f32::NAN] {
+        let mut config = short_config();
+        config.slew = CommandSlew::pedal(bad);
+        assert_eq!(
+            FlightController::new(config).err(),
+            Some(ConfigError::SlewInvalid)
+        );
+    }
+    let mut config = short_config();
+    config.slew = CommandSlew::pedal(f32::INFINITY);
+    assert!(FlightController::new(config).is_ok());
+    assert_eq!(Config::bo105_default(Axis::Lat).slew, CommandSlew::NONE);
 }
 
 #[test]
@@ -685,10 +789,14 @@ proptest! {
             Just(ExcitationMode::OffAxisNoise)
         ],
         freeze in any::<bool>(),
+        slewed in any::<bool>(),
     ) {
         let mut config = short_config();
         config.test.mode = mode;
         config.test.freeze_in_band = freeze;
+        if slewed {
+            config.slew = CommandSlew { per_s: [4.0, 2.0, 4.0, 1.0] };
+        }
         let mixer = config.mixer;
         let mut rig = Rig::into_sweep(config);
         for (meas, sticks, switch, fresh) in ticks {

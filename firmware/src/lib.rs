@@ -39,7 +39,8 @@
 //! per instant is an [`excitation_sample`]), [`amplitude`] (the
 //! adaptive sweep amplitude), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
-//! [`safety`] (abort checks), [`trim`] (trim capture), [`mixer`] (CCPM-120),
+//! [`safety`] (abort checks), [`trim`] (trim capture), [`slew`] (the commands' slew
+//! limit), [`mixer`] (CCPM-120),
 //! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); for the
 //! board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot calibration
 //! and, on the host, a register-level emulator of the chip), [`receiver`] (SBUS decoding,
@@ -83,6 +84,7 @@ pub mod pulse;
 pub mod receiver;
 pub mod safety;
 pub mod sink;
+pub mod slew;
 pub mod sweep;
 pub mod trim;
 pub mod turns;

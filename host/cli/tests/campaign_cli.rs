@@ -75,6 +75,12 @@ fn check_summary(dir: &Path) -> Value {
         for angle in ["phi", "theta"] {
             let deg = number(&m["max_abs_deg"][angle], angle);
             assert!(deg > 0.0 && deg < 90.0, "{mode} {angle}: {deg}");
+            // Every record captured a trim: the excursion from it is there too.
+            let from_trim = number(&m["max_from_trim_deg"][angle], angle);
+            assert!(
+                from_trim > 0.0 && from_trim < 90.0,
+                "{mode} {angle} from trim: {from_trim}"
+            );
         }
         assert!(m["aborts"].is_u64(), "{mode} aborts: {}", m["aborts"]);
     }

@@ -138,8 +138,11 @@ fn headline(summary: &CampaignSummary) -> String {
     ];
     for (name, mode) in modes {
         if let Some(mode) = mode {
+            let from_trim = mode.max_from_trim_deg.map_or(String::new(), |m| {
+                format!(" (from trim {:.1}°, {:.1}°)", m.phi, m.theta)
+            });
             text += &format!(
-                "{name:<9} lat–lon cross-coherence {}, max |phi| {:.1}°, |theta| {:.1}°, {} abort(s)\n",
+                "{name:<9} lat–lon cross-coherence {}, max |phi| {:.1}°, |theta| {:.1}°{from_trim}, {} abort(s)\n",
                 mode.cross_coherence_lat_lon
                     .map_or("-".to_string(), |c| format!("{c:.3}")),
                 mode.max_abs_deg.phi,
@@ -477,6 +480,57 @@ mod tests {
         assert!(
             error.to_string().starts_with("`frf` arguments: "),
             "{error}"
+        );
+    }
+
+    /// The headline gives each mode's largest excursion from its captured trim beside the
+    /// absolute attitude, and leaves it out for a mode that captured none.
+    #[test]
+    fn the_headline_shows_the_excursion_from_trim() {
+        use crate::artifacts::summary::{ModeSummary, PeakAttitudeDeg};
+        let mode = |from_trim: Option<PeakAttitudeDeg>| ModeSummary {
+            cross_coherence_lat_lon: Some(0.2),
+            max_abs_deg: PeakAttitudeDeg {
+                phi: 14.0,
+                theta: 9.5,
+            },
+            max_from_trim_deg: from_trim,
+            aborts: 0,
+            records: 6,
+            folder: "fly-cah".into(),
+        };
+        let summary = CampaignSummary {
+            vehicle: "trex700l".into(),
+            link: "in-process".into(),
+            seed: 1,
+            verification_seed: 2,
+            t_rec_s: 90.0,
+            quick: false,
+            modes: Modes {
+                cah: Some(mode(Some(PeakAttitudeDeg {
+                    phi: 9.24,
+                    theta: 9.76,
+                }))),
+                standard: Some(mode(None)),
+                noise: None,
+            },
+            fit: None,
+            verify: None,
+            timings_s: BTreeMap::new(),
+            error: None,
+        };
+        let text = headline(&summary);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 2, "{text}");
+        assert!(
+            lines[0].starts_with("cah ")
+                && lines[0]
+                    .contains("max |phi| 14.0°, |theta| 9.5° (from trim 9.2°, 9.8°), 0 abort(s)"),
+            "{text}"
+        );
+        assert!(
+            lines[1].contains("|theta| 9.5°, 0 abort(s)") && !lines[1].contains("from trim"),
+            "{text}"
         );
     }
 }
