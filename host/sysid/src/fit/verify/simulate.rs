@@ -94,11 +94,10 @@ impl DiscreteModel {
         generator *= step_s;
         let exponential = generator.exp();
         if exponential.iter().any(|v| !v.is_finite()) {
-            return Err(VerifyError::BadModel {
-                reason:
-                    "the matrix exponential is not finite (model far too fast for the sample rate)"
-                        .into(),
-            });
+            // e^{A·h} overflows: an unstable mode grows past f64 within one sample step,
+            // so the response runs away at once. A verification scores that like any other
+            // run-away (TIC 1) rather than refusing the model.
+            return Err(VerifyError::Diverged { sample: 0 });
         }
         let c = &model.h0 + &model.h1 * &a;
         let d = &model.h1 * &b;

@@ -243,6 +243,13 @@ fn mismatches_are_reported() {
     assert!(result.outputs.iter().all(|o| o.theil == 1.0));
     assert!(result.measured.is_empty());
 
+    // So is one so fast that e^{A·h} overflows in the first sample step.
+    let mut explosive = model.clone();
+    explosive.f[(2, 2)] = 1.0e6;
+    let result = verify_fitted(&explosive, &record_of(&model, 0.0)).unwrap();
+    assert_eq!(result.diverged_at_s, Some(0.0));
+    assert!(result.outputs.iter().all(|o| o.theil == 1.0));
+
     // An output missing from the record is listed, not an error.
     let mut partial = record_of(&model, 0.0);
     partial.outputs.retain(|c| c.name != "ay");
