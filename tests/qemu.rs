@@ -85,6 +85,23 @@ fn frames(bytes: &[u8]) -> Vec<Frame> {
 }
 
 /// The image, or `None` (after printing why) when the test cannot run here.
+/// `qemu-system-arm` on the netduinoplus2 machine (an STM32F405) booting `image`, no
+/// display or monitor; the caller adds the serial ports.
+fn netduinoplus2(image: &std::path::Path) -> std::process::Command {
+    let mut command = std::process::Command::new("qemu-system-arm");
+    command
+        .args([
+            "-M",
+            "netduinoplus2",
+            "-nographic",
+            "-monitor",
+            "none",
+            "-kernel",
+        ])
+        .arg(image);
+    command
+}
+
 fn image_or_skip(test: &str) -> Option<PathBuf> {
     match qemu_and_image() {
         Ok(image) => Some(image),
@@ -327,16 +344,7 @@ fn qemu_log_uart_carries_the_same_frames_as_the_link() {
     };
     let dir = Scratch::new("qemu-log-uart");
     let (link, log) = (dir.path().join("usart1.bin"), dir.path().join("usart3.bin"));
-    let mut qemu = std::process::Command::new("qemu-system-arm")
-        .args([
-            "-M",
-            "netduinoplus2",
-            "-nographic",
-            "-monitor",
-            "none",
-            "-kernel",
-        ])
-        .arg(&image)
+    let mut qemu = netduinoplus2(&image)
         .arg("-serial")
         .arg(format!("file:{}", link.display()))
         .args(["-serial", "null", "-serial"])
@@ -393,16 +401,7 @@ impl Board {
         let (sbus_listener, sbus_port) = listen();
         let chardev =
             |id: &str, port: u16| format!("socket,id={id},host=127.0.0.1,port={port},server=off");
-        let qemu = std::process::Command::new("qemu-system-arm")
-            .args([
-                "-M",
-                "netduinoplus2",
-                "-nographic",
-                "-monitor",
-                "none",
-                "-kernel",
-            ])
-            .arg(image)
+        let qemu = netduinoplus2(image)
             .args(["-chardev", &chardev("usart1", link_port)])
             .args(["-chardev", &chardev("usart2", sbus_port)])
             .args(["-serial", "chardev:usart1", "-serial", "chardev:usart2"])

@@ -95,3 +95,36 @@ pub fn synthetic_document(
     };
     exact_frf_document(truth, &bands, grid)
 }
+
+/// The pitch toy of the trim-point tests: q̇ = Mu·u + Mlon·lon, u̇ = Xu·u − g·θ, θ̇ = q
+/// (Mu 0.05, Mlon 6, Xu −0.02), one pair q/lon; `Mu` listed in `trim_derived` or not.
+pub fn pitch_toy(mu_trim_derived: bool) -> ModelStructure {
+    let trim_derived = if mu_trim_derived {
+        "trim_derived = [\"Mu\"]\n"
+    } else {
+        ""
+    };
+    let text = format!(
+        r#"
+name = "toy"
+states = ["u", "q", "theta"]
+controls = ["lat", "lon", "ped", "col"]
+outputs = ["q"]
+{trim_derived}pairs = [{{ output = "q", input = "lon", range = [1.0, 10.0] }}]
+[parameters]
+Mu = 0.05
+Mlon = 6.0
+Xu = -0.02
+[F.u]
+u = "Xu"
+theta = -9.81
+[F.q]
+u = "Mu"
+[F.theta]
+q = 1.0
+[G.q]
+lon = "Mlon"
+"#
+    );
+    ModelStructure::parse(&text, "toy.toml").unwrap()
+}

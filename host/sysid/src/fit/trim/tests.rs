@@ -2,7 +2,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::*;
 use crate::fit::structure::ModelStructure;
-use crate::fit::test_support::{hybrid_structure, hybrid_truth_values};
+use crate::fit::test_support::{hybrid_structure, hybrid_truth_values, pitch_toy};
 
 /// Trim points of the linear model `structure` at `values`: at each point the given
 /// u, v, w, r (columns of `set`), every other state and the four sticks solved from
@@ -122,27 +122,7 @@ fn derivation_is_exact_on_a_linear_model() {
 fn the_papers_formula_is_the_special_case_without_flapping_or_couplings() {
     // A 1-state-per-row toy: q̇ = Mu·u + Mlon·lon, u̇ = −g θ + Xu u, θ̇ = q. Forward trim
     // points with lon = −(Mu/Mlon)·u: the derivation returns M_u = −M_lon ∂lon/∂u.
-    let text = r#"
-name = "toy"
-states = ["u", "q", "theta"]
-controls = ["lat", "lon", "ped", "col"]
-outputs = ["q"]
-pairs = [{ output = "q", input = "lon", range = [1.0, 10.0] }]
-[parameters]
-Mu = 0.05
-Mlon = 6.0
-Xu = -0.02
-[F.u]
-u = "Xu"
-theta = -9.81
-[F.q]
-u = "Mu"
-[F.theta]
-q = 1.0
-[G.q]
-lon = "Mlon"
-"#;
-    let structure = ModelStructure::parse(text, "toy.toml").unwrap();
+    let structure = pitch_toy(false);
     let gradient = -0.011; // ∂lon/∂u [1/(m/s)]
     let points = TrimPoints {
         points: [-1.0, 0.0, 2.0]

@@ -1,5 +1,7 @@
 use super::*;
-use crate::fit::test_support::{hybrid_structure, hybrid_truth_values, synthetic_document};
+use crate::fit::test_support::{
+    hybrid_structure, hybrid_truth_values, pitch_toy, synthetic_document,
+};
 use crate::fit::trim::tests::{linear_trim_points, names, STEPS};
 use crate::fit::trim::{TrimBalance, TrimPoint};
 use crate::fit::{fit, FitOptions, ParameterStatus};
@@ -46,28 +48,7 @@ fn a_residual_is_the_stick_error_that_closes_the_balance() {
     // q̇ = Mu·u + Mlon·lon: forward points trimmed with lon = −(Mu/Mlon)·u. With M_u off
     // by δ the pitch balance misses by δ·Δu_i, which the stick closes with δ·Δu_i/M_lon:
     // e_i = δ·Δu_i/(M_lon·σ).
-    let text = r#"
-name = "toy"
-states = ["u", "q", "theta"]
-controls = ["lat", "lon", "ped", "col"]
-outputs = ["q"]
-trim_derived = ["Mu"]
-pairs = [{ output = "q", input = "lon", range = [1.0, 10.0] }]
-[parameters]
-Mu = 0.05
-Mlon = 6.0
-Xu = -0.02
-[F.u]
-u = "Xu"
-theta = -9.81
-[F.q]
-u = "Mu"
-[F.theta]
-q = 1.0
-[G.q]
-lon = "Mlon"
-"#;
-    let structure = ModelStructure::parse(text, "toy.toml").unwrap();
+    let structure = pitch_toy(true);
     let speeds = [-1.0, 0.0, 2.0];
     let points = TrimPoints {
         points: speeds
