@@ -57,7 +57,9 @@ pub struct FitArgs {
     /// structure file's own start values are tried too, and the lower J_ave is kept.
     #[arg(long, value_name = "model6.json")]
     pub start_from: Option<PathBuf>,
-    /// Most optimizer starts (stops earlier once a minimum is found twice), 1–64.
+    /// Most optimizer starts, 1–64: the structure's start values and two perturbations of
+    /// them (±30 %) explore, later starts perturb the best minimum so far (±10 %); stops
+    /// earlier once a minimum is found twice.
     #[arg(long, default_value_t = 8, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
     pub max_starts: usize,
     /// Fit frequencies per pair (n_ω; CIFER uses 20), 2–200: the fit's time grows with it.
