@@ -2,11 +2,12 @@
 """The identification bars of a vehicle's default campaign over a range of seeds.
 
     cargo build --release -p sweephold
-    python3 docs/bars.py [--vehicle bo105|trex700l] [--seeds 1-10] [--out DIR] [--reuse]
+    python3 docs/bars.py [--vehicle bo105|trex700l] [--seeds 1-10] [--out DIR] [--reuse] [-- CAMPAIGN ARGS]
 
 Flies `sweephold campaign --vehicle V --seed N --out DIR/V-N` for each seed (unless
 --reuse finds a completed campaign there) and prints one Markdown row per seed and a count
-row, read from each campaign's summary.json and model6.json:
+row, read from each campaign's summary.json and model6.json. Arguments after `--` are passed
+to every campaign (e.g. `-- --trim-balance joint`).
 
 - key: the nine key parameters (tau_f Lb1s Mb1c Zcol Nped Mf_lat Mf_lon Lf_lat Lf_lon)
   within 10 % of the truth;
@@ -36,10 +37,10 @@ def seeds(text):
     return range(int(lo), int(hi or lo) + 1)
 
 
-def campaign(vehicle, seed, folder, reuse):
+def campaign(vehicle, seed, folder, reuse, extra):
     if not (reuse and os.path.isfile(os.path.join(folder, "report.html"))):
         subprocess.run(
-            [BINARY, "campaign", "--vehicle", vehicle, "--seed", str(seed), "--out", folder, "--quiet"],
+            [BINARY, "campaign", "--vehicle", vehicle, "--seed", str(seed), "--out", folder, "--quiet", *extra],
             check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         )
     path = os.path.join(folder, "summary.json")
@@ -112,15 +113,17 @@ def main():
     parser.add_argument("--seeds", default="1-10", help="e.g. 1-10")
     parser.add_argument("--out", default="out/bars")
     parser.add_argument("--reuse", action="store_true", help="keep completed campaigns in OUT")
+    parser.add_argument("extra", nargs="*", help="after --: arguments for every campaign")
     args = parser.parse_args()
     if not os.path.isfile(BINARY):
         sys.exit(f"error: {BINARY} not found: run `cargo build --release -p sweephold` first")
-    print(f"{args.vehicle}, default campaign, seeds {args.seeds}\n")
+    setup = "default campaign" + (" " + " ".join(args.extra) if args.extra else "")
+    print(f"{args.vehicle}, {setup}, seeds {args.seeds}\n")
     print("| seed | key ≤10 % | hover ≤25 %, origin poles | speed derivatives vs truth | worst rate-pair J vs truth | truth J_ave | TIC p, q, r | 6-DOF confirmed | flagged free | s |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     counts, n = {}, 0
     for seed in seeds(args.seeds):
-        summary, six = campaign(args.vehicle, seed, os.path.join(args.out, f"{args.vehicle}-{seed}"), args.reuse)
+        summary, six = campaign(args.vehicle, seed, os.path.join(args.out, f"{args.vehicle}-{seed}"), args.reuse, args.extra)
         if summary is None:
             print(f"| {seed} | no summary.json |")
             continue

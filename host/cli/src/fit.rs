@@ -13,6 +13,7 @@ use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use anyhow::{bail, Context};
 use clap::Args;
 use sysid::document::FrfDocument;
+use sysid::fit::equation_error::equation_error_start;
 use sysid::fit::modes::{
     eigenvalue_text, hover_summary, mode_records, mode_table, origin_text, poles_at_origin,
     ModeComparison, ModeError, ModeRecord, HOVER_MODE_LIMIT_RAD_S,
@@ -21,7 +22,7 @@ use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
 };
-use sysid::fit::trim::TrimPoints;
+use sysid::fit::trim::{TrimBalance, TrimPoints};
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
 };
@@ -57,6 +58,12 @@ pub struct FitArgs {
     /// structure file's own start values are tried too, and the lower J_ave is kept.
     #[arg(long, value_name = "model6.json")]
     pub start_from: Option<PathBuf>,
+    /// Also start from a frequency-domain equation-error fit of the same responses: the
+    /// state equations solved by linear least squares with the measured state responses
+    /// (every state must be an output or follow from known rows, as in the 6-DOF); the
+    /// lower J_ave of the start sets is kept.
+    #[arg(long)]
+    pub equation_error_start: bool,
     /// Most optimizer starts, 1–64: the structure's start values and two perturbations of
     /// them (±30 %) explore, later starts perturb the best minimum so far (±10 %); stops
     /// earlier once a minimum is found twice.
@@ -78,9 +85,44 @@ pub struct FitArgs {
     /// `sweephold sim trim-points` writes the simulator's): the structure's `trim_derived`
     /// parameters (the shipped 6-DOF: Lv Mu Nv Zw Nr; the hybrid: Mfu Lfu Nv Zw Nr) are
     /// derived from the steady-state balance at the points and held (status `trim`) until
-    /// they settle, then released (status `free`) into one cost with the balances.
+    /// they settle; `--trim-balance` says what follows.
     #[arg(long, value_name = "FILE")]
     pub trim_points: Option<PathBuf>,
+    /// How the trim points enter the fit: `hold` keeps the derived parameters at the
+    /// balance's values (status `trim`); `joint` then releases them (status `free`) and
+    /// refits with the balances as weighted residuals of the cost (stick uncertainty
+    /// 3.5·10⁻⁴ of travel, an SBUS count).
+    #[arg(long, value_enum, default_value_t = TrimBalanceArg::Hold, value_name = "HOW")]
+    pub trim_balance: TrimBalanceArg,
+}
+
+/// `--trim-balance` of `fit` and `campaign`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TrimBalanceArg {
+    /// Derived from the balance and held (status `trim`).
+    Hold,
+    /// Held until they settle, then fitted with the others under the balances' cost.
+    Joint,
+}
+
+impl TrimBalanceArg {
+    /// The fit's setting.
+    pub fn balance(self) -> TrimBalance {
+        match self {
+            TrimBalanceArg::Hold => TrimBalance::Hold,
+            TrimBalanceArg::Joint => TrimBalance::Joint {
+                stick_sigma: sysid::fit::trim::joint::DEFAULT_STICK_SIGMA,
+            },
+        }
+    }
+
+    /// The value as written on the command line.
+    pub fn as_arg(self) -> &'static str {
+        match self {
+            TrimBalanceArg::Hold => "hold",
+            TrimBalanceArg::Joint => "joint",
+        }
+    }
 }
 
 impl FitArgs {
@@ -93,6 +135,7 @@ impl FitArgs {
             seed: self.seed,
             reduce: self.reduce,
             trim_points,
+            trim_balance: self.trim_balance.balance(),
             ..FitOptions::default()
         }
     }
@@ -202,6 +245,25 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             format!("{} ({})", path.display(), previous.structure),
             started,
         ));
+    }
+    if args.equation_error_start {
+        let solved = equation_error_start(&structure, &data)?;
+        let _ = writeln!(
+            report,
+            "start values from an equation-error fit: {} blocks (state/control), weighted \
+             equation error {:.4} -> {:.4} in {} iteration(s){}",
+            solved.blocks.len(),
+            solved.cost[0],
+            solved.cost[1],
+            solved.iterations,
+            if solved.uninformed.is_empty() {
+                String::new()
+            } else {
+                format!("; not informed, kept: {}", solved.uninformed.join(" "))
+            }
+        );
+        let _ = writeln!(report);
+        starts.push(("equation error".to_string(), solved.structure));
     }
     starts.push((
         format!("{} (the file's start values)", args.model.display()),
@@ -440,7 +502,7 @@ lat = "b"
         let frf_path = directory.join("frf.json");
         fs::write(&frf_path, serde_json::to_string(&frf).unwrap()).unwrap();
         let out = directory.join("model.json");
-        let args = FitArgs {
+        let mut args = FitArgs {
             frf: frf_path,
             model: structure_path.clone(),
             out: Some(out.clone()),
@@ -452,12 +514,23 @@ lat = "b"
             truth: None,
             constants: Vec::new(),
             trim_points: None,
+            trim_balance: TrimBalanceArg::Hold,
+            equation_error_start: false,
         };
         run(&args).unwrap();
         let document: ModelDocument =
             serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();
         assert!((document.parameter("a").unwrap() + 1.5).abs() < 1e-6);
         assert!((document.parameter("b").unwrap() - 2.0).abs() < 1e-6);
+
+        // From an equation-error start too (the state is measured: x is an output).
+        args.equation_error_start = true;
+        args.max_starts = 2;
+        run(&args).unwrap();
+        let document: ModelDocument =
+            serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();
+        assert!((document.parameter("a").unwrap() + 1.5).abs() < 1e-6);
+        args.equation_error_start = false;
 
         // A malformed structure file is reported with its line.
         fs::write(&structure_path, LAG.replace("lat = \"b\"", "lat = \"Zq\"")).unwrap();

@@ -8,11 +8,10 @@ use std::path::PathBuf;
 
 use anyhow::anyhow;
 use sysid::document::FrfDocument;
+use sysid::fit::equation_error::equation_error_start;
 use sysid::fit::modes::{mode_records, poles_at_origin};
 use sysid::fit::trim::TrimPoints;
-use sysid::fit::{
-    fit, fit_from_alternative_starts, start_from_quasi_steady, FitResult, ModelStructure,
-};
+use sysid::fit::{fit_from_alternative_starts, start_from_quasi_steady, FitResult, ModelStructure};
 use sysid::models;
 
 use super::{verb_args, Campaign, TrimPointsArg};
@@ -65,6 +64,8 @@ impl Campaign<'_> {
             argv.push("--max-starts".into());
             argv.push(max_starts.to_string().into());
         }
+        argv.push("--trim-balance".into());
+        argv.push(self.args.trim_balance.as_arg().into());
         verb_args("fit", argv)
     }
 
@@ -105,13 +106,25 @@ impl Campaign<'_> {
         // Nor does it take the trim points: its derivatives only start the hybrid, and on
         // most seeds it lands in a degenerate minimum (X_ped, Z_ped of 10⁶–10⁸ with long
         // delays) whose steady balance gives no usable Z_w.
-        let result = fit(&structure, frf, &args.options(None))?;
+        // Its starts: an equation-error fit of the same responses (when the structure
+        // allows one: with every state measured) and the file's own values.
+        let mut starts = Vec::with_capacity(2);
+        if let Ok(solved) = equation_error_start(&structure, frf) {
+            starts.push(("equation error".to_string(), solved.structure));
+        }
+        starts.push((format!("{}.toml", models::BO105_6DOF.name), structure));
+        let (result, _outcomes) = fit_from_alternative_starts(&starts, frf, &args.options(None))?;
         write_json(&out_path(&args)?, &result.to_document())?;
         let line = format!(
-            "{}: J_ave {:.1}, {} pairs",
+            "{}: J_ave {:.1}, {} pairs{}",
             result.structure.name,
             result.average_cost,
-            result.pairs.len()
+            result.pairs.len(),
+            if starts.len() > 1 {
+                ", equation-error start"
+            } else {
+                ""
+            }
         );
         Ok((result, line))
     }

@@ -301,6 +301,7 @@ mod tests {
             seed: 7,
             quick: true,
             trim_points: TrimPointsArg::Default,
+            trim_balance: crate::fit::TrimBalanceArg::Hold,
             amplitude: AmplitudeArg::Adaptive,
             fc: CampaignLink::InProcess,
             quiet: true,

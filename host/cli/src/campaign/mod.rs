@@ -33,6 +33,7 @@ use crate::artifacts::files;
 use crate::artifacts::flown::{lateral_coherence, FlownRecords, ModeCoherence};
 use crate::artifacts::stage::Stage;
 use crate::artifacts::summary::{CampaignSummary, Modes, StageFailure};
+use crate::fit::TrimBalanceArg;
 use crate::fly::plan::PAPER_T_REC_S;
 use crate::fly::{AmplitudeArg, ModeArg, VehicleArg};
 use crate::output::{write_json, StagedFolder};
@@ -75,6 +76,11 @@ pub struct CampaignArgs {
     /// worse today (docs/decisions/2026-11-24-trim-points.md).
     #[arg(long, value_enum, default_value_t = TrimPointsArg::Default, value_name = "WHEN")]
     pub trim_points: TrimPointsArg,
+    /// How the trim points enter the 9-DOF fit (as `fit --trim-balance`): `hold` keeps
+    /// the derived parameters at the balance's values (status `trim`), `joint` releases
+    /// them into one cost with the balances.
+    #[arg(long, value_enum, default_value_t = TrimBalanceArg::Hold, value_name = "HOW")]
+    pub trim_balance: TrimBalanceArg,
     /// Sweep amplitude of the fit records (cah, standard, noise): `fixed` (the paper's)
     /// or `adaptive` (see `fly --amplitude`); the held-out doublets are never shaped.
     #[arg(long, value_enum, default_value_t = AmplitudeArg::Fixed)]
@@ -412,6 +418,7 @@ mod tests {
             seed: 7,
             quick: true,
             trim_points: TrimPointsArg::Default,
+            trim_balance: TrimBalanceArg::Hold,
             amplitude: AmplitudeArg::Fixed,
             fc: CampaignLink::InProcess,
             quiet: true,

@@ -73,7 +73,7 @@ pub fn log_spaced(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 }
 
 /// Linear interpolation in ln ω; `omega` must lie in [data[0], data[last]].
-fn interpolate_log(data_omega: &[f64], values: &[f64], omega: f64) -> f64 {
+pub(crate) fn interpolate_log(data_omega: &[f64], values: &[f64], omega: f64) -> f64 {
     let upper = data_omega.partition_point(|&w| w < omega);
     if upper == 0 {
         return values[0];

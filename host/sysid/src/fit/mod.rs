@@ -15,6 +15,7 @@
 pub mod accuracy;
 pub mod cost;
 mod driver;
+pub mod equation_error;
 pub mod error;
 pub mod expression;
 pub mod model;
@@ -102,8 +103,8 @@ pub struct FitOptions {
     /// with the others under the balances ([`trim::joint`]). Without them those parameters
     /// are fitted like the rest.
     pub trim_points: Option<trim::TrimPoints>,
-    /// How the trim points enter the fit ([`trim::TrimBalance`]; default: held, then
-    /// the joint cost with the stick uncertainty [`trim::joint::DEFAULT_STICK_SIGMA`]).
+    /// How the trim points enter the fit ([`trim::TrimBalance`]; default: held, status
+    /// `trim`, as the paper fixes its speed derivatives).
     pub trim_balance: trim::TrimBalance,
 }
 
@@ -127,9 +128,7 @@ impl Default for FitOptions {
             correlation_limit: 0.9,
             min_auto_range_ratio: 3.0,
             trim_points: None,
-            trim_balance: trim::TrimBalance::Joint {
-                stick_sigma: trim::joint::DEFAULT_STICK_SIGMA,
-            },
+            trim_balance: trim::TrimBalance::Hold,
         }
     }
 }

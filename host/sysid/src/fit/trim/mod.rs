@@ -38,7 +38,7 @@
 //! Z_w): a column of c that is (numerically) zero is refused with the state named. The
 //! fit iterates: fit with θ_T free, derive θ_T, hold it (status `trim`) and refit from
 //! there, re-derive, until θ_T moves less than [`SETTLED_RELATIVE_CHANGE`]. With
-//! [`TrimBalance::Joint`] (the default) it then releases θ_T and refits with the balances
+//! [`TrimBalance::Joint`] (an option; the default is [`TrimBalance::Hold`]) it then releases θ_T and refits with the balances
 //! as residuals of the cost ([`joint`]).
 
 use nalgebra::{DMatrix, DVector};
