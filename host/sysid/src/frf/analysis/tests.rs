@@ -443,28 +443,29 @@ fn phase_branch_is_anchored_at_the_low_end_of_the_valid_range() {
     assert_eq!(pair.phase_deg, vec![-460.0, -180.0, 180.0, -360.0, -360.0]);
 }
 
-/// A first-order plant flown in a closed loop, u = r − K·y_measured, with a disturbance
-/// on the measured output: the controller feeds the disturbance into the control, so the
-/// cross-spectral estimate is pulled towards −1/K where the disturbance competes with
-/// the response; the reference estimate (r = the injected sweep) is not, at the price of
-/// more scatter.
-#[test]
-fn the_reference_estimator_removes_the_closed_loop_bias() {
-    let (gain, time_constant, feedback) = (2.0, 0.5, 1.5);
-    let truth = |w: f64| Complex64::new(gain, 0.0) / Complex64::new(1.0, w * time_constant);
+/// A 0.5–20 rad/s sweep (amplitude 0.2, `duration` s) into the first-order plant
+/// T·ẏ = −y + g·u, flown in a closed loop u = r − K·y_measured; the measured output carries
+/// white noise (seed `noise_seed`) through a first-order low-pass at 5 rad/s, so that it
+/// competes with the response inside the band (γ² 0.5–0.9). Returns (control u, measured
+/// output, excitation r).
+fn closed_loop_lag(
+    gain: f64,
+    time_constant: f64,
+    feedback: f64,
+    duration: f64,
+    noise_seed: u64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let sweep = Sweep {
         omega_min: 0.5,
         omega_max: 20.0,
-        duration: 240.0,
+        duration,
         amplitude: 0.2,
     };
     let len = (sweep.duration * RATE) as usize;
     let dt = 1.0 / RATE;
     let decay = (-dt / time_constant).exp();
-    // Disturbance: white noise through a first-order low-pass at 5 rad/s, so that it
-    // competes with the response inside the band (γ² 0.5–0.9).
     let filter = (-5.0 * dt).exp();
-    let mut noise = Noise::new(7);
+    let mut noise = Noise::new(noise_seed);
     let (mut state, mut measured, mut disturbance) = (0.0, 0.0, 0.0);
     let (mut control, mut output, mut excitation) = (Vec::new(), Vec::new(), Vec::new());
     for n in 0..len {
@@ -478,6 +479,19 @@ fn the_reference_estimator_removes_the_closed_loop_bias() {
         output.push(measured);
         excitation.push(r);
     }
+    (control, output, excitation)
+}
+
+/// A first-order plant flown in a closed loop, u = r − K·y_measured, with a disturbance
+/// on the measured output: the controller feeds the disturbance into the control, so the
+/// cross-spectral estimate is pulled towards −1/K where the disturbance competes with
+/// the response; the reference estimate (r = the injected sweep) is not, at the price of
+/// more scatter.
+#[test]
+fn the_reference_estimator_removes_the_closed_loop_bias() {
+    let (gain, time_constant, feedback) = (2.0, 0.5, 1.5);
+    let truth = |w: f64| Complex64::new(gain, 0.0) / Complex64::new(1.0, w * time_constant);
+    let (control, output, excitation) = closed_loop_lag(gain, time_constant, feedback, 240.0, 7);
     // Mean magnitude error [dB] over 1–10 rad/s (clear of the band edges).
     let mean_error = |estimator| {
         let mut rec = record(
@@ -797,29 +811,7 @@ fn a_sweep_whose_amplitude_changes_at_its_zero_crossings_is_estimated_as_well() 
 #[test]
 fn reference_ranges_keep_the_cross_spectral_responses() {
     let (gain, time_constant, feedback) = (2.0, 0.5, 1.5);
-    let sweep = Sweep {
-        omega_min: 0.5,
-        omega_max: 20.0,
-        duration: 120.0,
-        amplitude: 0.2,
-    };
-    let len = (sweep.duration * RATE) as usize;
-    let dt = 1.0 / RATE;
-    let decay = (-dt / time_constant).exp();
-    let filter = (-5.0 * dt).exp();
-    let mut noise = Noise::new(11);
-    let (mut state, mut measured, mut disturbance) = (0.0, 0.0, 0.0);
-    let (mut control, mut output, mut excitation) = (Vec::new(), Vec::new(), Vec::new());
-    for n in 0..len {
-        let r = sweep.value(n as f64 * dt);
-        let u = r - feedback * measured;
-        state = decay * state + (1.0 - decay) * gain * u;
-        disturbance = filter * disturbance + (1.0 - filter) * 0.5 * noise.gaussian();
-        measured = state + disturbance;
-        control.push(u);
-        output.push(measured);
-        excitation.push(r);
-    }
+    let (control, output, excitation) = closed_loop_lag(gain, time_constant, feedback, 120.0, 11);
     let mut rec = record(
         RATE,
         [0.5, 20.0],
