@@ -378,14 +378,16 @@ fn fit_model_takes_a_shipped_name_a_file_wins_and_an_unknown_name_lists_them() {
     assert!(out.status.success(), "{}", stderr(&out));
     let document: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.0.join("model.json")).unwrap()).unwrap();
-    assert_eq!(document["structure"], "bo105-9dof-hybrid");
+    assert_eq!(document["structure"], "trex700l-9dof-hybrid");
+    // Its servos are known actuators, written into model.json.
+    assert_eq!(document["actuators"][0]["natural_frequency_rad_s"], 60.0);
     assert!(
         document["average_cost"].as_f64().unwrap() < 1e-6,
         "{}",
         document["average_cost"]
     );
     // F[b1c, p] = Kpq = hub_height·Lfu and F[b1c, v] = Mfv = Lfu: their ratio is the
-    // hub height the name put in, the TREX's (the file has the Bo-105's 1.48 m).
+    // hub height the name put in, the TREX's.
     let states: Vec<&str> = document["states"]
         .as_array()
         .unwrap()

@@ -1,11 +1,14 @@
 //! The model structures shipped with sysid (`host/sysid/models/*.toml`), compiled in so that
 //! a program can fit them by name from any directory.
 //!
-//! The two files are written for the Bo-105: their `[constants]` (hub position, shaft tilt,
-//! gravity, hover trim attitude) and the rotor-data parameter they fix (`Kcs`) are its
-//! numbers. The `trex700l-*` entries are the same files for the TREX 700L: the caller puts
-//! in that vehicle's numbers ([`VehicleData::FromCaller`]; `sweephold` does so from its
-//! simulator's data), since this crate knows no vehicle data.
+//! The `bo105-*` files are written for the Bo-105: their `[constants]` (hub position, shaft
+//! tilt, gravity, hover trim attitude) and the rotor-data parameter they fix (`Kcs`) are
+//! its numbers. `trex700l-9dof-hybrid` is the TREX 700L's own file (its numbers, start
+//! values of its size, its servos as known actuators); `trex700l-6dof` is the 6-DOF file,
+//! which has no vehicle numbers. For both TREX entries the caller puts in the flown
+//! vehicle's numbers over the file's ([`VehicleData::FromCaller`]; `sweephold` does so
+//! from its simulator's data and the captured trim), since this crate knows no vehicle
+//! data.
 //!
 //! ```
 //! let hybrid = sysid::models::shipped("bo105-9dof-hybrid").unwrap();
@@ -25,14 +28,19 @@ pub const BO105_6DOF_TOML: &str = include_str!("../models/bo105-6dof.toml");
 /// the hingeless rotor's flap couplings.
 pub const BO105_9DOF_HYBRID_TOML: &str = include_str!("../models/bo105-9dof-hybrid.toml");
 
+/// `host/sysid/models/trex700l-9dof-hybrid.toml`: the hybrid for the TREX 700L, with its
+/// servos as known actuators.
+pub const TREX700L_9DOF_HYBRID_TOML: &str = include_str!("../models/trex700l-9dof-hybrid.toml");
+
 /// Where a shipped structure's vehicle numbers come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VehicleData {
     /// The file's own numbers are this vehicle's: parse it as it is.
     InFile,
-    /// The file carries the Bo-105's numbers: the caller replaces the constants the file
-    /// declares (geometry, gravity, trim attitude) and its fixed rotor-data parameters
-    /// (`Kcs`) with the vehicle's, e.g. through [`ShippedStructure::parse_with_constants`].
+    /// The caller replaces the constants the file declares (geometry, gravity, trim
+    /// attitude, servos) and its fixed rotor-data parameters (`Kcs`) with the flown
+    /// vehicle's, e.g. through [`ShippedStructure::parse_with_constants`]; the file's own
+    /// numbers are defaults (the Bo-105's in a `bo105-*` file).
     FromCaller,
 }
 
@@ -83,14 +91,14 @@ pub const TREX700L_6DOF: ShippedStructure = ShippedStructure {
     vehicle_data: VehicleData::FromCaller,
 };
 
-/// `trex700l-9dof-hybrid`: the 9-DOF hybrid file with the TREX 700L's numbers put in by
-/// the caller.
+/// `trex700l-9dof-hybrid`: the TREX 700L's hybrid (its numbers, its servos), the flown
+/// vehicle's numbers put in by the caller.
 pub const TREX700L_9DOF_HYBRID: ShippedStructure = ShippedStructure {
     name: "trex700l-9dof-hybrid",
-    description: "the 9-DOF hybrid file with the TREX 700L's geometry, flap cross-coupling \
-                  and hover trim",
-    file: "bo105-9dof-hybrid.toml",
-    toml: BO105_9DOF_HYBRID_TOML,
+    description: "9-DOF hybrid for the TREX 700L: its geometry, flap cross-coupling, hover \
+                  trim and servos (known second-order actuators)",
+    file: "trex700l-9dof-hybrid.toml",
+    toml: TREX700L_9DOF_HYBRID_TOML,
     vehicle: "trex700l",
     vehicle_data: VehicleData::FromCaller,
 };

@@ -28,6 +28,8 @@
 //!   transport delay; `tau_lat … tau_col` take that. The 6-DOF equivalent delays
 //!   `teq_lat`, `teq_lon` add the rotor lag τ_f (the flapping folded in), `teq_ped`,
 //!   `teq_col` do not. These delays are approximations of the truth, not exact entries.
+//!   A structure that models the servos (`[actuators]`, their ω_n and ζ put in by
+//!   [`crate::with_vehicle_data`]) has them exactly; its `tau_*` are the transport delay.
 //!
 //! A structure parameter the mapping does not know is left out of the truth values; the
 //! truth model then holds it at 0 (listed in [`StructureTruth::unmapped`]). Truth values
@@ -146,7 +148,15 @@ pub fn structure_truth(
     let value_of = |name: &str| -> Option<f64> {
         match name {
             "tau_f" => return Some(tau_f),
-            "tau_lat" | "tau_lon" | "tau_ped" | "tau_col" => return Some(delay),
+            "tau_lat" | "tau_lon" | "tau_ped" | "tau_col" => {
+                // A structure that models the servo (`[actuators]`) leaves the delay
+                // only the transport delay.
+                let control = structure.controls.iter().position(|c| *c == name[4..])?;
+                return Some(match structure.actuators.get(control).copied().flatten() {
+                    Some(_) => truth.actuator.transport_delay_s,
+                    None => delay,
+                });
+            }
             "teq_lat" | "teq_lon" => return Some(delay + tau_f),
             "teq_ped" | "teq_col" => return Some(delay),
             _ => {}

@@ -34,21 +34,26 @@ impl TrimAttitude {
     }
 }
 
-/// The 9-DOF hybrid structure (both vehicles), with the data of `vehicle` in it: the file
-/// is written for the Bo-105 — its geometry constants (`hub_height`, `hub_forward`,
-/// `shaft_tilt_sine`), gravity, its hover trim attitude, and the flap cross-coupling
-/// `Kcs` it fixes from rotor theory — and another vehicle gets its own
-/// ([`bo105::Rotor::flap_cross_coupling`], the hub position and shaft tilt of its main
-/// rotor). `trim`: the captured trim attitude, when known (else the file's).
+/// The vehicle's 9-DOF hybrid structure (`bo105-9dof-hybrid`, `trex700l-9dof-hybrid`: the
+/// TREX's own file, with its servos), with the data of `vehicle` in it — its geometry
+/// constants (`hub_height`, `hub_forward`, `shaft_tilt_sine`), gravity, the servos' ω_n
+/// and ζ where the file models them, the flap cross-coupling `Kcs` the file fixes from
+/// rotor theory ([`bo105::Rotor::flap_cross_coupling`]) — and `trim`: the captured trim
+/// attitude, when known (else the file's).
 pub fn nine_dof_hybrid(
     vehicle: bo105::Vehicle,
     trim: Option<TrimAttitude>,
 ) -> Result<ModelStructure, StructureError> {
-    with_vehicle_data(&models::BO105_9DOF_HYBRID, vehicle, trim, &BTreeMap::new())
+    let file = match vehicle {
+        bo105::Vehicle::Bo105 => &models::BO105_9DOF_HYBRID,
+        bo105::Vehicle::Trex700l => &models::TREX700L_9DOF_HYBRID,
+    };
+    with_vehicle_data(file, vehicle, trim, &BTreeMap::new())
 }
 
 /// A shipped structure with the data of `vehicle` in it: of the constants `hub_height`,
-/// `hub_forward`, `shaft_tilt_sine`, `gravity` and (with `trim`) the trim attitude's, those
+/// `hub_forward`, `shaft_tilt_sine`, `gravity`, `servo_natural_frequency`,
+/// `servo_damping` and (with `trim`) the trim attitude's, those
 /// the file declares; a fixed `Kcs` (the flap cross-coupling, rotor data) if it has one;
 /// then `overrides` of its constants. A file without any of them (the 6-DOF) is unchanged.
 pub fn with_vehicle_data(
@@ -62,11 +67,18 @@ pub fn with_vehicle_data(
     // The hub is at body (x, z) = (hub[0], hub[2]) from the CG, z down: its height above
     // the CG is −hub[2].
     let hub = helicopter.main_rotor.hub;
+    let servo = bo105::SimOptions::default().actuator;
     let mut constants = BTreeMap::from([
         ("hub_height".to_string(), -hub[2]),
         ("hub_forward".to_string(), hub[0]),
         ("shaft_tilt_sine".to_string(), helicopter.shaft_tilt.sin()),
         ("gravity".to_string(), helicopter.gravity),
+        // The servos `sweephold fly` flies with (a file with `[actuators]` declares these).
+        (
+            "servo_natural_frequency".to_string(),
+            servo.natural_frequency_rad_s,
+        ),
+        ("servo_damping".to_string(), servo.damping),
     ]);
     if let Some(trim) = trim {
         for (name, value) in trim.constants() {

@@ -1,7 +1,7 @@
 //! The simulator's linear truth: a vehicle trimmed in hover and linearized, its servos'
 //! equivalent delay, and the simulator's names for the body states and controls.
 
-use bo105::{linearize, trim, Linearization, SimOptions, Vehicle};
+use bo105::{linearize, trim, ActuatorModel, Linearization, SimOptions, Vehicle};
 use sysid::fit::Model;
 
 use crate::Error;
@@ -20,6 +20,9 @@ pub struct VehicleTruth {
     pub linearization: Linearization,
     /// Equivalent delay of the default servos: 2ζ/ω_n + transport delay \[s\].
     pub actuator_delay_s: f64,
+    /// The default servos themselves (a structure with `[actuators]` models their lag,
+    /// and its delays are the transport delay alone).
+    pub actuator: ActuatorModel,
 }
 
 impl VehicleTruth {
@@ -41,6 +44,7 @@ impl VehicleTruth {
             vehicle,
             linearization,
             actuator_delay_s: servo_lag + actuator.transport_delay_s,
+            actuator,
         })
     }
 

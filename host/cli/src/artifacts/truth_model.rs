@@ -3,7 +3,8 @@
 //! curves from the campaign folder alone.
 
 use serde::{Deserialize, Serialize};
-use sysid::fit::report::ModelMatrices;
+use sysid::fit::model::Actuator;
+use sysid::fit::report::{no_actuators, ModelMatrices};
 use sysid::fit::Model;
 
 /// A truth model on file.
@@ -23,6 +24,9 @@ pub struct TruthModelDocument {
     pub matrices: ModelMatrices,
     /// Delay per control \[s\].
     pub delays: Vec<f64>,
+    /// Known actuator per control (as `model.json`'s; left out when none has one).
+    #[serde(default, skip_serializing_if = "no_actuators")]
+    pub actuators: Vec<Option<Actuator>>,
 }
 
 impl TruthModelDocument {
@@ -36,13 +40,19 @@ impl TruthModelDocument {
             outputs: model.outputs.clone(),
             matrices: ModelMatrices::from_model(model),
             delays: model.delays.clone(),
+            actuators: model.actuators.clone(),
         }
     }
 
     /// The numeric model; `None` when a matrix does not fit the names.
     pub fn model(&self) -> Option<Model> {
-        self.matrices
-            .to_model(&self.states, &self.controls, &self.outputs, &self.delays)
+        self.matrices.to_model(
+            &self.states,
+            &self.controls,
+            &self.outputs,
+            &self.delays,
+            &self.actuators,
+        )
     }
 }
 

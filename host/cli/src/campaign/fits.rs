@@ -141,12 +141,11 @@ impl Campaign<'_> {
         trim_points: &Option<TrimPoints>,
     ) -> anyhow::Result<(FitResult, String)> {
         // As `sweephold fit --start-from model6.json --reduce`.
-        let args = self.fit_args(
-            models::BO105_9DOF_HYBRID.name,
-            files::MODEL_9DOF,
-            true,
-            None,
-        )?;
+        let structure = match self.args.vehicle {
+            VehicleArg::Bo105 => models::BO105_9DOF_HYBRID.name,
+            VehicleArg::Trex700l => models::TREX700L_9DOF_HYBRID.name,
+        };
+        let args = self.fit_args(structure, files::MODEL_9DOF, true, None)?;
         // Kinematics and gravity about the trim the flight controller captured.
         let hybrid = self.measured(structures::nine_dof_hybrid(self.args.vehicle.sim(), trim)?);
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;

@@ -72,8 +72,9 @@ pub struct CampaignArgs {
     pub quick: bool,
     /// Derive the hybrid's hover derivatives (M_fu, L_fu, N_v, Z_w, N_r) from trim points,
     /// the simulator's steady flights (`trim-points.csv`): `on`, `off` (fitted like the
-    /// others), or `default`: on for the Bo-105, off for the TREX 700L, whose fit they make
-    /// worse today (docs/decisions/2026-11-24-trim-points.md).
+    /// others), or `default`: on for the Bo-105, off for the TREX 700L, where they bring its
+    /// hover modes and speed derivatives right but cost key parameters today
+    /// (docs/decisions/2026-11-24-trex700l-servo-band.md).
     #[arg(long, value_enum, default_value_t = TrimPointsArg::Default, value_name = "WHEN")]
     pub trim_points: TrimPointsArg,
     /// How the trim points enter the 9-DOF fit (as `fit --trim-balance`): `hold` keeps

@@ -137,6 +137,14 @@ impl VehicleArg {
         }
     }
 
+    /// The two sweep bands flown per axis [rad/s].
+    pub fn sweep_bands(self) -> [(f64, f64); 2] {
+        match self {
+            VehicleArg::Bo105 => plan::PAPER_BANDS,
+            VehicleArg::Trex700l => plan::TREX700L_BANDS,
+        }
+    }
+
     /// The firmware's preset for this vehicle, exciting `axis`.
     pub fn firmware_config(self, axis: Axis) -> Config {
         match self {
@@ -351,7 +359,14 @@ impl FlyArgs {
             InputArg::Sweep => self.amplitude.sweep_kind(),
             other => other.kind(),
         };
-        plan_records(&self.axes, self.mode.mode(), input, self.t_rec_s, self.seed)
+        plan_records(
+            &self.vehicle.sweep_bands(),
+            &self.axes,
+            self.mode.mode(),
+            input,
+            self.t_rec_s,
+            self.seed,
+        )
     }
 
     fn check(&self) -> anyhow::Result<()> {

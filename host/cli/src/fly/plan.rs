@@ -37,16 +37,27 @@ impl RecordPlan {
 /// (Fig. 9), 90 s each, concatenated in identification.
 pub const PAPER_BANDS: [(f64, f64); 2] = [(0.2, 31.4), (0.01, 18.85)];
 
+/// The TREX 700L's two sweep bands [rad/s]: the first reaches 62.8 rad/s (10 Hz), past
+/// its coupled rotor–body modes (about 30 rad/s in pitch, 57 rad/s in roll), which the
+/// paper's 31.4 rad/s top leaves out: below them the roll response is a first-order lag
+/// whose pole the fit trades against the delay (docs/decisions/2026-11-24-trex700l-servo-band.md).
+/// At the 200 Hz loop 62.8 rad/s has 20 samples per period (the firmware accepts up to
+/// 0.4 of Nyquist, 251 rad/s); the 5 % sweep asks the servos for 3.1 /s at the top,
+/// inside their 4 /s rate. The second band is the paper's.
+pub const TREX700L_BANDS: [(f64, f64); 2] = [(0.2, 62.8), (0.01, 18.85)];
+
 /// The paper's sweep amplitude: 5 % of stick travel.
 pub const PAPER_AMPLITUDE: f64 = 0.05;
 
 /// The paper's record length \[s\].
 pub const PAPER_T_REC_S: f64 = 90.0;
 
-/// Records for `axes`: two sweeps per axis (the paper's bands), or one pulse input per
-/// axis for doublet/3-2-1-1 (verification records). Each record gets its own noise seed,
-/// derived from `seed` so that the same seed gives the same campaign.
+/// Records for `axes`: two sweeps per axis (the vehicle's `bands`, [`PAPER_BANDS`] for the
+/// Bo-105), or one pulse input per axis for doublet/3-2-1-1 (verification records, on
+/// the first band). Each record gets its own noise seed, derived from `seed` so that the
+/// same seed gives the same campaign.
 pub fn plan_records(
+    bands: &[(f64, f64); 2],
     axes: &[Axis],
     mode: ExcitationMode,
     input: InputKind,
@@ -56,8 +67,8 @@ pub fn plan_records(
     let mut plans = Vec::new();
     for &axis in axes {
         let bands: &[(f64, f64)] = match input {
-            InputKind::Sweep | InputKind::AdaptiveSweep => &PAPER_BANDS,
-            InputKind::Doublet | InputKind::ThreeTwoOneOne => &PAPER_BANDS[..1],
+            InputKind::Sweep | InputKind::AdaptiveSweep => bands,
+            InputKind::Doublet | InputKind::ThreeTwoOneOne => &bands[..1],
         };
         for (n, &(omega_min, omega_max)) in bands.iter().enumerate() {
             let index = n as u32 + 1;
@@ -91,6 +102,7 @@ mod tests {
     #[test]
     fn two_sweeps_per_axis_with_distinct_seeds() {
         let plans = plan_records(
+            &PAPER_BANDS,
             &Axis::ALL,
             ExcitationMode::ConditionalAttitudeHold,
             InputKind::Sweep,
@@ -106,6 +118,7 @@ mod tests {
         seeds.dedup();
         assert_eq!(seeds.len(), 8);
         let again = plan_records(
+            &PAPER_BANDS,
             &Axis::ALL,
             ExcitationMode::ConditionalAttitudeHold,
             InputKind::Sweep,
@@ -127,6 +140,7 @@ mod tests {
     #[test]
     fn one_pulse_record_per_axis() {
         let plans = plan_records(
+            &PAPER_BANDS,
             &[Axis::Lon],
             ExcitationMode::ConditionalAttitudeHold,
             InputKind::Doublet,

@@ -81,6 +81,9 @@ pub struct FittedModel {
     pub matrices: ModelMatrices,
     /// Delay per control \[s\].
     pub delays: Vec<f64>,
+    /// Known actuator per control (absent: none).
+    #[serde(default)]
+    pub actuators: Vec<Option<sysid::fit::model::Actuator>>,
     /// J per fitted pair, with its range.
     pub pairs: Vec<PairFit>,
 }
@@ -88,8 +91,13 @@ pub struct FittedModel {
 impl FittedModel {
     /// The numeric model; `None` when a matrix does not fit the names.
     pub fn model(&self) -> Option<Model> {
-        self.matrices
-            .to_model(&self.states, &self.controls, &self.outputs, &self.delays)
+        self.matrices.to_model(
+            &self.states,
+            &self.controls,
+            &self.outputs,
+            &self.delays,
+            &self.actuators,
+        )
     }
 }
 

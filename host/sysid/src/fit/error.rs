@@ -59,6 +59,15 @@ pub enum StructureProblem {
     /// A pair range that is neither `"auto"` nor `[lo, hi]` with 0 < lo < hi.
     #[error("bad range: {0}")]
     BadRange(String),
+    /// An `[actuators]` entry whose natural frequency or damping is not a positive
+    /// number (or the name of a `[constants]` entry holding one).
+    #[error("actuator of `{control}`: {reason}")]
+    BadActuator {
+        /// The control.
+        control: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// The file could not be read.
     #[error("cannot read: {0}")]
     Io(String),

@@ -1,12 +1,16 @@
-//! The numeric state-space model `M ẋ = F x + G u(t − τ)`, `y = H0 x + H1 ẋ`, and its
-//! transfer function
+//! The numeric state-space model `M ẋ = F x + G u_a(t − τ)`, `y = H0 x + H1 ẋ`, where
+//! `u_a` is each control after its known actuator `A_j(s)` (identity when it has none),
+//! and its transfer function
 //!
 //! ```text
-//! T(s) = (H0 + s·H1) (s·M − F)⁻¹ G · diag(e^{−τ_j s}),   s = jω
+//! T(s) = (H0 + s·H1) (s·M − F)⁻¹ G · diag(A_j(s) e^{−τ_j s}),   s = jω
+//! A_j(s) = ω_j² / (s² + 2 ζ_j ω_j s + ω_j²)      (a second-order servo, ω_j ζ_j known)
 //! ```
 //!
 //! evaluated by an LU solve of the small complex matrix `sM − F` per frequency (never an
-//! explicit inverse).
+//! explicit inverse). The actuator is a factor per control, not extra states, so that it
+//! costs the fit nothing; [`Model::with_actuator_states`] writes it as states for the
+//! time-domain simulation.
 
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -33,6 +37,36 @@ pub struct Model {
     pub h1: DMatrix<f64>,
     /// Delay per control \[s\].
     pub delays: Vec<f64>,
+    /// Known actuator per control (`None`: the control acts directly).
+    pub actuators: Vec<Option<Actuator>>,
+}
+
+/// A known second-order actuator (a servo): `A(s) = ω² / (s² + 2ζω s + ω²)`, unit gain at
+/// steady state. Known from the servo's data, not identified: written into the structure
+/// file (`[actuators]`) so that the fitted delays and rotor terms need not absorb it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Actuator {
+    /// Natural frequency ω \[rad/s\], > 0.
+    pub natural_frequency_rad_s: f64,
+    /// Damping ratio ζ, > 0.
+    pub damping: f64,
+}
+
+impl Actuator {
+    /// Whether ω and ζ are finite and positive.
+    pub fn is_valid(&self) -> bool {
+        self.natural_frequency_rad_s.is_finite()
+            && self.natural_frequency_rad_s > 0.0
+            && self.damping.is_finite()
+            && self.damping > 0.0
+    }
+
+    /// A(s).
+    pub fn response(&self, s: Complex64) -> Complex64 {
+        let w = self.natural_frequency_rad_s;
+        let w2 = Complex64::new(w * w, 0.0);
+        w2 / (s * s + s * (2.0 * self.damping * w) + w2)
+    }
 }
 
 /// What one LU solve at one frequency gives for one input/output pair: enough for the
@@ -45,9 +79,10 @@ pub(crate) struct PairSolution {
     pub x: DVector<Complex64>,
     /// w = (sM − F)⁻ᵀ c_i with c_i = row i of (H0 + sH1): T = wᵀ g_j = c_iᵀ x.
     pub w: DVector<Complex64>,
-    /// T including the delay factor e^{−τ_j s}.
+    /// T including the input factor A_j(s)·e^{−τ_j s}.
     pub response: Complex64,
-    /// e^{−τ_j s}.
+    /// A_j(s)·e^{−τ_j s}: the actuator and the delay of input j (fixed in the fit, so
+    /// every matrix entry's derivative carries it as a factor).
     pub delay_factor: Complex64,
 }
 
@@ -96,6 +131,7 @@ impl Model {
             h0: DMatrix::zeros(p, n),
             h1: DMatrix::zeros(p, n),
             delays: vec![0.0; m],
+            actuators: vec![None; m],
             states,
             controls,
             outputs,
@@ -110,6 +146,72 @@ impl Model {
     /// Index of an output by name.
     pub fn output_index(&self, name: &str) -> Option<usize> {
         self.outputs.iter().position(|o| o == name)
+    }
+
+    /// The factor of control `input` at s: its actuator's response times its delay
+    /// `A_j(s)·e^{−τ_j s}`.
+    pub(crate) fn input_factor(&self, input: usize, s: Complex64) -> Complex64 {
+        let delay = (-s * self.delays[input]).exp();
+        match self.actuators.get(input).copied().flatten() {
+            Some(actuator) => actuator.response(s) * delay,
+            None => delay,
+        }
+    }
+
+    /// The same model with every actuator written as two states (`<control>_actuator`
+    /// and `<control>_actuator_rate`: `ẍ_a = ω²(u − x_a) − 2ζω ẋ_a`), the control's G
+    /// column moved to the actuator position's F column, and no actuator left: the same
+    /// transfer function, in the form a time-domain simulation steps. A model without
+    /// actuators is returned as it is.
+    pub fn with_actuator_states(&self) -> Model {
+        let actuated: Vec<(usize, Actuator)> = self
+            .actuators
+            .iter()
+            .enumerate()
+            .filter_map(|(j, a)| a.map(|a| (j, a)))
+            .collect();
+        if actuated.is_empty() {
+            return self.clone();
+        }
+        let n = self.states.len();
+        let mut states = self.states.clone();
+        for &(j, _) in &actuated {
+            states.push(format!("{}_actuator", self.controls[j]));
+            states.push(format!("{}_actuator_rate", self.controls[j]));
+        }
+        let mut model = Model::zeros(states, self.controls.clone(), self.outputs.clone());
+        let size = model.states.len();
+        for i in 0..size {
+            model.m[(i, i)] = 1.0;
+        }
+        model.m.view_mut((0, 0), (n, n)).copy_from(&self.m);
+        model.f.view_mut((0, 0), (n, n)).copy_from(&self.f);
+        model
+            .g
+            .view_mut((0, 0), (n, self.controls.len()))
+            .copy_from(&self.g);
+        model
+            .h0
+            .view_mut((0, 0), (self.outputs.len(), n))
+            .copy_from(&self.h0);
+        model
+            .h1
+            .view_mut((0, 0), (self.outputs.len(), n))
+            .copy_from(&self.h1);
+        model.delays = self.delays.clone();
+        for (k, &(j, actuator)) in actuated.iter().enumerate() {
+            let (position, rate) = (n + 2 * k, n + 2 * k + 1);
+            let w = actuator.natural_frequency_rad_s;
+            for i in 0..n {
+                model.f[(i, position)] = self.g[(i, j)];
+                model.g[(i, j)] = 0.0;
+            }
+            model.f[(position, rate)] = 1.0;
+            model.f[(rate, position)] = -w * w;
+            model.f[(rate, rate)] = -2.0 * actuator.damping * w;
+            model.g[(rate, j)] = w * w;
+        }
+        model
     }
 
     /// `sM − F` at s = jω.
@@ -146,8 +248,7 @@ impl Model {
         match lu.solve(&column) {
             Some(x) => {
                 let row = self.output_row(output_index, s);
-                let undelayed = row.dot(&x);
-                undelayed * (-s * self.delays[input_index]).exp()
+                row.dot(&x) * self.input_factor(input_index, s)
             }
             None => Complex64::new(f64::NAN, f64::NAN),
         }
@@ -170,7 +271,7 @@ impl Model {
         let x = system.clone().lu().solve(&column)?;
         // Aᵀ w = c: the transposed (not conjugated) system, since T = cᵀ A⁻¹ g.
         let w = system.transpose().lu().solve(&row)?;
-        let delay_factor = (-s * self.delays[input_index]).exp();
+        let delay_factor = self.input_factor(input_index, s);
         let response = row.dot(&x) * delay_factor;
         Some(PairSolution {
             s,
@@ -185,6 +286,7 @@ impl Model {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     fn names(list: &[&str]) -> Vec<String> {
         list.iter().map(|s| s.to_string()).collect()
@@ -205,6 +307,59 @@ mod tests {
             let got = model.frequency_response(0, 0, omega);
             assert!((got - expected).norm() < 1e-12 * expected.norm());
         }
+    }
+
+    #[test]
+    fn a_known_actuator_multiplies_the_response_and_its_state_form_agrees() {
+        // ẋ = a x + b u_a(t − τ), u_a = ω²/(s² + 2ζωs + ω²) u, y = [x, ẋ]:
+        // T = b A(s) e^{−τs} / (s − a), and s times that for ẋ.
+        let mut model = Model::zeros(names(&["x"]), names(&["u"]), names(&["x", "xdot"]));
+        model.m[(0, 0)] = 1.0;
+        model.f[(0, 0)] = -2.0;
+        model.g[(0, 0)] = 3.0;
+        model.h0[(0, 0)] = 1.0;
+        model.h1[(1, 0)] = 1.0;
+        model.delays[0] = 0.01;
+        let servo = Actuator {
+            natural_frequency_rad_s: 60.0,
+            damping: 0.7,
+        };
+        model.actuators[0] = Some(servo);
+        let states = model.with_actuator_states();
+        assert_eq!(
+            states.states,
+            names(&["x", "u_actuator", "u_actuator_rate"])
+        );
+        assert!(states.actuators.iter().all(Option::is_none));
+        for omega in [0.1, 1.0, 7.0, 30.0, 60.0, 200.0] {
+            let s = Complex64::new(0.0, omega);
+            let actuator = 3600.0 / (s * s + s * 84.0 + 3600.0);
+            let expected = 3.0 * actuator * (-s * 0.01).exp() / (s + 2.0);
+            for (output, scale) in [(0, Complex64::new(1.0, 0.0)), (1, s)] {
+                let expected = expected * scale;
+                for got in [
+                    model.frequency_response(0, output, omega),
+                    states.frequency_response(0, output, omega),
+                    model.pair_solution(0, output, omega).unwrap().response,
+                ] {
+                    assert!((got - expected).norm() < 1e-12 * expected.norm(), "{omega}");
+                }
+            }
+        }
+        // At ω_n the servo is −90° and 1/(2ζ) in gain.
+        let at = servo.response(Complex64::new(0.0, 60.0));
+        assert!((at.norm() - 1.0 / 1.4).abs() < 1e-12 && (at.arg() + PI / 2.0).abs() < 1e-12);
+        assert!(servo.is_valid());
+        assert!(!Actuator {
+            damping: 0.0,
+            ..servo
+        }
+        .is_valid());
+        assert!(!Actuator {
+            natural_frequency_rad_s: f64::NAN,
+            ..servo
+        }
+        .is_valid());
     }
 
     #[test]

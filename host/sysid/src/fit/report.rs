@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use super::model::{Model, RowMajor};
+use super::model::{Actuator, Model, RowMajor};
 use super::modes::{ModeRecord, TruthModeRecord};
 use super::reduce::ReductionStep;
 use super::{AccuracyFlag, FitResult, PairFit, ParameterReport, ParameterStatus, StartOutcome};
@@ -46,14 +46,16 @@ impl ModelMatrices {
         }
     }
 
-    /// The numeric model with these names and delays; `None` when a matrix does not fit
-    /// the names or the delays do not match the controls.
+    /// The numeric model with these names, delays and actuators (empty: none); `None`
+    /// when a matrix does not fit the names, the delays or actuators do not match the
+    /// controls, or an actuator is not valid.
     pub fn to_model(
         &self,
         states: &[String],
         controls: &[String],
         outputs: &[String],
         delays: &[f64],
+        actuators: &[Option<Actuator>],
     ) -> Option<Model> {
         let (n, m, p) = (states.len(), controls.len(), outputs.len());
         let sized = |matrix: &RowMajor, rows: usize, cols: usize| {
@@ -62,7 +64,13 @@ impl ModelMatrices {
                 .flatten()
         };
         (delays.len() == m).then_some(())?;
+        let actuators = match actuators.len() {
+            0 => vec![None; m],
+            k if k == m && actuators.iter().flatten().all(Actuator::is_valid) => actuators.to_vec(),
+            _ => return None,
+        };
         Some(Model {
+            actuators,
             m: sized(&self.m, n, n)?,
             f: sized(&self.f, n, n)?,
             g: sized(&self.g, n, m)?,
@@ -104,6 +112,10 @@ pub struct ModelDocument {
     pub matrices: ModelMatrices,
     /// Delay per control \[s\], in `controls` order.
     pub delays: Vec<f64>,
+    /// Known actuator per control, in `controls` order (`null`: none); left out when no
+    /// control has one.
+    #[serde(default, skip_serializing_if = "no_actuators")]
+    pub actuators: Vec<Option<Actuator>>,
     /// Base parameters in structure order, then constrained ones.
     pub parameters: Vec<ParameterReport>,
     /// J per pair.
@@ -241,6 +253,7 @@ impl ModelDocument {
             outputs: model.outputs.clone(),
             matrices: ModelMatrices::from_model(model),
             delays: model.delays.clone(),
+            actuators: model.actuators.clone(),
             parameters: result
                 .parameters
                 .iter()
@@ -276,9 +289,19 @@ impl ModelDocument {
 
     /// The numeric model; `None` when a matrix has the wrong size.
     pub fn model(&self) -> Option<Model> {
-        self.matrices
-            .to_model(&self.states, &self.controls, &self.outputs, &self.delays)
+        self.matrices.to_model(
+            &self.states,
+            &self.controls,
+            &self.outputs,
+            &self.delays,
+            &self.actuators,
+        )
     }
+}
+
+/// Whether no control has an actuator (the field is then left out of the JSON).
+pub fn no_actuators(actuators: &[Option<Actuator>]) -> bool {
+    actuators.iter().all(Option::is_none)
 }
 
 fn percent_cell(value: Option<f64>) -> String {

@@ -229,6 +229,7 @@ mod tests {
                 h1: empty,
             },
             delays: Vec::new(),
+            actuators: Vec::new(),
             parameters: parameters
                 .iter()
                 .map(|(name, value)| ParameterReport {

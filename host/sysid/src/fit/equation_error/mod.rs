@@ -194,9 +194,10 @@ pub fn equation_error_start(
         let mut k = 0;
         for block in &blocks {
             let g = model.g[(block.row, block.control)];
-            let delay = model.delays[block.control];
             for point in &block.points {
-                let mut e = -g * (-point.s * delay).exp();
+                // The control as the state equation sees it: through its actuator, if
+                // the structure has one, and its delay.
+                let mut e = -g * model.input_factor(block.control, point.s);
                 for l in 0..n {
                     let coefficient = point.s * model.m[(block.row, l)] - model.f[(block.row, l)];
                     e += coefficient * point.x[l];

@@ -13,7 +13,7 @@
 use std::collections::BTreeMap;
 
 use super::error::FitError;
-use super::model::Model;
+use super::model::{Actuator, Model};
 
 mod parse;
 mod schema;
@@ -174,6 +174,9 @@ pub struct ModelStructure {
     pub entries: Vec<MatrixEntry>,
     /// Delay τ per control \[s\], as expressions (constant 0 when not given).
     pub delays: Vec<ParameterExpression>,
+    /// Known actuator per control (`[actuators]`; `None` when not given): fixed, not
+    /// parameters.
+    pub actuators: Vec<Option<Actuator>>,
     /// Pairs to fit.
     pub pairs: Vec<PairSpec>,
     /// Clips every `auto` range to this band [rad/s] (e.g. 6-DOF fits stop below the
@@ -256,6 +259,7 @@ impl ModelStructure {
         for (control, delay) in self.delays.iter().enumerate() {
             model.delays[control] = delay.evaluate(values);
         }
+        model.actuators = self.actuators.clone();
         Ok(model)
     }
 

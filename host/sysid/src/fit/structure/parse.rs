@@ -6,7 +6,8 @@ use std::path::Path;
 use toml::Spanned;
 
 use super::schema::{
-    explain_syntax, line_of, Context, RawParameter, RawRange, RawRows, RawStructure, RawValue,
+    explain_syntax, line_of, Context, RawActuator, RawParameter, RawRange, RawRows, RawStructure,
+    RawValue,
 };
 use super::validate::{check_band, check_every_parameter_is_used, file_constants};
 use super::{
@@ -15,6 +16,7 @@ use super::{
 };
 use crate::fit::error::{StructureError, StructureProblem};
 use crate::fit::expression::{parse_linear_with_constants, LinearForm};
+use crate::fit::model::Actuator;
 
 /// Resolves expressions against base and constrained parameters.
 struct Resolver<'a> {
@@ -339,6 +341,11 @@ impl ModelStructure {
             let control = context.index_of(&controls, key, "control")?;
             delays[control] = resolve_value(value, &|| format!("delay of `{}`", key.get_ref()))?;
         }
+        let mut actuators = vec![None; controls.len()];
+        for (key, value) in &raw.actuators {
+            let control = context.index_of(&controls, key, "control")?;
+            actuators[control] = Some(actuator(context, key, value, &constants)?);
+        }
         check_every_parameter_is_used(
             context,
             &raw_parameters,
@@ -436,6 +443,7 @@ impl ModelStructure {
             derived,
             entries,
             delays,
+            actuators,
             pairs,
             auto_range_limit,
             default_output_states,
@@ -457,4 +465,42 @@ impl std::str::FromStr for ModelStructure {
     fn from_str(text: &str) -> Result<Self, Self::Err> {
         Self::parse_str(text)
     }
+}
+
+/// An `[actuators]` entry: each number given as a number or a constant's name, both
+/// finite and positive.
+fn actuator(
+    context: &Context,
+    control: &Spanned<String>,
+    raw: &Spanned<RawActuator>,
+    constants: &BTreeMap<String, f64>,
+) -> Result<Actuator, StructureError> {
+    let bad = |reason: String| {
+        context.error(
+            control.span(),
+            StructureProblem::BadActuator {
+                control: control.get_ref().clone(),
+                reason,
+            },
+        )
+    };
+    let number = |value: &RawValue, what: &str| match value {
+        RawValue::Number(x) => Ok(*x),
+        RawValue::Expression(name) => constants.get(name.trim()).copied().ok_or_else(|| {
+            bad(format!(
+                "{what} `{name}` is neither a number nor a name under [constants]"
+            ))
+        }),
+    };
+    let actuator = Actuator {
+        natural_frequency_rad_s: number(&raw.get_ref().natural_frequency, "natural_frequency")?,
+        damping: number(&raw.get_ref().damping, "damping")?,
+    };
+    if !actuator.is_valid() {
+        return Err(bad(format!(
+            "natural_frequency {} rad/s and damping {} must be finite and positive",
+            actuator.natural_frequency_rad_s, actuator.damping
+        )));
+    }
+    Ok(actuator)
 }

@@ -41,6 +41,15 @@ pub(super) enum RawRange {
     Band(Vec<f64>),
 }
 
+/// `[actuators]` entry: `lat = { natural_frequency = 60.0, damping = "servo_damping" }`,
+/// numbers or names of `[constants]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawActuator {
+    pub(super) natural_frequency: RawValue,
+    pub(super) damping: RawValue,
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawPair {
@@ -78,6 +87,8 @@ pub(super) struct RawStructure {
     #[serde(default)]
     pub(super) delays: BTreeMap<Spanned<String>, Spanned<RawValue>>,
     #[serde(default)]
+    pub(super) actuators: BTreeMap<Spanned<String>, Spanned<RawActuator>>,
+    #[serde(default)]
     pub(super) pairs: Vec<Spanned<RawPair>>,
     #[serde(default)]
     pub(super) trim_derived: Vec<Spanned<String>>,
@@ -90,6 +101,9 @@ pub(super) fn explain_syntax(message: &str) -> String {
          `start`, `fixed`, `expr` (and optional `min`, `max`, `description`)"
     } else if message.contains("RawValue") {
         "a matrix entry or delay is a number or a string expression such as \"-tau_f\""
+    } else if message.contains("RawActuator") {
+        "an actuator is a table { natural_frequency = …, damping = … } of numbers or \
+         names of constants"
     } else if message.contains("RawRange") {
         "a range is \"auto\" or [lo, hi] in rad/s"
     } else {

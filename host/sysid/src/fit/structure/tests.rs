@@ -359,3 +359,60 @@ fn other_semantic_errors_name_the_line() {
     assert!(matches!(error.problem, StructureProblem::DuplicateName(_)));
     assert_eq!(error.line, Some(34));
 }
+
+#[test]
+fn actuators_take_numbers_or_constants_and_refuse_anything_else() {
+    let with = |table: &str| {
+        SMALL.replace(
+            "[delays]",
+            &format!("[constants]\nservo_w = 60.0\n\n[actuators]\n{table}\n\n[delays]"),
+        )
+    };
+    let structure = ModelStructure::parse(
+        &with(r#"u = { natural_frequency = "servo_w", damping = 0.7 }"#),
+        "a.toml",
+    )
+    .unwrap();
+    let expected = Actuator {
+        natural_frequency_rad_s: 60.0,
+        damping: 0.7,
+    };
+    assert_eq!(structure.actuators, vec![Some(expected)]);
+    let model = structure.model(&structure.values()).unwrap();
+    assert_eq!(model.actuators, vec![Some(expected)]);
+    // Without the table there is none.
+    assert_eq!(
+        ModelStructure::parse(SMALL, "s.toml").unwrap().actuators,
+        vec![None]
+    );
+
+    let problem = |table: &str| error_of(&with(table));
+    let unknown = problem(r#"u = { natural_frequency = "b", damping = 0.7 }"#);
+    assert!(
+        matches!(&unknown.problem, StructureProblem::BadActuator { control, reason }
+            if control == "u" && reason.contains("`b`")),
+        "{unknown}"
+    );
+    assert_eq!(unknown.line, Some(30));
+    let negative = problem("u = { natural_frequency = 60.0, damping = -0.7 }");
+    assert!(
+        matches!(negative.problem, StructureProblem::BadActuator { .. }),
+        "{negative}"
+    );
+    let not_a_control = problem("v = { natural_frequency = 60.0, damping = 0.7 }");
+    assert!(
+        matches!(
+            not_a_control.problem,
+            StructureProblem::UnknownName {
+                kind: "control",
+                ..
+            }
+        ),
+        "{not_a_control}"
+    );
+    let missing = problem("u = { natural_frequency = 60.0 }");
+    assert!(
+        matches!(missing.problem, StructureProblem::Syntax(_)),
+        "{missing}"
+    );
+}

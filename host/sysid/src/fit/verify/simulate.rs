@@ -171,6 +171,12 @@ pub fn simulate_with_resets(
             ),
         });
     }
+    // Known actuators become states here (the frequency domain keeps them as factors).
+    let with_actuators = model.with_actuator_states();
+    let actuated: Vec<usize> = (0..model.controls.len())
+        .filter(|&j| model.actuators.get(j).copied().flatten().is_some())
+        .collect();
+    let model = &with_actuators;
     let discrete = DiscreteModel::new(model, 1.0 / sample_rate_hz)?;
     let length = inputs.first().map_or(0, Vec::len);
     if inputs.iter().any(|series| series.len() != length) {
@@ -192,11 +198,24 @@ pub fn simulate_with_resets(
     let input_at = |k: usize| DVector::from_fn(m, |j, _| delayed_inputs[j][k]);
     let mut outputs = vec![Vec::with_capacity(length); p];
     let mut state = DVector::zeros(n);
-    if let Some((_, bad)) = resets.iter().find(|(_, x)| x.len() != n) {
+    // A reset gives the model's own states; an actuator restarts at rest at its input.
+    let own = n - 2 * actuated.len();
+    if let Some((_, bad)) = resets.iter().find(|(_, x)| x.len() != own) {
         return Err(VerifyError::BadModel {
-            reason: format!("reset state of length {} for {n} states", bad.len()),
+            reason: format!("reset state of length {} for {own} states", bad.len()),
         });
     }
+    let resets: Vec<(usize, DVector<f64>)> = resets
+        .iter()
+        .map(|(at, x)| {
+            let mut full = DVector::zeros(n);
+            full.rows_mut(0, own).copy_from(x);
+            for (k, &j) in actuated.iter().enumerate() {
+                full[own + 2 * k] = delayed_inputs[j].get(*at).copied().unwrap_or(0.0);
+            }
+            (*at, full)
+        })
+        .collect();
     let mut next_reset = resets.iter().peekable();
     for k in 0..length {
         while let Some((_, reset)) = next_reset.next_if(|(at, _)| *at <= k) {
