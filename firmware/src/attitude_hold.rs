@@ -150,6 +150,18 @@ impl Gains {
     /// Kp 1.5 gives φ poles near −8 and −70 /s. With these, `sweephold fly --vehicle
     /// trex700l` flies every default record without an abort. Re-tune on the real
     /// aircraft before flight.
+    ///
+    /// Release fade τ_r = 0.3 s on roll and pitch: the output a hold leaves behind at
+    /// release is mostly its restoring command, and on an airframe this quick a fade of
+    /// 1 s carried it through trim and out beyond the engage angle on the other side
+    /// (cah excursions 9.7–12.1° from trim over seeds 1–10; 8.7–9.5° with 0.3 s).
+    ///
+    /// Heading: N_ped ≈ 80 rad/s² per stick, and the pedal slews at 4 /s. With Kp 1.5,
+    /// Kd 0.3 and ±0.3 of authority the heading hold needed 0.15 s to reverse its
+    /// output, longer than its own loop's half period, and it limit-cycled at ±25–35°
+    /// whenever it engaged. Kp 0.6, Kd 0.12 (ψ̈ ≈ −80·(0.6ψ + 0.12r): ω_n ≈ 6.9 rad/s,
+    /// ζ ≈ 0.7) within ±0.12 reverse in 0.06 s and hold the heading within 12°
+    /// (docs/decisions/2026-11-25-trex700l-pedal-and-release.md).
     pub const fn trex700l() -> Self {
         Gains {
             lat: AxisGains {
@@ -160,7 +172,7 @@ impl Gains {
                 integrator_limit: 0.3,
                 reversed: false,
                 bumpless_time_s: 0.05,
-                release_time_s: 1.0,
+                release_time_s: 0.3,
             },
             lon: AxisGains {
                 kp: 2.0,
@@ -170,14 +182,14 @@ impl Gains {
                 integrator_limit: 0.3,
                 reversed: false,
                 bumpless_time_s: 0.05,
-                release_time_s: 1.0,
+                release_time_s: 0.3,
             },
             ped: AxisGains {
-                kp: 1.5,
+                kp: 0.6,
                 ki: 0.05,
-                kd: 0.3,
-                output_limit: 0.3,
-                integrator_limit: 0.3,
+                kd: 0.12,
+                output_limit: 0.12,
+                integrator_limit: 0.12,
                 reversed: false,
                 bumpless_time_s: 0.05,
                 release_time_s: 1.0,

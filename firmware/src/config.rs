@@ -8,6 +8,7 @@ use sweephold_protocol::{
 use crate::amplitude::AdaptiveSettings;
 use crate::attitude_hold::{AxisGains, Gains};
 use crate::excitation::Excitation;
+use crate::excitation_scale::ExcitationScale;
 use crate::hold::HoldThresholds;
 use crate::mixer::MixerConfig;
 use crate::safety::SafetyLimits;
@@ -61,6 +62,9 @@ pub struct Config {
     pub adaptive: AdaptiveSettings,
     /// Slew limit on the commands of the excitation phases (off: [`CommandSlew::NONE`]).
     pub slew: CommandSlew,
+    /// The share of the test's amplitude and noise each axis gets (the vehicle's stick
+    /// units; [`ExcitationScale::UNIT`] flies the test as sent).
+    pub excitation_scale: ExcitationScale,
 }
 
 /// What the conditional-hold thresholds (engage 6°, release 4°) apply to on the roll and
@@ -120,6 +124,8 @@ pub enum ConfigError {
     AdaptiveAmplitudeInvalid,
     /// A command slew limit zero, negative or NaN (see `CommandSlew::is_valid`).
     SlewInvalid,
+    /// An excitation scale outside (0, 1] (see `ExcitationScale::is_valid`).
+    ExcitationScaleInvalid,
 }
 
 impl ConfigError {
@@ -146,6 +152,7 @@ impl ConfigError {
             ConfigError::MixerInvalid => "mixer settings invalid",
             ConfigError::AdaptiveAmplitudeInvalid => "adaptive amplitude settings invalid",
             ConfigError::SlewInvalid => "command slew limits must be positive",
+            ConfigError::ExcitationScaleInvalid => "excitation scales must lie in (0, 1]",
         }
     }
 }
@@ -212,11 +219,14 @@ impl Config {
             mixer: MixerConfig::trex700l(),
             adaptive: AdaptiveSettings::PRESET,
             slew: CommandSlew::NONE,
+            excitation_scale: ExcitationScale::UNIT,
         }
     }
 
     /// TREX 700L defaults at 200 Hz: [`paper_test`] with 0.3 s pulses (faster airframe),
-    /// 1 s trim capture, [`Gains::trex700l`], [`SafetyLimits::trex700l`], CCPM-120 mixer.
+    /// 1 s trim capture, [`Gains::trex700l`], [`SafetyLimits::trex700l`], CCPM-120 mixer,
+    /// the pedal slewed at 4 /s ([`TREX700L_SLEW`]) and excited at 1/5
+    /// ([`ExcitationScale::trex700l`]).
     pub const fn trex700l_default(primary: Axis) -> Self {
         let mut test = paper_test(primary);
         test.pulse.width_s = 0.3;
@@ -233,6 +243,7 @@ impl Config {
             mixer: MixerConfig::trex700l(),
             adaptive: AdaptiveSettings::PRESET,
             slew: TREX700L_SLEW,
+            excitation_scale: ExcitationScale::trex700l(),
         }
     }
 
@@ -336,6 +347,9 @@ impl Config {
         }
         if !self.slew.is_valid() {
             return Err(ConfigError::SlewInvalid);
+        }
+        if !self.excitation_scale.is_valid() {
+            return Err(ConfigError::ExcitationScaleInvalid);
         }
         // Record-length rule T_rec ≥ 4·T_max, T_max = 2π/ω_min: shorter is flown, flagged.
         let longest_period = core::f32::consts::TAU / sweep.omega_min;
@@ -499,6 +513,14 @@ mod tests {
         assert_eq!(
             refused(|c| c.adaptive.max_slope_per_s = 0.0),
             AdaptiveAmplitudeInvalid
+        );
+        assert_eq!(
+            refused(|c| c.excitation_scale.per_axis[2] = 0.0),
+            ExcitationScaleInvalid
+        );
+        assert_eq!(
+            refused(|c| c.excitation_scale.per_axis[0] = f32::NAN),
+            ExcitationScaleInvalid
         );
     }
 

@@ -25,6 +25,8 @@
 //!   [`PulseSignal`](crate::pulse::PulseSignal)); every command there is
 //!   `trim + perturbation`, clamped to [−1, 1] and, with a slew limit configured
 //!   ([`Config::slew`]), moved from the tick before's command by at most its axis' step.
+//!   The perturbation's sweep (or pulse) and noise are the test's, times the vehicle's
+//!   per-axis [`ExcitationScale`](crate::excitation_scale::ExcitationScale).
 //!
 //! # Sample fields
 //!
@@ -253,7 +255,7 @@ impl FlightController {
             shaper: (config.test.input == InputKind::AdaptiveSweep).then(|| {
                 AmplitudeShaper::new(
                     config.adaptive,
-                    config.test.sweep.amplitude,
+                    config.test.sweep.amplitude * config.excitation_scale.of(config.test.primary),
                     config.test.hold_release_rad,
                     config.safety.rate_limit_rad_s,
                 )
@@ -490,8 +492,17 @@ impl FlightController {
         self.set_phase(phase, tick, sink);
         self.excitation_tick = self.excitation_tick.saturating_add(1);
 
+        // The vehicle's share of the test's amplitudes on each axis, applied before the
+        // adaptive shaping so that its stick-travel and servo-rate bounds see what is flown.
+        let scale = self.config.excitation_scale;
+        sample.value *= scale.of(self.config.test.primary);
         let trim = self.trim;
         let [noise_lat, noise_lon, noise_ped] = self.noise.next_sample();
+        let [noise_lat, noise_lon, noise_ped] = [
+            noise_lat * scale.of(Axis::Lat),
+            noise_lon * scale.of(Axis::Lon),
+            noise_ped * scale.of(Axis::Ped),
+        ];
         let gains = &self.config.gains;
         // lat ↔ φ (damped by p), lon ↔ θ (q), ped ↔ heading error ψ − ψ_trim wrapped to
         // ±π (r); all as deviations from the captured trim.

@@ -2,6 +2,7 @@
 //! public API and decoded with the protocol's own decoder.
 
 use super::*;
+use crate::excitation_scale::ExcitationScale;
 use crate::slew::CommandSlew;
 use proptest::prelude::*;
 use sweephold_protocol::{Decoder, InputKind, PilotInput, WARN_RECORD_SHORT};
@@ -354,6 +355,63 @@ fn slew_limits_must_be_positive() {
     config.slew = CommandSlew::pedal(f32::INFINITY);
     assert!(FlightController::new(config).is_ok());
     assert_eq!(Config::bo105_default(Axis::Lat).slew, CommandSlew::NONE);
+}
+
+#[test]
+fn the_excitation_scale_multiplies_the_primary_sweep_and_each_axis_noise() {
+    let run = |primary: Axis, scale: ExcitationScale| {
+        let mut config = short_config();
+        config.test.primary = primary;
+        config.excitation_scale = scale;
+        let mut rig = Rig::into_sweep(config);
+        (0..400)
+            .map(|_| {
+                rig.step();
+                rig.sample()
+            })
+            .collect::<Vec<_>>()
+    };
+    let scale = ExcitationScale {
+        per_axis: [0.5, 0.25, 0.2, 1.0],
+    };
+    for primary in [Axis::Lat, Axis::Ped] {
+        let unit = run(primary, ExcitationScale::UNIT);
+        let scaled = run(primary, scale);
+        let mut excited = [false; 3];
+        for (a, b) in unit.iter().zip(&scaled) {
+            assert_eq!(b.hold, [HoldState::Released; 3]);
+            let parts = |s: &Sample| (s.sweep.to_array(), s.noise.to_array());
+            let ((sweep_a, noise_a), (sweep_b, noise_b)) = (parts(a), parts(b));
+            for axis in 0..3 {
+                let k = scale.per_axis[axis];
+                assert!((sweep_b[axis] - k * sweep_a[axis]).abs() <= 1e-6 * sweep_a[axis].abs());
+                assert!((noise_b[axis] - k * noise_a[axis]).abs() <= 1e-6 * noise_a[axis].abs());
+                excited[axis] |= sweep_a[axis] != 0.0 || noise_a[axis] != 0.0;
+            }
+            let command = b.command.to_array();
+            for axis in 0..3 {
+                let expected = PILOT[axis] + sweep_b[axis] + noise_b[axis];
+                assert!((command[axis] - expected).abs() < 1e-6);
+            }
+        }
+        assert_eq!(excited, [true; 3], "primary {primary:?}");
+    }
+}
+
+#[test]
+fn excitation_scales_must_lie_in_zero_to_one() {
+    for bad in [0.0, 1.5, f32::NAN] {
+        let mut config = short_config();
+        config.excitation_scale.per_axis[2] = bad;
+        assert_eq!(
+            FlightController::new(config).err(),
+            Some(ConfigError::ExcitationScaleInvalid)
+        );
+    }
+    assert_eq!(
+        Config::bo105_default(Axis::Lat).excitation_scale,
+        ExcitationScale::UNIT
+    );
 }
 
 #[test]

@@ -75,6 +75,7 @@ pub mod controller;
 pub mod estimator;
 pub mod excitation;
 pub mod excitation_sample;
+pub mod excitation_scale;
 pub mod filters;
 pub mod hold;
 pub mod imu;
