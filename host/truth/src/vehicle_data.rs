@@ -53,7 +53,7 @@ pub fn nine_dof_hybrid(
 
 /// A shipped structure with the data of `vehicle` in it: of the constants `hub_height`,
 /// `hub_forward`, `shaft_tilt_sine`, `gravity`, `servo_natural_frequency`,
-/// `servo_damping` and (with `trim`) the trim attitude's, those
+/// `servo_damping`, `inertia_xz_over_zz` and (with `trim`) the trim attitude's, those
 /// the file declares; a fixed `Kcs` (the flap cross-coupling, rotor data) if it has one;
 /// then `overrides` of its constants. A file without any of them (the 6-DOF) is unchanged.
 pub fn with_vehicle_data(
@@ -79,6 +79,10 @@ pub fn with_vehicle_data(
             servo.natural_frequency_rad_s,
         ),
         ("servo_damping".to_string(), servo.damping),
+        (
+            "inertia_xz_over_zz".to_string(),
+            helicopter.ixz / helicopter.izz,
+        ),
     ]);
     if let Some(trim) = trim {
         for (name, value) in trim.constants() {
@@ -171,5 +175,29 @@ mod tests {
         let lfu = |s: &ModelStructure| s.parameter_value("Lfu", &s.values()).unwrap();
         assert!((kpq(&trex) - trex_hub * lfu(&trex)).abs() < 1e-15);
         assert!((kpq(&bo105) - 1.48 * lfu(&bo105)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_trex_yaw_flap_coupling_follows_its_product_of_inertia() {
+        let nb1s = |s: &ModelStructure| s.parameter_value("Nb1s", &s.values()).unwrap();
+        let lb1s = |s: &ModelStructure| s.parameter_value("Lb1s", &s.values()).unwrap();
+        let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l, None).unwrap();
+        let data = bo105::Helicopter::trex700l();
+        assert_eq!(trex.constants["inertia_xz_over_zz"], data.ixz / data.izz);
+        // Derived, not a base parameter the fit could move.
+        assert!(trex.parameter_index("Nb1s").is_none());
+        assert!(trex.derived.iter().any(|d| d.name == "Nb1s"));
+        assert_eq!(nb1s(&trex), data.ixz / data.izz * lb1s(&trex));
+        // Another airframe's product of inertia reaches the model through the constant.
+        let overrides = BTreeMap::from([("inertia_xz_over_zz".to_string(), 0.05)]);
+        let file = &models::TREX700L_9DOF_HYBRID;
+        let tilted = with_vehicle_data(file, bo105::Vehicle::Trex700l, None, &overrides).unwrap();
+        assert!((nb1s(&tilted) - 0.05 * lb1s(&tilted)).abs() < 1e-12);
+        assert!(nb1s(&tilted) > 0.0);
+        // The Bo-105's file keeps N_b1s free and declares no such constant.
+        let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
+        assert!(!bo105.constants.contains_key("inertia_xz_over_zz"));
+        let index = bo105.parameter_index("Nb1s").unwrap();
+        assert_eq!(bo105.parameters[index].kind, ParameterKind::Free);
     }
 }

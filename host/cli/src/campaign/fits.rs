@@ -65,19 +65,15 @@ impl Campaign<'_> {
             argv.push(max_starts.to_string().into());
         }
         argv.push("--trim-balance".into());
-        argv.push(self.args.trim_balance.as_arg().into());
+        let balance = self.args.trim_balance.for_vehicle(self.args.vehicle);
+        argv.push(balance.as_arg().into());
         verb_args("fit", argv)
     }
 
     /// The trim points stage, when the campaign uses them (`--trim-points`): the
     /// simulator's steady flights, `trim-points.csv`.
     pub(super) fn trim_points(&mut self) -> Result<Option<TrimPoints>, CampaignError> {
-        let used = match self.args.trim_points {
-            TrimPointsArg::On => true,
-            TrimPointsArg::Off => false,
-            TrimPointsArg::Default => self.args.vehicle == VehicleArg::Bo105,
-        };
-        if !used {
+        if self.args.trim_points == TrimPointsArg::Off {
             return Ok(None);
         }
         self.stage(Stage::TrimPoints, |run| {

@@ -71,17 +71,17 @@ pub struct CampaignArgs {
     #[arg(long)]
     pub quick: bool,
     /// Derive the hybrid's hover derivatives (M_fu, L_fu, N_v, Z_w, N_r) from trim points,
-    /// the simulator's steady flights (`trim-points.csv`): `on`, `off` (fitted like the
-    /// others), or `default`: on for the Bo-105, off for the TREX 700L, where they bring its
-    /// hover modes and speed derivatives right but cost key parameters today
-    /// (docs/decisions/2026-11-24-trex700l-servo-band.md).
-    #[arg(long, value_enum, default_value_t = TrimPointsArg::Default, value_name = "WHEN")]
+    /// the simulator's steady flights (`trim-points.csv`): `on` (the default for both
+    /// vehicles) or `off` (fitted like the others).
+    #[arg(long, value_enum, default_value_t = TrimPointsArg::On, value_name = "WHEN")]
     pub trim_points: TrimPointsArg,
     /// How the trim points enter the 9-DOF fit (as `fit --trim-balance`): `hold` keeps
     /// the derived parameters at the balance's values (status `trim`), `joint` releases
-    /// them into one cost with the balances.
-    #[arg(long, value_enum, default_value_t = TrimBalanceArg::Hold, value_name = "HOW")]
-    pub trim_balance: TrimBalanceArg,
+    /// them into one cost with the balances, `default` is `hold` for the Bo-105 and
+    /// `joint` for the TREX 700L, whose key parameters held balances pull by 10–27 %
+    /// (docs/decisions/2026-11-25-trex700l-yaw-flap-coupling.md).
+    #[arg(long, value_enum, default_value_t = CampaignTrimBalance::Default, value_name = "HOW")]
+    pub trim_balance: CampaignTrimBalance,
     /// Sweep amplitude of the fit records (cah, standard, noise): `fixed` (the paper's)
     /// or `adaptive` (see `fly --amplitude`); the held-out doublets are never shaped.
     #[arg(long, value_enum, default_value_t = AmplitudeArg::Fixed)]
@@ -212,12 +212,34 @@ impl CampaignLink {
 /// `campaign --trim-points`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum TrimPointsArg {
-    /// On for the Bo-105, off for the TREX 700L.
-    Default,
     /// Derive from trim points.
     On,
     /// Fit like the other parameters.
     Off,
+}
+
+/// `campaign --trim-balance`: the fit's [`TrimBalanceArg`], or the vehicle's default.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CampaignTrimBalance {
+    /// `hold` for the Bo-105, `joint` for the TREX 700L.
+    Default,
+    /// Derived from the balance and held (status `trim`).
+    Hold,
+    /// Held until they settle, then fitted with the others under the balances' cost.
+    Joint,
+}
+
+impl CampaignTrimBalance {
+    /// The fit's setting for `vehicle`.
+    pub fn for_vehicle(self, vehicle: VehicleArg) -> TrimBalanceArg {
+        match (self, vehicle) {
+            (CampaignTrimBalance::Hold, _) | (CampaignTrimBalance::Default, VehicleArg::Bo105) => {
+                TrimBalanceArg::Hold
+            }
+            (CampaignTrimBalance::Joint, _)
+            | (CampaignTrimBalance::Default, VehicleArg::Trex700l) => TrimBalanceArg::Joint,
+        }
+    }
 }
 
 /// Everything a campaign holds between stages.
@@ -406,6 +428,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_trim_balance_default_is_per_vehicle_and_an_explicit_one_wins() {
+        use CampaignTrimBalance as C;
+        let balance = |c: C, v| c.for_vehicle(v);
+        assert_eq!(balance(C::Default, VehicleArg::Bo105), TrimBalanceArg::Hold);
+        assert_eq!(
+            balance(C::Default, VehicleArg::Trex700l),
+            TrimBalanceArg::Joint
+        );
+        for vehicle in [VehicleArg::Bo105, VehicleArg::Trex700l] {
+            assert_eq!(balance(C::Hold, vehicle), TrimBalanceArg::Hold);
+            assert_eq!(balance(C::Joint, vehicle), TrimBalanceArg::Joint);
+        }
+        let parsed: CampaignArgs = verb_args("campaign", Vec::<OsString>::new()).unwrap();
+        assert_eq!(
+            (parsed.trim_points, parsed.trim_balance),
+            (TrimPointsArg::On, C::Default)
+        );
+    }
+
+    #[test]
     fn a_failed_stage_keeps_the_previous_campaign_and_its_own_files() {
         let dir = std::env::temp_dir().join(format!("sweephold-stage-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
@@ -418,8 +460,8 @@ mod tests {
             out: out.clone(),
             seed: 7,
             quick: true,
-            trim_points: TrimPointsArg::Default,
-            trim_balance: TrimBalanceArg::Hold,
+            trim_points: TrimPointsArg::On,
+            trim_balance: CampaignTrimBalance::Default,
             amplitude: AmplitudeArg::Fixed,
             fc: CampaignLink::InProcess,
             quiet: true,
