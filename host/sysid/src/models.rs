@@ -149,6 +149,7 @@ impl ShippedStructure {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::ParameterKind;
 
     #[test]
     fn every_shipped_structure_parses_under_its_files_name() {
@@ -182,6 +183,28 @@ mod tests {
             let on_disk = std::fs::read_to_string(folder.join(shipped.file)).unwrap();
             assert_eq!(shipped.toml, on_disk, "{}", shipped.file);
         }
+    }
+
+    #[test]
+    fn the_dampings_of_both_hybrids_are_bounded_at_zero() {
+        // Z_w on both (heave damping); X_u and Y_v on the TREX's, whose drag dampings are
+        // below what its sweeps resolve (its file's header).
+        let upper = |shipped: &ShippedStructure, name: &str| {
+            let structure = shipped.parse().unwrap();
+            let index = structure.parameter_index(name).unwrap();
+            let parameter = &structure.parameters[index];
+            assert_eq!(parameter.kind, ParameterKind::Free, "{name}");
+            assert!(
+                parameter.value < 0.0,
+                "{name} starts at {}",
+                parameter.value
+            );
+            parameter.upper
+        };
+        for name in ["Xu", "Yv", "Zw"] {
+            assert_eq!(upper(&TREX700L_9DOF_HYBRID, name), Some(0.0), "{name}");
+        }
+        assert_eq!(upper(&BO105_9DOF_HYBRID, "Zw"), Some(0.0));
     }
 
     #[test]
