@@ -53,7 +53,8 @@ pub fn nine_dof_hybrid(
 
 /// A shipped structure with the data of `vehicle` in it: of the constants `hub_height`,
 /// `hub_forward`, `shaft_tilt_sine`, `gravity`, `servo_natural_frequency`,
-/// `servo_damping`, `inertia_xz_over_zz` and (with `trim`) the trim attitude's, those
+/// `servo_damping`, `inertia_xz_over_zz`, `tail_arm`, `tail_height`, `izz_over_ixx`,
+/// `mass_over_iyy` and (with `trim`) the trim attitude's, those
 /// the file declares; a fixed `Kcs` (the flap cross-coupling, rotor data) if it has one;
 /// then `overrides` of its constants. A file without any of them (the 6-DOF) is unchanged.
 pub fn with_vehicle_data(
@@ -82,6 +83,14 @@ pub fn with_vehicle_data(
         (
             "inertia_xz_over_zz".to_string(),
             helicopter.ixz / helicopter.izz,
+        ),
+        // The tail rotor's hub behind and above the CG (body x forward, z down).
+        ("tail_arm".to_string(), -helicopter.tail_rotor.hub[0]),
+        ("tail_height".to_string(), -helicopter.tail_rotor.hub[2]),
+        ("izz_over_ixx".to_string(), helicopter.izz / helicopter.ixx),
+        (
+            "mass_over_iyy".to_string(),
+            helicopter.mass / helicopter.iyy,
         ),
     ]);
     if let Some(trim) = trim {
@@ -199,5 +208,48 @@ mod tests {
         assert!(!bo105.constants.contains_key("inertia_xz_over_zz"));
         let index = bo105.parameter_index("Nb1s").unwrap();
         assert_eq!(bo105.parameters[index].kind, ParameterKind::Free);
+    }
+
+    /// The TREX file ties its body terms to the tail rotor, the shaft and the hub (its
+    /// header). Checked here against the simulator's hover linearization, which knows
+    /// nothing of those ties: each relation holds there within 5 %.
+    #[test]
+    fn the_trex_body_terms_are_its_tail_rotors_shafts_and_hubs_in_the_simulator() {
+        let truth = crate::VehicleTruth::at_hover(bo105::Vehicle::Trex700l).unwrap();
+        let structure = nine_dof_hybrid(bo105::Vehicle::Trex700l, None).unwrap();
+        let c = |name: &str| structure.constants[name];
+        let a = |row: &str, column: &str| truth.a(row, column).unwrap();
+        let b = |row: &str, control: &str| truth.b(row, control).unwrap();
+        let close = |what: &str, value: f64, expected: f64| {
+            assert!(
+                (value - expected).abs() <= 0.05 * expected.abs(),
+                "{what}: simulator {value}, tie {expected}"
+            );
+        };
+        let (arm, height) = (c("tail_arm"), c("tail_height"));
+        assert!(arm > 0.5 && height > 0.0, "{arm} {height}");
+        close("Y_p", a("v", "p"), height * a("v", "v"));
+        close("Y_r", a("v", "r"), -arm * a("v", "v"));
+        close("N_p", a("r", "p"), height * a("r", "v"));
+        close("N_r", a("r", "r"), -arm * a("r", "v"));
+        close("L_r", a("p", "r"), height * c("izz_over_ixx") * a("r", "v"));
+        let data = bo105::Helicopter::trex700l();
+        close(
+            "N_v",
+            a("r", "v"),
+            -arm * data.mass / data.izz * a("v", "v"),
+        );
+        // Upright shaft, hub over the CG: no x force or pitching moment from thrust, and
+        // nothing gives X_r or M_v in hover.
+        assert_eq!((c("shaft_tilt_sine"), c("hub_forward")), (0.0, 0.0));
+        for (value, what) in [
+            (a("u", "w"), "X_w"),
+            (b("u", "col"), "X_col"),
+            (b("q", "col"), "M_col"),
+            (a("u", "r"), "X_r"),
+            (a("q", "v"), "M_v"),
+        ] {
+            assert!(value.abs() < 1e-6, "{what} = {value}");
+        }
     }
 }

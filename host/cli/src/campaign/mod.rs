@@ -79,7 +79,7 @@ pub struct CampaignArgs {
     /// the derived parameters at the balance's values (status `trim`), `joint` releases
     /// them into one cost with the balances, `default` is `hold` for the Bo-105 and
     /// `joint` for the TREX 700L, whose key parameters held balances pull by 10–27 %
-    /// (docs/decisions/2026-11-25-trex700l-yaw-flap-coupling.md).
+    /// (docs/decisions/2026-11-25-trex700l-hover-body-terms.md).
     #[arg(long, value_enum, default_value_t = CampaignTrimBalance::Default, value_name = "HOW")]
     pub trim_balance: CampaignTrimBalance,
     /// Sweep amplitude of the fit records (cah, standard, noise): `fixed` (the paper's)
