@@ -70,9 +70,10 @@ pub struct CampaignArgs {
     /// Short records (20 s instead of 90 s) for tests and a first look.
     #[arg(long)]
     pub quick: bool,
-    /// Derive the hybrid's hover derivatives (M_fu, L_fu, N_v, Z_w, N_r) from trim points,
-    /// the simulator's steady flights (`trim-points.csv`): `on` (the default for both
-    /// vehicles) or `off` (fitted like the others).
+    /// Derive the hybrid's hover derivatives (its file's `trim_derived`: M_fu, L_fu, N_v,
+    /// Z_w, and N_r on the Bo-105) from trim points, the simulator's steady flights
+    /// (`trim-points.csv`): `on` (the default for both vehicles) or `off` (fitted like the
+    /// others).
     #[arg(long, value_enum, default_value_t = TrimPointsArg::On, value_name = "WHEN")]
     pub trim_points: TrimPointsArg,
     /// How the trim points enter the 9-DOF fit (as `fit --trim-balance`): `hold` keeps
