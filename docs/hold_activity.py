@@ -44,7 +44,13 @@ BANDS = ((0.3, 1.0, 30.0), (1.0, 31.4, 10.0))  # (lowest, highest rad/s, window 
 def decode(dump):
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "record.csv")
-        subprocess.run([BINARY, "decode", "-q", "--format", "csv", dump, "-o", out], check=True)
+        done = subprocess.run(
+            [BINARY, "decode", "-q", "--format", "csv", dump, "-o", out],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        )
+        if done.returncode != 0:
+            last = (done.stderr.strip().splitlines() or ["decode failed"])[-1].removeprefix("error: ")
+            raise SystemExit(f"error: {dump}: {last}")
         with open(out) as f:
             rows = [row for row in csv.DictReader(f) if row["phase"] in EXCITATION]
     if not rows:
@@ -87,7 +93,12 @@ def band_coherence(a, b, lowest, highest, window_s):
 
 def record_figures(dump, primary, other):
     rows = decode(dump)
-    column = lambda name: [float(row[name]) for row in rows]
+    columns = {}
+
+    def column(name):
+        if name not in columns:
+            columns[name] = [float(row[name]) for row in rows]
+        return columns[name]
 
     def command(axis):
         return [c - p for c, p in zip(column(f"cmd_{axis}"), column(f"pilot_{axis}"))]
