@@ -27,6 +27,7 @@ Standard library only: the DFT is evaluated at the band's bins directly.
 import argparse
 import cmath
 import csv
+import functools
 import glob
 import math
 import os
@@ -67,13 +68,21 @@ def rms(values):
     return math.sqrt(sum(v * v for v in values) / len(values))
 
 
+@functools.lru_cache(maxsize=None)
+def window_and_twiddles(n, bins):
+    """The Hann window of n samples and the DFT factors of the given bins (the same for
+    every record: computed once)."""
+    hann = [0.5 - 0.5 * math.cos(2 * math.pi * i / (n - 1)) for i in range(n)]
+    twiddles = {k: [cmath.exp(-2j * math.pi * k * i / n) for i in range(n)] for k in bins}
+    return hann, twiddles
+
+
 def band_coherence(a, b, lowest, highest, window_s):
     """Welch magnitude-squared coherence of a and b, averaged over the bins in the band."""
     n = int(window_s * RATE_HZ)
     step = n // 2
-    hann = [0.5 - 0.5 * math.cos(2 * math.pi * i / (n - 1)) for i in range(n)]
-    bins = [k for k in range(1, n // 2) if lowest <= 2 * math.pi * k / window_s < highest]
-    twiddles = {k: [cmath.exp(-2j * math.pi * k * i / n) for i in range(n)] for k in bins}
+    bins = tuple(k for k in range(1, n // 2) if lowest <= 2 * math.pi * k / window_s < highest)
+    hann, twiddles = window_and_twiddles(n, bins)
     saa = {k: 0.0 for k in bins}
     sbb = {k: 0.0 for k in bins}
     sab = {k: 0j for k in bins}
