@@ -1,6 +1,7 @@
 //! Are the Cramér–Rao bounds honest? Fly the default Bo-105 campaign (mode cah) with 20
-//! seeds, identify each one the way `sweephold campaign` does (frequency responses, 6-DOF
-//! fit, 9-DOF hybrid fit started from it with `--reduce`), and compare, per key parameter,
+//! seeds, identify each one with the single verbs (`frf`, `fit` 6-DOF, `fit` 9-DOF hybrid
+//! started from it with `--reduce`; unlike `sweephold campaign`, no trim points and the
+//! `frf` defaults), and compare, per key parameter,
 //! the spread of the 20 estimates (sample standard deviation σ) with the mean Cramér–Rao
 //! bound the fits reported for it (CR_abs = CR % · |value| / 100). A bound is honest when
 //! σ / mean(CR_abs) lies within [1/3, 3]. Prints the table; exits non-zero when a
