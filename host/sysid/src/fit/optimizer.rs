@@ -154,6 +154,15 @@ where
         let normal = jacobian.tr_mul(&jacobian);
         let gradient = jacobian.tr_mul(&residual);
         let held: Vec<bool> = (0..n).map(|i| bounds.holds(&x, &gradient, i)).collect();
+        // The system the steps of this iteration solve: a held parameter decoupled (its
+        // row and column zero; its diagonal is set per λ below) with a zero right-hand side.
+        let mut system = normal.clone();
+        let mut descent = -&gradient;
+        for i in (0..n).filter(|&i| held[i]) {
+            system.row_mut(i).fill(0.0);
+            system.column_mut(i).fill(0.0);
+            descent[i] = 0.0;
+        }
         // Stationarity (MINPACK's gtol) of the free parameters: the residual is orthogonal
         // to every Jacobian column, max_i |J_iᵀr| / (‖J_i‖·‖r‖) ≤ tolerance.
         let residual_norm = cost.sqrt();
@@ -182,17 +191,14 @@ where
         let mut accepted = false;
         let mut step_small = false;
         while lambda < 1e16 {
-            let mut damped = normal.clone();
-            let mut descent = -&gradient;
+            let mut damped = system.clone();
             for i in 0..n {
-                damped[(i, i)] += lambda * scaling[i];
-            }
-            for i in (0..n).filter(|&i| held[i]) {
-                // Held on its bound: decoupled, with a zero step.
-                damped.row_mut(i).fill(0.0);
-                damped.column_mut(i).fill(0.0);
-                damped[(i, i)] = 1.0;
-                descent[i] = 0.0;
+                // A held parameter's pivot is 1 whatever λ: its step is exactly zero.
+                damped[(i, i)] = if held[i] {
+                    1.0
+                } else {
+                    damped[(i, i)] + lambda * scaling[i]
+                };
             }
             let Some(cholesky) = damped.cholesky() else {
                 lambda *= nu;
