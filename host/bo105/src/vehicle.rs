@@ -9,6 +9,13 @@
 use std::fmt;
 use std::str::FromStr;
 
+use aircraft::Aircraft;
+
+/// A shipped aircraft file; the `aircraft` crate's tests read every one of them.
+fn shipped(name: &str) -> Aircraft {
+    aircraft::shipped(name).expect("a shipped aircraft")
+}
+
 /// Which aircraft to simulate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Vehicle {
@@ -22,10 +29,12 @@ pub enum Vehicle {
 impl Vehicle {
     /// The parameter set of this vehicle.
     pub fn helicopter(self) -> Helicopter {
-        match self {
-            Vehicle::Bo105 => Helicopter::bo105(),
-            Vehicle::Trex700l => Helicopter::trex700l(),
-        }
+        Helicopter::from_aircraft(&self.aircraft())
+    }
+
+    /// This vehicle's shipped aircraft file.
+    pub fn aircraft(self) -> Aircraft {
+        shipped(self.name())
     }
 
     /// The lower-case name used on the command line.
@@ -200,7 +209,7 @@ impl Gearing {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Helicopter {
     /// Display name.
-    pub name: &'static str,
+    pub name: String,
     /// Mass \[kg\].
     pub mass: f64,
     /// Roll inertia I_xx [kg·m²].
@@ -234,166 +243,79 @@ pub struct Helicopter {
 }
 
 impl Helicopter {
-    /// The MBB Bo-105 from Padfield's Helisim data.
-    ///
-    /// Gearing (positive stick produces a positive moment: lat → roll right, lon → nose up,
-    /// ped → nose right, col → up):
-    /// θ1c = −8°·lat (±8°), θ1s = +10°·lon (±10°), θ0_TR = 8.5° − 16.5°·ped (−8°…25°),
-    /// θ0 = 11° + 9°·col (2°…20°).
+    /// The MBB Bo-105 from Padfield's Helisim data: the shipped aircraft file `bo105`.
     pub fn bo105() -> Helicopter {
-        let deg = std::f64::consts::PI / 180.0;
-        Helicopter {
-            name: "Bo-105",
-            mass: 2200.0,
-            ixx: 1433.0,
-            iyy: 4973.0,
-            izz: 4099.0,
-            ixz: 660.0,
-            air_density: 1.225,
-            gravity: 9.80665,
-            main_rotor: Rotor {
-                radius: 4.91,
-                omega: 44.4,
-                blades: 4.0,
-                chord: 0.27,
-                twist: -0.14,
-                lift_slope: 6.113,
-                flap_inertia: 231.7,
-                hub_stiffness: 113_330.0,
-                profile_drag: [0.0074, 38.66],
-                // CG 0.0163 R forward of the shaft, hub 1.48 m above the CG.
-                hub: [-0.0163 * 4.91, 0.0, -1.48],
-            },
-            shaft_tilt: 0.0524,
-            tail_rotor: Rotor {
-                radius: 0.95,
-                omega: 2220.0 * 2.0 * std::f64::consts::PI / 60.0,
-                blades: 2.0,
-                chord: 0.18,
-                twist: 0.0,
-                lift_slope: 5.7,
-                flap_inertia: 1.0,
-                hub_stiffness: 0.0,
-                profile_drag: [0.008, 9.5],
-                hub: [-6.0, 0.0, -1.72],
-            },
-            fuselage_drag_area: [1.4, 8.0, 10.0],
-            fin: Surface {
-                area: 0.805,
-                incidence: 0.0812,
-                lift_slope: 2.704,
-                position: [-5.4, 0.0, -0.9],
-                stall_angle: 0.35,
-            },
-            tailplane: Surface {
-                area: 0.803,
-                incidence: 0.0698,
-                lift_slope: 3.262,
-                position: [-4.56, 0.0, -0.2],
-                stall_angle: 0.35,
-            },
-            gearing: [
-                Gearing {
-                    centre: 0.0,
-                    gain: -8.0 * deg,
-                },
-                Gearing {
-                    centre: 0.0,
-                    gain: 10.0 * deg,
-                },
-                Gearing {
-                    centre: 8.5 * deg,
-                    gain: -16.5 * deg,
-                },
-                Gearing {
-                    centre: 11.0 * deg,
-                    gain: 9.0 * deg,
-                },
-            ],
-        }
+        Helicopter::from_aircraft(&shipped("bo105"))
     }
 
-    /// A TREX 700L-class RC helicopter. **Approximate**: no published identified model
-    /// exists; the numbers are typical of the class (1.56 m rotor, 5 kg, 1900 rpm,
-    /// flybarless, two blades of ~0.2 kg with 62 mm chord).
-    ///
-    /// The flybarless head is modelled as a stiff hub with an equivalent centre-spring
-    /// stiffness of 350 N·m/rad per blade (head dampers), chosen so the roll flap-moment
-    /// derivative L_β1s = (N_b K_β/2 + T h)/I_xx ≈ 3 000 s⁻², of the order of a first
-    /// 700-size estimate (3 588.6). The flap time constant follows from the blade
-    /// data (γ ≈ 3.4, Ω = 199 rad/s): τ_f ≈ 0.023 s. A hub spring can only shorten τ_f, so
-    /// that estimate's 0.068 s (at 1500 rpm) cannot be reached with 1900 rpm and real blades.
-    /// CCPM-120 mixing is a firmware concern: here the controls are the same four stick
-    /// fractions as for the Bo-105. Gearing: θ1c = −8°·lat, θ1s = +8°·lon,
-    /// θ0_TR = 5° − 25°·ped, θ0 = 2° + 12°·col.
+    /// A TREX 700L-class RC helicopter, **approximate** (no published identified model
+    /// exists): the shipped aircraft file `trex700l`, whose header says where its numbers
+    /// come from.
     pub fn trex700l() -> Helicopter {
-        let deg = std::f64::consts::PI / 180.0;
+        Helicopter::from_aircraft(&shipped("trex700l"))
+    }
+
+    /// The simulator's parameter set of an aircraft file. The tail rotor's flap data are
+    /// not used by the model (its blades do not flap) and are set to 1 kg·m² and 0.
+    pub fn from_aircraft(aircraft: &Aircraft) -> Helicopter {
+        let xyz = |q: &[aircraft::Quantity; 3]| [q[0].value, q[1].value, q[2].value];
+        let pair = |q: &[aircraft::Quantity; 2]| [q[0].value, q[1].value];
+        let m = &aircraft.main_rotor;
+        let t = &aircraft.tail_rotor;
+        let surface = |s: &aircraft::Surface| Surface {
+            area: s.area.value,
+            incidence: s.incidence.value,
+            lift_slope: s.lift_slope.value,
+            position: xyz(&s.position),
+            stall_angle: s.stall_angle.value,
+        };
+        let gearing = |g: &aircraft::Gearing| Gearing {
+            centre: g.centre.value,
+            gain: g.per_stick.value,
+        };
+        let c = &aircraft.controls;
         Helicopter {
-            name: "TREX 700L class (approximate)",
-            mass: 5.0,
-            ixx: 0.12,
-            iyy: 0.40,
-            izz: 0.35,
-            ixz: 0.0,
-            air_density: 1.225,
-            gravity: 9.80665,
+            name: aircraft.title.clone(),
+            mass: aircraft.airframe.mass.value,
+            ixx: aircraft.airframe.ixx.value,
+            iyy: aircraft.airframe.iyy.value,
+            izz: aircraft.airframe.izz.value,
+            ixz: aircraft.airframe.ixz.value,
+            air_density: aircraft.environment.air_density.value,
+            gravity: aircraft.environment.gravity.value,
             main_rotor: Rotor {
-                radius: 0.78,
-                omega: 1900.0 * 2.0 * std::f64::consts::PI / 60.0,
-                blades: 2.0,
-                chord: 0.062,
-                twist: 0.0,
-                lift_slope: 5.5,
-                flap_inertia: 0.046,
-                hub_stiffness: 350.0,
-                profile_drag: [0.012, 0.0],
-                hub: [0.0, 0.0, -0.25],
+                radius: m.radius.value,
+                omega: m.head_speed.value,
+                blades: f64::from(m.blades),
+                chord: m.chord.value,
+                twist: m.twist.value,
+                lift_slope: m.lift_slope.value,
+                flap_inertia: m.flap_inertia.value,
+                hub_stiffness: m.hub_stiffness.value,
+                profile_drag: pair(&m.profile_drag),
+                hub: xyz(&m.hub),
             },
-            shaft_tilt: 0.0,
+            shaft_tilt: m.shaft_tilt.value,
             tail_rotor: Rotor {
-                radius: 0.135,
-                omega: 1900.0 * 4.7 * 2.0 * std::f64::consts::PI / 60.0,
-                blades: 2.0,
-                chord: 0.032,
-                twist: 0.0,
-                lift_slope: 5.0,
+                radius: t.radius.value,
+                omega: t.speed.value,
+                blades: f64::from(t.blades),
+                chord: t.chord.value,
+                twist: t.twist.value,
+                lift_slope: t.lift_slope.value,
                 flap_inertia: 1.0,
                 hub_stiffness: 0.0,
-                profile_drag: [0.012, 0.0],
-                hub: [-0.95, 0.0, -0.12],
+                profile_drag: pair(&t.profile_drag),
+                hub: xyz(&t.hub),
             },
-            fuselage_drag_area: [0.03, 0.10, 0.12],
-            fin: Surface {
-                area: 0.012,
-                incidence: 0.0,
-                lift_slope: 3.0,
-                position: [-0.90, 0.0, -0.05],
-                stall_angle: 0.35,
-            },
-            tailplane: Surface {
-                area: 0.010,
-                incidence: 0.0,
-                lift_slope: 3.0,
-                position: [-0.70, 0.0, 0.0],
-                stall_angle: 0.35,
-            },
+            fuselage_drag_area: xyz(&aircraft.airframe.drag_area),
+            fin: surface(&aircraft.fin),
+            tailplane: surface(&aircraft.tailplane),
             gearing: [
-                Gearing {
-                    centre: 0.0,
-                    gain: -8.0 * deg,
-                },
-                Gearing {
-                    centre: 0.0,
-                    gain: 8.0 * deg,
-                },
-                Gearing {
-                    centre: 5.0 * deg,
-                    gain: -25.0 * deg,
-                },
-                Gearing {
-                    centre: 2.0 * deg,
-                    gain: 12.0 * deg,
-                },
+                gearing(&c.lat),
+                gearing(&c.lon),
+                gearing(&c.ped),
+                gearing(&c.col),
             ],
         }
     }

@@ -1,4 +1,5 @@
-//! `sweephold sim`: trim and linearize the simulated helicopters (crate `bo105`).
+//! `sweephold sim`: trim and linearize a simulated helicopter (crate `bo105`): a shipped
+//! aircraft or an aircraft file.
 //!
 //! ```text
 //! sweephold sim trim      --vehicle bo105 [--speed KT] [--json]
@@ -13,10 +14,9 @@ use std::fmt::Write as _;
 
 use std::path::PathBuf;
 
+use aircraft::Aircraft;
 use anyhow::{anyhow, Context};
-use bo105::{
-    linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim, Vehicle,
-};
+use bo105::{linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim};
 use clap::{Args, Subcommand};
 use serde_json::{json, Map, Value};
 use sysid::fit::trim::{TrimPoint, TrimPoints};
@@ -45,8 +45,8 @@ pub enum SimCommand {
 /// Arguments of `sim trim-points`.
 #[derive(Args, Debug)]
 pub struct TrimPointsArgs {
-    /// Vehicle: bo105 or trex700l.
-    #[arg(long, default_value = "bo105", value_name = "NAME")]
+    /// Vehicle: a shipped aircraft (bo105, trex700l) or the path of an aircraft file.
+    #[arg(long, default_value = "bo105", value_name = "NAME|FILE")]
     pub vehicle: String,
     /// Write the CSV here (atomically) instead of to standard output.
     #[arg(long, value_name = "FILE")]
@@ -70,10 +70,10 @@ pub const TRIM_FLIGHTS: [(&str, [f64; 3], f64); 9] = [
     ("turn left", [0.0, 0.0, 0.0], -0.1),
 ];
 
-/// The trim points of `vehicle` at [`TRIM_FLIGHTS`]: what a pilot would record flying
-/// them, taken from the nonlinear model's trims (exact: no measurement noise).
-pub fn simulator_trim_points(vehicle: Vehicle) -> anyhow::Result<TrimPoints> {
-    let heli = vehicle.helicopter();
+/// The trim points of `heli` (called `name` in messages) at [`TRIM_FLIGHTS`]: what a
+/// pilot would record flying them, taken from the nonlinear model's trims (exact: no
+/// measurement noise).
+pub fn simulator_trim_points(heli: &Helicopter, name: &str) -> anyhow::Result<TrimPoints> {
     let points = TRIM_FLIGHTS
         .iter()
         .map(|&(label, velocity_ned, turn_rate)| {
@@ -81,8 +81,8 @@ pub fn simulator_trim_points(vehicle: Vehicle) -> anyhow::Result<TrimPoints> {
                 velocity_ned,
                 turn_rate,
             };
-            let t = trim_steady(&heli, &flight)
-                .with_context(|| format!("{} trim point `{label}`", vehicle.name()))?;
+            let t = trim_steady(heli, &flight)
+                .with_context(|| format!("{name} trim point `{label}`"))?;
             let x = &t.state.0;
             let mut states = [0.0; 8];
             states.copy_from_slice(&x[..8]);
@@ -99,8 +99,8 @@ pub fn simulator_trim_points(vehicle: Vehicle) -> anyhow::Result<TrimPoints> {
 /// Which aircraft and flight condition.
 #[derive(Args, Debug)]
 pub struct CaseArgs {
-    /// Vehicle: bo105 or trex700l.
-    #[arg(long, default_value = "bo105", value_name = "NAME")]
+    /// Vehicle: a shipped aircraft (bo105, trex700l) or the path of an aircraft file.
+    #[arg(long, default_value = "bo105", value_name = "NAME|FILE")]
     pub vehicle: String,
     /// Forward speed in knots (0 = hover).
     #[arg(
@@ -134,7 +134,7 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
         SimCommand::Trim(case) => {
             let (vehicle, heli, trimmed) = trimmed_case(case)?;
             if case.json {
-                serde_json::to_string_pretty(&trim_json(vehicle, &heli, &trimmed))? + "\n"
+                serde_json::to_string_pretty(&trim_json(&vehicle, &heli, &trimmed))? + "\n"
             } else {
                 trim_table(&heli, &trimmed)
             }
@@ -143,14 +143,16 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
             let (vehicle, heli, trimmed) = trimmed_case(&lin.case)?;
             let model = linearize_with(&heli, &trimmed, lin.dynamic_inflow);
             if lin.case.json {
-                serde_json::to_string_pretty(&linearization_json(vehicle, &trimmed, &model))? + "\n"
+                serde_json::to_string_pretty(&linearization_json(&vehicle, &trimmed, &model))?
+                    + "\n"
             } else {
                 linearization_table(&heli, &trimmed, &model)
             }
         }
         SimCommand::TrimPoints(points) => {
-            let vehicle: Vehicle = points.vehicle.parse().map_err(|e| anyhow!("{e}"))?;
-            let csv = simulator_trim_points(vehicle)?.to_csv();
+            let vehicle = aircraft::resolve(&points.vehicle)?;
+            let heli = Helicopter::from_aircraft(&vehicle);
+            let csv = simulator_trim_points(&heli, &vehicle.name)?.to_csv();
             match &points.out {
                 Some(path) => {
                     crate::output::write_atomic(path, csv.as_bytes())?;
@@ -165,24 +167,23 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
 }
 
 /// Parse the vehicle and speed and trim.
-fn trimmed_case(case: &CaseArgs) -> anyhow::Result<(Vehicle, Helicopter, Trim)> {
-    let vehicle: Vehicle = case.vehicle.parse().map_err(|e| anyhow!("{e}"))?;
+fn trimmed_case(case: &CaseArgs) -> anyhow::Result<(Aircraft, Helicopter, Trim)> {
+    let vehicle = aircraft::resolve(&case.vehicle)?;
     let speed: f64 = case.speed.trim().parse().map_err(|_| {
         anyhow!(
             "invalid --speed `{}`: expected a number of knots",
             case.speed
         )
     })?;
-    let heli = vehicle.helicopter();
-    let trimmed =
-        trim(&heli, speed).with_context(|| format!("{} at {speed} kt", vehicle.name()))?;
+    let heli = Helicopter::from_aircraft(&vehicle);
+    let trimmed = trim(&heli, speed).with_context(|| format!("{} at {speed} kt", vehicle.name))?;
     Ok((vehicle, heli, trimmed))
 }
 
-fn trim_json(vehicle: Vehicle, heli: &Helicopter, t: &Trim) -> Value {
+fn trim_json(vehicle: &Aircraft, heli: &Helicopter, t: &Trim) -> Value {
     let p = t.blade_pitch_rad;
     json!({
-        "vehicle": vehicle.name(),
+        "vehicle": vehicle.name,
         "speed_kt": t.speed_kt,
         "controls": { "lat": t.controls[0], "lon": t.controls[1], "ped": t.controls[2], "col": t.controls[3] },
         "blade_pitch_deg": {
@@ -203,7 +204,7 @@ fn matrix_json(rows: &[Vec<f64>]) -> Value {
     Value::Array(rows.iter().map(|row| json!(row)).collect())
 }
 
-fn linearization_json(vehicle: Vehicle, t: &Trim, lin: &Linearization) -> Value {
+fn linearization_json(vehicle: &Aircraft, t: &Trim, lin: &Linearization) -> Value {
     let eig = |values: &[(f64, f64)]| {
         Value::Array(
             values
@@ -218,7 +219,7 @@ fn linearization_json(vehicle: Vehicle, t: &Trim, lin: &Linearization) -> Value 
         .map(|(k, v)| (k.clone(), json!(v)))
         .collect();
     json!({
-        "vehicle": vehicle.name(),
+        "vehicle": vehicle.name,
         "speed_kt": t.speed_kt,
         "states": lin.states,
         "controls": lin.controls,
@@ -385,13 +386,13 @@ mod tests {
     #[test]
     fn json_documents_have_the_documented_keys() {
         let (vehicle, heli, t) = trimmed_case(&case("bo105", "20")).unwrap();
-        let doc = trim_json(vehicle, &heli, &t);
+        let doc = trim_json(&vehicle, &heli, &t);
         for key in ["controls", "blade_pitch_deg", "attitude_deg", "residual"] {
             assert!(doc.get(key).is_some(), "{key}");
         }
         assert!(doc["controls"]["col"].is_f64());
         let lin = linearize_with(&heli, &t, false);
-        let doc = linearization_json(vehicle, &t, &lin);
+        let doc = linearization_json(&vehicle, &t, &lin);
         for key in [
             "states",
             "controls",

@@ -68,13 +68,14 @@ pub fn with_vehicle_data(
     // The hub is at body (x, z) = (hub[0], hub[2]) from the CG, z down: its height above
     // the CG is −hub[2].
     let hub = helicopter.main_rotor.hub;
-    let servo = bo105::SimOptions::default().actuator;
+    // The servos of the aircraft file, which `sweephold fly` flies with too.
+    let servo = bo105::ActuatorModel::from_aircraft(&vehicle.aircraft());
     let mut constants = BTreeMap::from([
         ("hub_height".to_string(), -hub[2]),
         ("hub_forward".to_string(), hub[0]),
         ("shaft_tilt_sine".to_string(), helicopter.shaft_tilt.sin()),
         ("gravity".to_string(), helicopter.gravity),
-        // The servos `sweephold fly` flies with (a file with `[actuators]` declares these).
+        // A structure file with `[actuators]` declares these.
         (
             "servo_natural_frequency".to_string(),
             servo.natural_frequency_rad_s,

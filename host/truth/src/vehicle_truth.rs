@@ -1,7 +1,7 @@
 //! The simulator's linear truth: a vehicle trimmed in hover and linearized, its servos'
 //! equivalent delay, and the simulator's names for the body states and controls.
 
-use bo105::{linearize, trim, ActuatorModel, Linearization, SimOptions, Vehicle};
+use bo105::{linearize, trim, ActuatorModel, Linearization, Vehicle};
 use sysid::fit::Model;
 
 use crate::Error;
@@ -18,21 +18,21 @@ pub struct VehicleTruth {
     pub vehicle: Vehicle,
     /// Linearization at hover trim (flapping states included, quasi-static derivatives).
     pub linearization: Linearization,
-    /// Equivalent delay of the default servos: 2ζ/ω_n + transport delay \[s\].
+    /// Equivalent delay of the aircraft's servos: 2ζ/ω_n + transport delay \[s\].
     pub actuator_delay_s: f64,
-    /// The default servos themselves (a structure with `[actuators]` models their lag,
+    /// The aircraft's servos themselves (a structure with `[actuators]` models their lag,
     /// and its delays are the transport delay alone).
     pub actuator: ActuatorModel,
 }
 
 impl VehicleTruth {
-    /// Trim `vehicle` at hover and linearize it; the servos are `SimOptions::default()`'s,
-    /// the ones `sweephold fly` flies with.
+    /// Trim `vehicle` at hover and linearize it; the servos are its aircraft file's, the
+    /// ones `sweephold fly` flies with.
     pub fn at_hover(vehicle: Vehicle) -> Result<VehicleTruth, Error> {
         let heli = vehicle.helicopter();
         let trimmed = trim(&heli, 0.0).map_err(|source| Error::Trim { vehicle, source })?;
         let linearization = linearize(&heli, &trimmed);
-        let actuator = SimOptions::default().actuator;
+        let actuator = ActuatorModel::from_aircraft(&vehicle.aircraft());
         let servo_lag = if actuator.natural_frequency_rad_s.is_finite()
             && actuator.natural_frequency_rad_s > 0.0
         {

@@ -16,6 +16,17 @@ pub struct ActuatorModel {
 }
 
 impl ActuatorModel {
+    /// The servos an aircraft file describes.
+    pub fn from_aircraft(aircraft: &aircraft::Aircraft) -> ActuatorModel {
+        let servos = &aircraft.servos;
+        ActuatorModel {
+            natural_frequency_rad_s: servos.natural_frequency.value,
+            damping: servos.damping.value,
+            rate_limit_per_s: servos.rate_limit.value,
+            transport_delay_s: servos.transport_delay.value,
+        }
+    }
+
     /// Instant actuators, no delay.
     pub fn ideal() -> ActuatorModel {
         ActuatorModel {

@@ -77,7 +77,8 @@ impl Campaign<'_> {
             return Ok(None);
         }
         self.stage(Stage::TrimPoints, |run| {
-            let points = crate::sim::simulator_trim_points(run.args.vehicle.sim())?;
+            let vehicle = run.args.vehicle.sim();
+            let points = crate::sim::simulator_trim_points(&vehicle.helicopter(), vehicle.name())?;
             write_atomic(
                 &run.dir().join(files::TRIM_POINTS),
                 points.to_csv().as_bytes(),

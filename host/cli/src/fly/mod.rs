@@ -616,7 +616,10 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
 
 /// The simulator's options for `args` (before the seed and the disturbances).
 fn sim_options(args: &FlyArgs) -> bo105::SimOptions {
-    let mut sim_options = bo105::SimOptions::default();
+    let mut sim_options = bo105::SimOptions {
+        actuator: bo105::ActuatorModel::from_aircraft(&args.vehicle.sim().aircraft()),
+        ..bo105::SimOptions::default()
+    };
     if args.perfect_sensors {
         // Sensors only: the actuators keep their servo dynamics and delay.
         sim_options.sensor_noise = bo105::SensorNoise::perfect();

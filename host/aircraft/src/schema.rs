@@ -1,0 +1,131 @@
+//! The aircraft file's tables and keys exactly as written, before units and ranges are
+//! checked: every value keeps its place in the file ([`Spanned`]) so that a later check
+//! can name the line. Unknown keys and missing keys are refused here, by serde.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::quantity::Written;
+
+/// A written value with its place in the file.
+pub(crate) type Value = Spanned<RawValue>;
+/// A written list of values with its place in the file.
+pub(crate) type Values = Spanned<Vec<Value>>;
+
+/// A number or a string, as TOML holds it.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub(crate) enum RawValue {
+    Number(f64),
+    Text(String),
+}
+
+impl RawValue {
+    pub(crate) fn written(&self) -> Written {
+        match self {
+            RawValue::Number(x) => Written::Number(*x),
+            RawValue::Text(text) => Written::Text(text.clone()),
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct File {
+    pub name: Spanned<String>,
+    pub title: Option<String>,
+    #[serde(default)]
+    pub description: String,
+    pub environment: Environment,
+    pub airframe: Airframe,
+    pub main_rotor: MainRotor,
+    pub tail_rotor: TailRotor,
+    pub fin: Surface,
+    pub tailplane: Surface,
+    pub controls: Controls,
+    pub servos: Servos,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Environment {
+    pub air_density: Value,
+    pub gravity: Value,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Airframe {
+    pub mass: Value,
+    pub ixx: Value,
+    pub iyy: Value,
+    pub izz: Value,
+    pub ixz: Value,
+    pub drag_area: Values,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct MainRotor {
+    pub radius: Value,
+    pub head_speed: Value,
+    pub rotation: Spanned<String>,
+    pub blades: Value,
+    pub chord: Value,
+    pub twist: Value,
+    pub lift_slope: Value,
+    pub flap_inertia: Value,
+    pub hub_stiffness: Value,
+    pub profile_drag: Values,
+    pub hub: Values,
+    pub shaft_tilt: Value,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TailRotor {
+    pub radius: Value,
+    pub speed: Option<Value>,
+    pub gear_ratio: Option<Value>,
+    pub blades: Value,
+    pub chord: Value,
+    pub twist: Value,
+    pub lift_slope: Value,
+    pub profile_drag: Values,
+    pub hub: Values,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Surface {
+    pub area: Value,
+    pub incidence: Value,
+    pub lift_slope: Value,
+    pub position: Values,
+    pub stall_angle: Value,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Controls {
+    pub lat: Gearing,
+    pub lon: Gearing,
+    pub ped: Gearing,
+    pub col: Gearing,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Gearing {
+    pub centre: Value,
+    pub per_stick: Value,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Servos {
+    pub natural_frequency: Value,
+    pub damping: Value,
+    pub rate_limit: Value,
+    pub transport_delay: Value,
+}

@@ -1,0 +1,281 @@
+//! Malformed aircraft files: each is the shipped TREX 700L file with one change, and each
+//! must be refused with one line that names the file, the line and the field.
+
+const TREX: &str = aircraft::SHIPPED[1].1;
+
+/// (what is wrong, text replaced, replacement, fragment the message must hold)
+const CASES: &[(&str, &str, &str, &str)] = &[
+    (
+        "missing field",
+        "mass = \"5.0 kg\"\n",
+        "",
+        "missing field `mass`",
+    ),
+    (
+        "missing table",
+        "[servos]",
+        "[servo_data]",
+        "unknown field `servo_data`",
+    ),
+    (
+        "unknown key",
+        "ixz = \"0 kg*m^2\"",
+        "ixz = \"0 kg*m^2\"\niyz = \"0 kg*m^2\"",
+        "unknown field `iyz`",
+    ),
+    (
+        "misspelt key",
+        "head_speed =",
+        "headspeed =",
+        "unknown field `headspeed`",
+    ),
+    (
+        "mass in metres",
+        "mass = \"5.0 kg\"",
+        "mass = \"5.0 m\"",
+        "airframe.mass: `5.0 m`: unit `m` is not one of kg, g",
+    ),
+    (
+        "mass without unit",
+        "mass = \"5.0 kg\"",
+        "mass = 5.0",
+        "airframe.mass: `5` has no unit",
+    ),
+    (
+        "zero mass",
+        "mass = \"5.0 kg\"",
+        "mass = \"0 kg\"",
+        "airframe.mass: 0 must be positive",
+    ),
+    (
+        "negative inertia",
+        "ixx = \"0.12 kg*m^2\"",
+        "ixx = \"-0.12 kg*m^2\"",
+        "airframe.ixx: -0.12 must be positive",
+    ),
+    (
+        "NaN radius",
+        "radius = \"0.78 m\"",
+        "radius = \"nan m\"",
+        "main_rotor.radius: the value is not a finite number",
+    ),
+    (
+        "NaN as a TOML float",
+        "damping = 0.7",
+        "damping = nan",
+        "servos.damping: the value is not a finite number",
+    ),
+    (
+        "infinite chord",
+        "chord = \"0.062 m\"",
+        "chord = \"inf m\"",
+        "main_rotor.chord: the value is not a finite number",
+    ),
+    (
+        "sigma above the value",
+        "iyy = \"0.40 kg*m^2\"",
+        "iyy = \"0.40 ± 0.5 kg*m^2\"",
+        "airframe.iyy: the uncertainty 0.5 is not smaller than the value 0.4",
+    ),
+    (
+        "negative sigma",
+        "izz = \"0.35 kg*m^2\"",
+        "izz = \"0.35 +- -0.01 kg*m^2\"",
+        "airframe.izz: `0.35 +- -0.01 kg*m^2`: the uncertainty must not be negative",
+    ),
+    (
+        "head speed in rad/s written as rpm",
+        "head_speed = \"1900 rpm\"",
+        "head_speed = \"1900 rad/s\"",
+        "main_rotor.head_speed: 1900 must be positive and at most 500 rad/s",
+    ),
+    (
+        "supersonic tip",
+        "head_speed = \"1900 rpm\"",
+        "head_speed = \"4000 rpm\"",
+        "main_rotor.head_speed: tip speed 327 m/s is above Mach 0.9",
+    ),
+    (
+        "half a blade",
+        "blades = 2\nchord = \"0.062 m\"",
+        "blades = 2.5\nchord = \"0.062 m\"",
+        "main_rotor.blades: 2.5 is not a whole number of blades",
+    ),
+    (
+        "one-bladed main rotor",
+        "blades = 2\nchord = \"0.062 m\"",
+        "blades = 1\nchord = \"0.062 m\"",
+        "main_rotor.blades: a main rotor has at least 2 blades",
+    ),
+    (
+        "inertias no body has",
+        "izz = \"0.35 kg*m^2\"",
+        "izz = \"0.60 kg*m^2\"",
+        "airframe.izz: 0.6 kg*m^2 exceeds the sum of the other two inertias",
+    ),
+    (
+        "product of inertia too large",
+        "ixz = \"0 kg*m^2\"",
+        "ixz = \"0.3 kg*m^2\"",
+        "airframe.ixz: I_xz² must be smaller than I_xx·I_zz",
+    ),
+    (
+        "tail rotor larger than the main rotor",
+        "radius = \"0.135 m\"",
+        "radius = \"0.9 m\"",
+        "tail_rotor.radius: 0.9 m is not smaller than the main rotor's 0.78 m",
+    ),
+    (
+        "tail rotor ahead of the CG",
+        "hub = [\"-0.95 m\"",
+        "hub = [\"0.95 m\"",
+        "tail_rotor.hub[0]: the tail rotor must be behind the CG",
+    ),
+    (
+        "tail speed twice",
+        "speed = \"8930 rpm\"",
+        "speed = \"8930 rpm\"\ngear_ratio = 4.7",
+        "tail_rotor.speed: give speed or gear_ratio, not both",
+    ),
+    (
+        "tail speed missing",
+        "speed = \"8930 rpm\"\n",
+        "",
+        "tail_rotor.speed: missing: give speed or gear_ratio",
+    ),
+    (
+        "position with two coordinates",
+        "position = [\"-0.90 m\", \"0 m\", \"-0.05 m\"]",
+        "position = [\"-0.90 m\", \"0 m\"]",
+        "fin.position: expected 3 values, found 2",
+    ),
+    (
+        "gearing that moves nothing",
+        "per_stick = \"8 deg\"",
+        "per_stick = \"0 deg\"",
+        "controls.lon.per_stick: must not be zero",
+    ),
+    (
+        "gearing in a unit of length",
+        "per_stick = \"-25 deg\"",
+        "per_stick = \"-25 mm\"",
+        "controls.ped.per_stick: `-25 mm`: unit `mm` is not one of rad, deg, °",
+    ),
+    (
+        "clockwise rotor",
+        "rotation = \"counterclockwise\"",
+        "rotation = \"clockwise\"",
+        "main_rotor.rotation: the simulator models rotors turning counterclockwise",
+    ),
+    (
+        "unknown rotation",
+        "rotation = \"counterclockwise\"",
+        "rotation = \"sideways\"",
+        "main_rotor.rotation: `sideways`: expected counterclockwise or clockwise",
+    ),
+    (
+        "servo damping with a unit",
+        "damping = 0.7",
+        "damping = \"0.7 s\"",
+        "servos.damping: `0.7 s`: a dimensionless value takes no unit",
+    ),
+    (
+        "servo rate of zero",
+        "rate_limit = \"4 /s\"",
+        "rate_limit = \"0 /s\"",
+        "servos.rate_limit: 0 must be positive",
+    ),
+    (
+        "air on the moon",
+        "gravity = \"9.80665 m/s^2\"",
+        "gravity = \"1.62 m/s^2\"",
+        "environment.gravity: 1.62 must be between 9.7 and 9.9",
+    ),
+    (
+        "profile drag out of range",
+        "profile_drag = [0.012, 0.0]\nhub = [\"0 m\"",
+        "profile_drag = [0.5, 0.0]\nhub = [\"0 m\"",
+        "main_rotor.profile_drag[0]: δ0 = 0.5 must be at most 0.1",
+    ),
+    (
+        "name with a space",
+        "name = \"trex700l\"",
+        "name = \"trex 700l\"",
+        "name: must be a non-empty word",
+    ),
+    ("not TOML", "[airframe]", "[airframe", "unclosed table"),
+    (
+        "text where a number belongs",
+        "blades = 2\nchord = \"0.032 m\"",
+        "blades = \"two\"\nchord = \"0.032 m\"",
+        "tail_rotor.blades: `two`: `two` is not a number",
+    ),
+];
+
+#[test]
+fn every_malformed_file_is_refused_on_one_line_naming_the_field() {
+    assert!(CASES.len() >= 20);
+    for (what, from, to, expected) in CASES {
+        assert!(
+            TREX.contains(from),
+            "{what}: `{from}` is not in the shipped file"
+        );
+        let text = TREX.replacen(from, to, 1);
+        let error = aircraft::parse(&text, "variant.toml")
+            .err()
+            .unwrap_or_else(|| panic!("{what}: accepted"))
+            .to_string();
+        assert!(
+            error.contains(expected),
+            "{what}: `{error}` lacks `{expected}`"
+        );
+        assert!(!error.contains('\n'), "{what}: more than one line: {error}");
+        assert!(error.starts_with("variant.toml:"), "{what}: {error}");
+    }
+}
+
+#[test]
+fn a_field_error_names_the_line_of_the_value() {
+    let text = TREX.replace("mass = \"5.0 kg\"", "mass = \"-5 kg\"");
+    let line = 1 + text.lines().position(|l| l.starts_with("mass =")).unwrap();
+    let error = aircraft::parse(&text, "variant.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.starts_with(&format!("variant.toml:{line}: airframe.mass:")),
+        "{error}"
+    );
+}
+
+#[test]
+fn the_shipped_files_read_and_a_file_on_disk_reads_like_its_text() {
+    for (name, text) in aircraft::SHIPPED {
+        let parsed = aircraft::parse(text, name).unwrap();
+        assert_eq!(parsed.name, name);
+        assert_eq!(aircraft::shipped(name).unwrap(), parsed);
+    }
+    let dir = std::env::temp_dir().join(format!("aircraft-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("heavier.toml");
+    let text = TREX
+        .replace("name = \"trex700l\"", "name = \"heavier\"")
+        .replace("mass = \"5.0 kg\"", "mass = \"5.6 ± 0.1 kg\"");
+    std::fs::write(&path, &text).unwrap();
+    let read = aircraft::resolve(path.to_str().unwrap()).unwrap();
+    assert_eq!(read.name, "heavier");
+    assert_eq!(
+        read.airframe.mass,
+        aircraft::Quantity {
+            value: 5.6,
+            sigma: Some(0.1)
+        }
+    );
+    let missing = aircraft::resolve(dir.join("none.toml").to_str().unwrap()).unwrap_err();
+    assert!(missing.to_string().contains("none.toml"), "{missing}");
+    let unknown = aircraft::resolve("ec135").unwrap_err().to_string();
+    assert_eq!(
+        unknown,
+        "unknown vehicle `ec135`: expected bo105, trex700l or the path of an aircraft file"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
