@@ -2,7 +2,7 @@
 """The identification bars of a vehicle's default campaign over a range of seeds.
 
     cargo build --release -p sweephold
-    python3 docs/bars.py [--vehicle bo105|trex700l] [--seeds 1-10] [--out DIR] [--reuse] [-- CAMPAIGN ARGS]
+    python3 docs/bars.py [--vehicle NAME|FILE] [--seeds 1-10] [--out DIR] [--reuse] [-- CAMPAIGN ARGS]
 
 Flies `sweephold campaign --vehicle V --seed N --out DIR/V-N` for each seed (unless
 --reuse finds a completed campaign there) and prints one Markdown row per seed and a count
@@ -109,7 +109,7 @@ def row(seed, summary, six):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--vehicle", default="bo105", choices=["bo105", "trex700l"])
+    parser.add_argument("--vehicle", default="bo105", help="a shipped aircraft (bo105, trex700l, fbl700) or an aircraft file")
     parser.add_argument("--seeds", default="1-10", help="e.g. 1-10")
     parser.add_argument("--out", default="out/bars")
     parser.add_argument("--reuse", action="store_true", help="keep completed campaigns in OUT")
@@ -123,7 +123,7 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|")
     counts, n = {}, 0
     for seed in seeds(args.seeds):
-        summary, six = campaign(args.vehicle, seed, os.path.join(args.out, f"{args.vehicle}-{seed}"), args.reuse, args.extra)
+        summary, six = campaign(args.vehicle, seed, os.path.join(args.out, f"{os.path.splitext(os.path.basename(args.vehicle))[0]}-{seed}"), args.reuse, args.extra)
         if summary is None:
             print(f"| {seed} | no summary.json |")
             continue

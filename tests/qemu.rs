@@ -296,13 +296,13 @@ fn qemu_refuses_a_bad_configuration_and_keeps_flying() {
         return;
     };
     use sweephold::fly::link::FlightControllerLink;
-    use sweephold::fly::VehicleArg;
+    use sweephold::vehicle::Vehicle;
     use sweephold_protocol::{Axis, SensorIn};
 
     let logs = Scratch::new("qemu-refusal");
     let mut link =
         QemuLink::new(&image, QemuTransport::Semihosting, &[]).with_log_folder(logs.path());
-    let mut bad = VehicleArg::Bo105.firmware_config(Axis::Ped);
+    let mut bad = Vehicle::shipped("bo105").firmware_config(Axis::Ped);
     bad.rate_hz = 20;
     let error = link.begin_record(&bad).expect_err("rate 20 Hz is refused");
     let text = error.to_string();
@@ -310,7 +310,7 @@ fn qemu_refuses_a_bad_configuration_and_keeps_flying() {
         text.contains("refused") && text.contains("tick rate outside 50-1000 Hz"),
         "{text}"
     );
-    link.begin_record(&VehicleArg::Bo105.firmware_config(Axis::Ped))
+    link.begin_record(&Vehicle::shipped("bo105").firmware_config(Axis::Ped))
         .expect("a valid configuration is accepted after a refusal");
     let mut telemetry = Vec::new();
     let input = SensorIn {

@@ -204,6 +204,14 @@ pub const fn paper_test(primary: Axis) -> TestConfig {
 }
 
 impl Config {
+    /// The preset of `vehicle` ([`Config::bo105_default`], [`Config::trex700l_default`]).
+    pub const fn preset(vehicle: VehicleId, primary: Axis) -> Self {
+        match vehicle {
+            VehicleId::Bo105 => Config::bo105_default(primary),
+            VehicleId::Trex700l => Config::trex700l_default(primary),
+        }
+    }
+
     /// Bo-105 (simulator) defaults at 200 Hz: [`paper_test`], 1 s trim capture,
     /// [`Gains::bo105`], [`SafetyLimits::bo105`], standard CCPM-120 mixer (unused by the
     /// simulator, which takes the commands).

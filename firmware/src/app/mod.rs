@@ -63,7 +63,7 @@ pub mod throttle;
 mod tests;
 
 use sweephold_protocol::{
-    Axis, Controls, Header, Measurements, Phase, PilotInput, ProtocolVersion, SensorIn,
+    Axis, Controls, Header, Measurements, Phase, PilotInput, ProtocolVersion, SensorIn, VehicleId,
 };
 
 use crate::attitude_hold::clamp_finite;
@@ -119,6 +119,14 @@ impl AppConfig {
             pilot: PilotModeGains::trex700l(),
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
+        }
+    }
+
+    /// The preset of `vehicle` ([`AppConfig::bo105`], [`AppConfig::trex700l`]).
+    pub const fn preset(vehicle: VehicleId, primary: Axis) -> Self {
+        match vehicle {
+            VehicleId::Bo105 => AppConfig::bo105(primary),
+            VehicleId::Trex700l => AppConfig::trex700l(primary),
         }
     }
 

@@ -10,8 +10,9 @@ use std::f64::consts::PI;
 use crate::quantity::{self, Dimension, Quantity};
 use crate::schema::{self, Value, Values};
 use crate::{
-    Aircraft, AircraftError, Airframe, Controls, Environment, Gearing, MainRotor, Rotation, Servos,
-    Surface, TailRotor,
+    Aircraft, AircraftError, Airframe, Controls, Environment, FlightController, Gearing,
+    Identification, MainRotor, Rotation, Servos, Surface, TailRotor, TrimBalance, ValidRanges,
+    FIRMWARE_PRESETS,
 };
 
 const DEG: f64 = PI / 180.0;
@@ -486,6 +487,9 @@ pub(crate) fn aircraft(
         )?,
     };
 
+    let flight_controller = flight_controller(&r, &file.flight_controller)?;
+    let identification = identification(&r, &file.identification)?;
+
     Ok(Aircraft {
         name: name.to_string(),
         title: file.title.as_deref().map_or(name, str::trim).to_string(),
@@ -498,6 +502,89 @@ pub(crate) fn aircraft(
         tailplane: r.surface(&file.tailplane, "tailplane")?,
         controls,
         servos,
+        flight_controller,
+        identification,
+    })
+}
+
+fn flight_controller(
+    r: &Reader,
+    f: &schema::FlightController,
+) -> Result<FlightController, AircraftError> {
+    let preset = f.preset.get_ref();
+    if !FIRMWARE_PRESETS.contains(&preset.as_str()) {
+        return Err(r.error(
+            f.preset.span().start,
+            "flight_controller.preset",
+            format!(
+                "`{preset}` is not a firmware preset ({})",
+                FIRMWARE_PRESETS.join(", ")
+            ),
+        ));
+    }
+    Ok(FlightController {
+        preset: preset.clone(),
+    })
+}
+
+fn identification(r: &Reader, i: &schema::Identification) -> Result<Identification, AircraftError> {
+    let bands = i.sweep_bands.get_ref();
+    if bands.len() != 2 {
+        return Err(r.error(
+            i.sweep_bands.span().start,
+            "identification.sweep_bands",
+            format!("expected 2 bands, found {}", bands.len()),
+        ));
+    }
+    let mut sweep_bands = [[0.0; 2]; 2];
+    for (k, (slot, band)) in sweep_bands.iter_mut().zip(bands).enumerate() {
+        let field = format!("identification.sweep_bands[{k}]");
+        let [low, high] =
+            r.values::<2>(band, &field, Dimension::AngularSpeed, Range::Positive(1e4))?;
+        if high.value <= low.value {
+            return Err(r.error(band.span().start, &field, "ω_max must exceed ω_min"));
+        }
+        *slot = [low.value, high.value];
+    }
+    let word = |written: &toml::Spanned<String>, field: &str, choices: &[&str]| {
+        let value = written.get_ref().as_str();
+        choices.iter().position(|c| *c == value).ok_or_else(|| {
+            r.error(
+                written.span().start,
+                field,
+                format!("`{value}`: expected {}", choices.join(" or ")),
+            )
+        })
+    };
+    let trim_balance = match word(
+        &i.trim_balance,
+        "identification.trim_balance",
+        &["hold", "joint"],
+    )? {
+        0 => TrimBalance::Hold,
+        _ => TrimBalance::Joint,
+    };
+    let valid_ranges = match word(
+        &i.valid_ranges,
+        "identification.valid_ranges",
+        &["estimate", "sweep-reference"],
+    )? {
+        0 => ValidRanges::Estimate,
+        _ => ValidRanges::SweepReference,
+    };
+    let structure = i.structure.get_ref().trim();
+    if structure.is_empty() {
+        return Err(r.error(
+            i.structure.span().start,
+            "identification.structure",
+            "must name a structure",
+        ));
+    }
+    Ok(Identification {
+        sweep_bands,
+        structure: structure.to_string(),
+        trim_balance,
+        valid_ranges,
     })
 }
 

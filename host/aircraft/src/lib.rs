@@ -8,7 +8,7 @@
 //! consistency between values (inertia triangle inequalities, tip speeds, blade count),
 //! and any problem is one line naming the file, line and field.
 //!
-//! The shipped aircraft (`bo105`, `trex700l`) are files in this crate's `vehicles/`
+//! The shipped aircraft (`bo105`, `trex700l`, `fbl700`) are files in this crate's `vehicles/`
 //! folder, compiled in ([`shipped`]); [`resolve`] takes a shipped name or the path of a
 //! user's file.
 //!
@@ -51,6 +51,56 @@ pub struct Aircraft {
     pub controls: Controls,
     /// The swashplate and tail servos.
     pub servos: Servos,
+    /// What the flight controller flies.
+    pub flight_controller: FlightController,
+    /// How the campaign identifies it.
+    pub identification: Identification,
+}
+
+/// The firmware presets a flight controller can fly: an aircraft names the one its
+/// controller's hold gains, limits, pedal scale and pilot mode come from (the board image
+/// is built with them; they are not yet parameters of the board).
+pub const FIRMWARE_PRESETS: [&str; 2] = ["bo105", "trex700l"];
+
+/// What the flight controller flies.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlightController {
+    /// The firmware preset, one of [`FIRMWARE_PRESETS`].
+    pub preset: String,
+}
+
+/// The campaign's settings for this aircraft.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Identification {
+    /// The two sweep bands flown per axis, [ω_min, ω_max] rad/s each: the first is the
+    /// record the responses come from above ω_min of the second.
+    pub sweep_bands: [[f64; 2]; 2],
+    /// The shipped 9-DOF hybrid structure fitted (its vehicle constants come from this
+    /// file), e.g. `trex700l-9dof-hybrid`.
+    pub structure: String,
+    /// How the trim-derived hover derivatives enter the 9-DOF fit.
+    pub trim_balance: TrimBalance,
+    /// Where the frequency responses' valid ranges come from.
+    pub valid_ranges: ValidRanges,
+}
+
+/// How the trim-derived hover derivatives enter the fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrimBalance {
+    /// Derived from the trim points' steady balance and held.
+    Hold,
+    /// Fitted jointly with the responses under the balances' cost.
+    Joint,
+}
+
+/// Where the valid frequency ranges come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ValidRanges {
+    /// The estimate's own coherence and random error.
+    Estimate,
+    /// The sweep-reference estimate's, which leave out where an engaged hold, not the
+    /// sweep, drives the swept control.
+    SweepReference,
 }
 
 /// Where the aircraft flies.
@@ -226,12 +276,13 @@ pub enum AircraftError {
 }
 
 /// The shipped aircraft files, by name.
-pub const SHIPPED: [(&str, &str); 2] = [
+pub const SHIPPED: [(&str, &str); 3] = [
     ("bo105", include_str!("../vehicles/bo105.toml")),
     ("trex700l", include_str!("../vehicles/trex700l.toml")),
+    ("fbl700", include_str!("../vehicles/fbl700.toml")),
 ];
 
-/// A shipped aircraft by name (`bo105`, `trex700l`; case-insensitive, `bo-105` and
+/// A shipped aircraft by name (`bo105`, `trex700l`, `fbl700`; case-insensitive, `bo-105` and
 /// `trex700` accepted), `None` for another name.
 pub fn shipped(name: &str) -> Option<Aircraft> {
     let name = match name.to_ascii_lowercase().as_str() {

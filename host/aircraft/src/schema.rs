@@ -44,6 +44,23 @@ pub(crate) struct File {
     pub tailplane: Surface,
     pub controls: Controls,
     pub servos: Servos,
+    pub flight_controller: FlightController,
+    pub identification: Identification,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct FlightController {
+    pub preset: Spanned<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Identification {
+    pub sweep_bands: Spanned<Vec<Values>>,
+    pub structure: Spanned<String>,
+    pub trim_balance: Spanned<String>,
+    pub valid_ranges: Spanned<String>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -275,7 +275,7 @@ fn the_shipped_files_read_and_a_file_on_disk_reads_like_its_text() {
     let unknown = aircraft::resolve("ec135").unwrap_err().to_string();
     assert_eq!(
         unknown,
-        "unknown vehicle `ec135`: expected bo105, trex700l or the path of an aircraft file"
+        "unknown vehicle `ec135`: expected bo105, trex700l, fbl700 or the path of an aircraft file"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

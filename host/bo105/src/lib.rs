@@ -28,4 +28,4 @@ pub use linearize::{linearize, linearize_with, Linearization};
 pub use model::State;
 pub use sim::{ActuatorModel, SensorNoise, SensorReading, Sim, SimOptions};
 pub use trim::{trim, trim_steady, SteadyFlight, Trim, TrimError, KNOT};
-pub use vehicle::{BladePitch, Gearing, Helicopter, Rotor, Surface, UnknownVehicle, Vehicle};
+pub use vehicle::{BladePitch, Gearing, Helicopter, Rotor, Surface};

@@ -6,67 +6,11 @@
 //! (Padfield's convention for the Bo-105), so the tail rotor pushes to the right (+y) and
 //! a positive tail-rotor collective yaws the nose left.
 
-use std::fmt;
-use std::str::FromStr;
-
 use aircraft::Aircraft;
 
 /// A shipped aircraft file; the `aircraft` crate's tests read every one of them.
 fn shipped(name: &str) -> Aircraft {
     aircraft::shipped(name).expect("a shipped aircraft")
-}
-
-/// Which aircraft to simulate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Vehicle {
-    /// MBB Bo-105, 2200 kg, hingeless rotor (Padfield's Helisim data).
-    #[default]
-    Bo105,
-    /// TREX 700L-class RC helicopter (approximate, see [`Helicopter::trex700l`]).
-    Trex700l,
-}
-
-impl Vehicle {
-    /// The parameter set of this vehicle.
-    pub fn helicopter(self) -> Helicopter {
-        Helicopter::from_aircraft(&self.aircraft())
-    }
-
-    /// This vehicle's shipped aircraft file.
-    pub fn aircraft(self) -> Aircraft {
-        shipped(self.name())
-    }
-
-    /// The lower-case name used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Vehicle::Bo105 => "bo105",
-            Vehicle::Trex700l => "trex700l",
-        }
-    }
-}
-
-impl fmt::Display for Vehicle {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A vehicle name that is neither `bo105` nor `trex700l`.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown vehicle `{0}` (expected bo105 or trex700l)")]
-pub struct UnknownVehicle(pub String);
-
-impl FromStr for Vehicle {
-    type Err = UnknownVehicle;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "bo105" | "bo-105" => Ok(Vehicle::Bo105),
-            "trex700l" | "trex700" | "trex-700l" => Ok(Vehicle::Trex700l),
-            _ => Err(UnknownVehicle(s.to_string())),
-        }
-    }
 }
 
 /// Blade and hub data of one rotor. The flap time constant is derived from these (Lock
@@ -415,19 +359,12 @@ mod tests {
     }
 
     #[test]
-    fn gearing_round_trips_and_vehicle_names_parse() {
+    fn gearing_round_trips() {
         let heli = Helicopter::bo105();
         let sticks = [0.1, -0.3, 0.25, 0.4];
         let back = heli.controls_for(&heli.blade_pitch(sticks));
         for (a, b) in sticks.iter().zip(back) {
             assert!((a - b).abs() < 1e-12);
         }
-        assert_eq!("bo105".parse::<Vehicle>(), Ok(Vehicle::Bo105));
-        assert_eq!("TREX700L".parse::<Vehicle>(), Ok(Vehicle::Trex700l));
-        let unknown = "ec135".parse::<Vehicle>().unwrap_err();
-        assert_eq!(
-            unknown.to_string(),
-            "unknown vehicle `ec135` (expected bo105 or trex700l)"
-        );
     }
 }

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use crate::arg_values;
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
+use crate::vehicle::Vehicle;
 use anyhow::{bail, Context};
 use clap::Args;
 use sysid::document::FrfDocument;
@@ -72,10 +73,11 @@ pub struct FitArgs {
     /// Fit frequencies per pair (n_ω; CIFER uses 20), 2–200: the fit's time grows with it.
     #[arg(long, default_value_t = 20, value_parser = arg_values::count::<2, 200>, allow_hyphen_values = true)]
     pub points: usize,
-    /// Score the fit against a simulator's linearization at hover (`bo105`, `trex700l`):
-    /// truth and error % per parameter, J against the truth model per pair.
-    #[arg(long, value_name = "VEHICLE")]
-    pub truth: Option<bo105::Vehicle>,
+    /// Score the fit against the simulator's linearization at hover of an aircraft (a
+    /// shipped one, `bo105`, `trex700l`, or an aircraft file): truth and error % per
+    /// parameter, J against the truth model per pair.
+    #[arg(long, value_name = "NAME|FILE", value_parser = Vehicle::parse)]
+    pub truth: Option<Vehicle>,
     /// Set one of the structure file's `[constants]`, e.g. `--constant hub_height=0.25` to
     /// fit the shipped Bo-105 file to another aircraft's geometry; repeatable. A name the
     /// file does not declare is an error.
@@ -288,10 +290,10 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         let _ = writeln!(report);
     }
 
-    let scored = match args.truth {
+    let scored = match &args.truth {
         Some(vehicle) => Some(truth::score_fit_with_modes(
             &result,
-            &truth::VehicleTruth::at_hover(vehicle)?,
+            &truth::VehicleTruth::at_hover(vehicle.aircraft())?,
         )?),
         None => None,
     };

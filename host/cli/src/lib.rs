@@ -25,6 +25,7 @@ pub mod report;
 pub mod sim;
 pub mod structures;
 pub mod table;
+pub mod vehicle;
 pub mod verify;
 
 /// Identify helicopter dynamics from automated frequency sweeps flown under conditional

@@ -14,8 +14,9 @@ use std::fmt::Write as _;
 
 use std::path::PathBuf;
 
-use aircraft::Aircraft;
 use anyhow::{anyhow, Context};
+
+use crate::vehicle::Vehicle;
 use bo105::{linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim};
 use clap::{Args, Subcommand};
 use serde_json::{json, Map, Value};
@@ -46,8 +47,8 @@ pub enum SimCommand {
 #[derive(Args, Debug)]
 pub struct TrimPointsArgs {
     /// Vehicle: a shipped aircraft (bo105, trex700l) or the path of an aircraft file.
-    #[arg(long, default_value = "bo105", value_name = "NAME|FILE")]
-    pub vehicle: String,
+    #[arg(long, default_value = "bo105", value_name = "NAME|FILE", value_parser = Vehicle::parse)]
+    pub vehicle: Vehicle,
     /// Write the CSV here (atomically) instead of to standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -100,8 +101,8 @@ pub fn simulator_trim_points(heli: &Helicopter, name: &str) -> anyhow::Result<Tr
 #[derive(Args, Debug)]
 pub struct CaseArgs {
     /// Vehicle: a shipped aircraft (bo105, trex700l) or the path of an aircraft file.
-    #[arg(long, default_value = "bo105", value_name = "NAME|FILE")]
-    pub vehicle: String,
+    #[arg(long, default_value = "bo105", value_name = "NAME|FILE", value_parser = Vehicle::parse)]
+    pub vehicle: Vehicle,
     /// Forward speed in knots (0 = hover).
     #[arg(
         long,
@@ -134,7 +135,7 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
         SimCommand::Trim(case) => {
             let (vehicle, heli, trimmed) = trimmed_case(case)?;
             if case.json {
-                serde_json::to_string_pretty(&trim_json(&vehicle, &heli, &trimmed))? + "\n"
+                serde_json::to_string_pretty(&trim_json(vehicle, &heli, &trimmed))? + "\n"
             } else {
                 trim_table(&heli, &trimmed)
             }
@@ -143,16 +144,14 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
             let (vehicle, heli, trimmed) = trimmed_case(&lin.case)?;
             let model = linearize_with(&heli, &trimmed, lin.dynamic_inflow);
             if lin.case.json {
-                serde_json::to_string_pretty(&linearization_json(&vehicle, &trimmed, &model))?
-                    + "\n"
+                serde_json::to_string_pretty(&linearization_json(vehicle, &trimmed, &model))? + "\n"
             } else {
                 linearization_table(&heli, &trimmed, &model)
             }
         }
         SimCommand::TrimPoints(points) => {
-            let vehicle = aircraft::resolve(&points.vehicle)?;
-            let heli = Helicopter::from_aircraft(&vehicle);
-            let csv = simulator_trim_points(&heli, &vehicle.name)?.to_csv();
+            let vehicle = &points.vehicle;
+            let csv = simulator_trim_points(&vehicle.helicopter(), vehicle.name())?.to_csv();
             match &points.out {
                 Some(path) => {
                     crate::output::write_atomic(path, csv.as_bytes())?;
@@ -167,23 +166,23 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
 }
 
 /// Parse the vehicle and speed and trim.
-fn trimmed_case(case: &CaseArgs) -> anyhow::Result<(Aircraft, Helicopter, Trim)> {
-    let vehicle = aircraft::resolve(&case.vehicle)?;
+fn trimmed_case(case: &CaseArgs) -> anyhow::Result<(&Vehicle, Helicopter, Trim)> {
+    let vehicle = &case.vehicle;
     let speed: f64 = case.speed.trim().parse().map_err(|_| {
         anyhow!(
             "invalid --speed `{}`: expected a number of knots",
             case.speed
         )
     })?;
-    let heli = Helicopter::from_aircraft(&vehicle);
-    let trimmed = trim(&heli, speed).with_context(|| format!("{} at {speed} kt", vehicle.name))?;
+    let heli = vehicle.helicopter();
+    let trimmed = trim(&heli, speed).with_context(|| format!("{vehicle} at {speed} kt"))?;
     Ok((vehicle, heli, trimmed))
 }
 
-fn trim_json(vehicle: &Aircraft, heli: &Helicopter, t: &Trim) -> Value {
+fn trim_json(vehicle: &Vehicle, heli: &Helicopter, t: &Trim) -> Value {
     let p = t.blade_pitch_rad;
     json!({
-        "vehicle": vehicle.name,
+        "vehicle": vehicle.name(),
         "speed_kt": t.speed_kt,
         "controls": { "lat": t.controls[0], "lon": t.controls[1], "ped": t.controls[2], "col": t.controls[3] },
         "blade_pitch_deg": {
@@ -204,7 +203,7 @@ fn matrix_json(rows: &[Vec<f64>]) -> Value {
     Value::Array(rows.iter().map(|row| json!(row)).collect())
 }
 
-fn linearization_json(vehicle: &Aircraft, t: &Trim, lin: &Linearization) -> Value {
+fn linearization_json(vehicle: &Vehicle, t: &Trim, lin: &Linearization) -> Value {
     let eig = |values: &[(f64, f64)]| {
         Value::Array(
             values
@@ -219,7 +218,7 @@ fn linearization_json(vehicle: &Aircraft, t: &Trim, lin: &Linearization) -> Valu
         .map(|(k, v)| (k.clone(), json!(v)))
         .collect();
     json!({
-        "vehicle": vehicle.name,
+        "vehicle": vehicle.name(),
         "speed_kt": t.speed_kt,
         "states": lin.states,
         "controls": lin.controls,
@@ -368,7 +367,7 @@ mod tests {
 
     fn case(vehicle: &str, speed: &str) -> CaseArgs {
         CaseArgs {
-            vehicle: vehicle.into(),
+            vehicle: Vehicle::shipped(vehicle),
             speed: speed.into(),
             json: true,
         }
@@ -376,23 +375,29 @@ mod tests {
 
     #[test]
     fn bad_vehicle_and_speed_are_one_line_errors() {
-        for (vehicle, speed) in [("ec135", "0"), ("bo105", "fast"), ("bo105", "-5")] {
+        for (vehicle, speed) in [("bo105", "fast"), ("bo105", "-5")] {
             let err = trimmed_case(&case(vehicle, speed)).unwrap_err();
             let text = format!("{err:#}");
             assert!(!text.contains('\n') && !text.is_empty(), "{text}");
         }
+        let unknown = Vehicle::parse("ec135").unwrap_err();
+        assert!(
+            !unknown.contains('\n') && unknown.contains("ec135"),
+            "{unknown}"
+        );
     }
 
     #[test]
     fn json_documents_have_the_documented_keys() {
-        let (vehicle, heli, t) = trimmed_case(&case("bo105", "20")).unwrap();
-        let doc = trim_json(&vehicle, &heli, &t);
+        let case = case("bo105", "20");
+        let (vehicle, heli, t) = trimmed_case(&case).unwrap();
+        let doc = trim_json(vehicle, &heli, &t);
         for key in ["controls", "blade_pitch_deg", "attitude_deg", "residual"] {
             assert!(doc.get(key).is_some(), "{key}");
         }
         assert!(doc["controls"]["col"].is_f64());
         let lin = linearize_with(&heli, &t, false);
-        let doc = linearization_json(&vehicle, &t, &lin);
+        let doc = linearization_json(vehicle, &t, &lin);
         for key in [
             "states",
             "controls",

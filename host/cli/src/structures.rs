@@ -47,17 +47,15 @@ fn shipped_for_its_vehicle(
     shipped: &ShippedStructure,
     overrides: &BTreeMap<String, f64>,
 ) -> anyhow::Result<ModelStructure> {
-    let vehicle: bo105::Vehicle = shipped
-        .vehicle
-        .parse()
-        .map_err(|e| anyhow!("{}: {e}", shipped.name))?;
-    let trim = bo105::trim(&vehicle.helicopter(), 0.0)
-        .map_err(|e| anyhow!("{} does not trim in hover: {e}", vehicle.name()))?;
+    let vehicle = aircraft::shipped(shipped.vehicle)
+        .ok_or_else(|| anyhow!("{}: no aircraft `{}`", shipped.name, shipped.vehicle))?;
+    let trim = bo105::trim(&bo105::Helicopter::from_aircraft(&vehicle), 0.0)
+        .map_err(|e| anyhow!("{} does not trim in hover: {e}", vehicle.name))?;
     let trim = TrimAttitude {
         phi: trim.phi,
         theta: trim.theta,
     };
-    Ok(with_vehicle_data(shipped, vehicle, Some(trim), overrides)?)
+    Ok(with_vehicle_data(shipped, &vehicle, Some(trim), overrides)?)
 }
 
 #[cfg(test)]
@@ -66,7 +64,7 @@ mod tests {
 
     #[test]
     fn without_air_data_keeps_the_imu_pairs_only() {
-        let full = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
+        let full = nine_dof_hybrid(&aircraft::shipped("bo105").unwrap(), None).unwrap();
         let imu = without_air_data(full.clone());
         assert_eq!(imu.states, full.states);
         assert_eq!(imu.parameters, full.parameters);
@@ -87,7 +85,7 @@ mod tests {
     #[test]
     fn built_in_structures_parse() {
         let six = six_dof().unwrap();
-        let nine = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
+        let nine = nine_dof_hybrid(&aircraft::shipped("bo105").unwrap(), None).unwrap();
         assert!(nine.states.len() > six.states.len());
         assert!(nine.states.iter().any(|s| s == "b1s"));
     }
@@ -109,7 +107,7 @@ mod tests {
         let heli = bo105::Helicopter::trex700l();
         let hover = bo105::trim(&heli, 0.0).unwrap();
         let campaign = nine_dof_hybrid(
-            bo105::Vehicle::Trex700l,
+            &aircraft::shipped("trex700l").unwrap(),
             Some(TrimAttitude {
                 phi: hover.phi,
                 theta: hover.theta,

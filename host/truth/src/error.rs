@@ -1,6 +1,6 @@
 //! Why the truth of a vehicle or a structure could not be computed.
 
-use bo105::{TrimError, Vehicle};
+use bo105::TrimError;
 use sysid::fit::FitError;
 
 /// What stops the truth mapping or the scoring against it.
@@ -9,8 +9,8 @@ pub enum Error {
     /// The vehicle does not trim in hover, so there is no linearization to map.
     #[error("cannot trim {vehicle} at hover")]
     Trim {
-        /// The vehicle.
-        vehicle: Vehicle,
+        /// The vehicle's name.
+        vehicle: String,
         /// Why its trim failed.
         source: TrimError,
     },
@@ -23,6 +23,13 @@ pub enum Error {
     /// The structure's own flap equations at the truth have no quasi-static solution.
     #[error("the structure's flapping block is singular at the truth")]
     SingularStructureFlappingBlock,
+    /// The aircraft names a structure that is not shipped, or not one with a vehicle's
+    /// constants to put in.
+    #[error("identification.structure `{0}` is not a shipped 9-DOF hybrid structure")]
+    UnknownStructure(String),
+    /// The structure file with the vehicle's data in it does not parse.
+    #[error(transparent)]
+    Structure(#[from] sysid::fit::StructureError),
     /// The structure's model at the truth values, or the cost between two models, failed.
     #[error(transparent)]
     Fit(#[from] FitError),
@@ -46,7 +53,7 @@ mod tests {
     #[test]
     fn a_failed_trim_names_the_vehicle_then_the_cause() {
         let error = Error::Trim {
-            vehicle: Vehicle::Trex700l,
+            vehicle: "trex700l".to_string(),
             source: TrimError::SingularJacobian,
         };
         assert_eq!(error.to_string(), "cannot trim trex700l at hover");

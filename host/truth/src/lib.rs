@@ -2,8 +2,8 @@
 //! simulator's own linearization, the truth `Model` built from them, and the cost of an
 //! identified model against it.
 //!
-//! - [`VehicleTruth`]: a vehicle of the simulator trimmed in hover and linearized, with its
-//!   servos' equivalent delay.
+//! - [`VehicleTruth`]: an aircraft file's helicopter simulated, trimmed in hover and
+//!   linearized, with its servos' equivalent delay.
 //! - [`structure_truth()`]: that linearization mapped onto a structure's parameters by name
 //!   (the rules are in the [`structure_truth`](mod@structure_truth) module), giving a
 //!   [`StructureTruth`].
@@ -12,8 +12,8 @@
 //! - [`with_vehicle_data`], [`nine_dof_hybrid`]: a shipped structure with the flown
 //!   vehicle's geometry, rotor data and trim attitude ([`TrimAttitude`]) in it.
 //!
-//! It builds on the simulator (`bo105`) and the identification library (`sysid`) and
-//! joins the two; neither of them imports it, nor does it import the command-line tool or
+//! It builds on the simulator (`bo105`), the identification library (`sysid`) and the
+//! aircraft files (`aircraft`), and joins them; none of them imports it, nor does it import the command-line tool or
 //! read telemetry.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -31,5 +31,5 @@ pub mod vehicle_truth;
 pub use error::Error;
 pub use scoring::{score_fit, score_fit_with_modes, ScoredFit, TRUTH_POINTS_PER_PAIR};
 pub use structure_truth::{structure_truth, StructureTruth};
-pub use vehicle_data::{nine_dof_hybrid, with_vehicle_data, TrimAttitude};
+pub use vehicle_data::{hybrid_structures, nine_dof_hybrid, with_vehicle_data, TrimAttitude};
 pub use vehicle_truth::VehicleTruth;

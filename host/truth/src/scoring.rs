@@ -65,7 +65,7 @@ pub fn score_fit_with_modes(result: &FitResult, truth: &VehicleTruth) -> Result<
         TRUTH_POINTS_PER_PAIR,
     )?;
     let section = TruthSection {
-        vehicle: truth.vehicle.name().to_string(),
+        vehicle: truth.aircraft.name.clone(),
         parameters,
         pairs: comparison
             .bands
@@ -96,7 +96,6 @@ pub fn score_fit_with_modes(result: &FitResult, truth: &VehicleTruth) -> Result<
 mod tests {
     use super::*;
     use crate::test_support::shipped;
-    use bo105::Vehicle;
 
     #[test]
     fn fit_to_the_truth_responses_recovers_the_truth_and_scores_zero() {
@@ -105,7 +104,7 @@ mod tests {
         use sysid::fit::synthetic::{exact_frf_document, SyntheticGrid};
         use sysid::fit::{fit, FitOptions, ModelDocument};
 
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&aircraft::shipped("bo105").unwrap()).unwrap();
         let structure = shipped("bo105-6dof.toml");
         let mapped = structure_truth(&structure, &truth).unwrap();
         // Everything at its truth and fixed, except Lp and Llat, started 30 % off.
@@ -179,7 +178,7 @@ mod tests {
 
     #[test]
     fn a_perfect_fit_scores_zero_against_the_truth() {
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&aircraft::shipped("bo105").unwrap()).unwrap();
         let structure = shipped("bo105-6dof.toml");
         let mapped = structure_truth(&structure, &truth).unwrap();
         let bands = vec![sysid::fit::PairBand {

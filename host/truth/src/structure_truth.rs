@@ -227,11 +227,15 @@ pub fn structure_truth(
 mod tests {
     use super::*;
     use crate::test_support::{shipped, worst_errors};
-    use bo105::Vehicle;
+    use bo105::Helicopter;
+
+    fn bo105_aircraft() -> aircraft::Aircraft {
+        aircraft::shipped("bo105").unwrap()
+    }
 
     #[test]
     fn hybrid_truth_reproduces_the_simulator_responses() {
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&bo105_aircraft()).unwrap();
         let structure = shipped("bo105-9dof-hybrid.toml");
         let mapped = structure_truth(&structure, &truth).unwrap();
         assert!(mapped.unmapped.is_empty(), "{:?}", mapped.unmapped);
@@ -245,7 +249,7 @@ mod tests {
         }
         // The flap cross-coupling the file fixes from rotor theory is the simulator's
         // (0.1 % apart: the two flap scales s_c, s_s differ by that much).
-        let rotor = truth.vehicle.helicopter().flap_cross_coupling();
+        let rotor = Helicopter::from_aircraft(&truth.aircraft).flap_cross_coupling();
         let kcs = mapped.values["Kcs"];
         assert!(
             (kcs / rotor - 1.0).abs() < 0.005,
@@ -259,7 +263,7 @@ mod tests {
         assert!((mapped.values["Kpq"] / (1.48 * mapped.values["Lfu"]) - 1.0).abs() < 1e-12);
         // The yaw rate reaches the disc through the shaft tilt and the hub's side velocity
         // x_hub·r, exactly as the file's r entries say.
-        let heli = truth.vehicle.helicopter();
+        let heli = Helicopter::from_aircraft(&truth.aircraft);
         let (x_hub, tilt) = (heli.main_rotor.hub[0], heli.shaft_tilt.sin());
         let lateral = tilt + truth.a("beta1s", "v").unwrap() * x_hub;
         let longitudinal = truth.a("beta1c", "v").unwrap() * x_hub;
@@ -295,7 +299,7 @@ mod tests {
 
     #[test]
     fn six_dof_truth_is_the_quasi_static_derivatives() {
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&bo105_aircraft()).unwrap();
         let structure = shipped("bo105-6dof.toml");
         let mapped = structure_truth(&structure, &truth).unwrap();
         assert!(mapped.unmapped.is_empty(), "{:?}", mapped.unmapped);
@@ -336,7 +340,7 @@ mod tests {
             exact_frf_document, paper_table1_range, SyntheticGrid, CAMPAIGN_FITTED_PAIRS,
         };
         use sysid::fit::{fit, FitOptions, PairBand};
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&bo105_aircraft()).unwrap();
         let structure = shipped("bo105-9dof-hybrid.toml");
         let mapped = structure_truth(&structure, &truth).unwrap();
         let delay = truth.actuator_delay_s;
@@ -386,7 +390,7 @@ mod tests {
     fn synthetic_reference_is_the_mapped_simulator_truth() {
         // `sysid`'s BO105_HYBRID_REFERENCE (tests and the fit benchmark) must not drift from
         // the simulator: it is this mapping, rounded.
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&bo105_aircraft()).unwrap();
         let mapped = structure_truth(&shipped("bo105-9dof-hybrid.toml"), &truth).unwrap();
         for (name, value) in sysid::fit::synthetic::BO105_HYBRID_REFERENCE {
             let expected = mapped.values[name];
@@ -400,7 +404,7 @@ mod tests {
     #[test]
     fn hybrid_truth_model_has_the_simulators_hover_modes_and_no_pole_at_the_origin() {
         use sysid::fit::modes::{mode_records, poles_at_origin, HOVER_MODE_LIMIT_RAD_S};
-        let truth = VehicleTruth::at_hover(Vehicle::Bo105).unwrap();
+        let truth = VehicleTruth::at_hover(&bo105_aircraft()).unwrap();
         let mapped = structure_truth(&shipped("bo105-9dof-hybrid.toml"), &truth).unwrap();
         let records = mode_records(&mapped.model).unwrap();
         let table = sysid::fit::modes::mode_table(&records);

@@ -5,9 +5,13 @@
 
 use std::collections::BTreeMap;
 
+use aircraft::Aircraft;
+use bo105::{ActuatorModel, Helicopter};
 use sysid::fit::structure::ParameterKind;
 use sysid::fit::{ModelStructure, StructureError};
 use sysid::models::{self, ShippedStructure};
+
+use crate::Error;
 
 /// The trim attitude a structure's Euler kinematics and gravity terms are written about
 /// \[rad\]: the one a flight controller captured before its excitation, or a simulator's
@@ -34,24 +38,34 @@ impl TrimAttitude {
     }
 }
 
-/// The vehicle's 9-DOF hybrid structure (`bo105-9dof-hybrid`, `trex700l-9dof-hybrid`: the
-/// TREX's own file, with its servos), with the data of `vehicle` in it — its geometry
+/// The aircraft's 9-DOF hybrid structure (its file's `identification.structure`:
+/// `bo105-9dof-hybrid`, or `trex700l-9dof-hybrid` with its servos), with the data of
+/// `aircraft` in it — its geometry
 /// constants (`hub_height`, `hub_forward`, `shaft_tilt_sine`), gravity, the servos' ω_n
 /// and ζ where the file models them, the flap cross-coupling `Kcs` the file fixes from
 /// rotor theory ([`bo105::Rotor::flap_cross_coupling`]) — and `trim`: the captured trim
 /// attitude, when known (else the file's).
 pub fn nine_dof_hybrid(
-    vehicle: bo105::Vehicle,
+    aircraft: &Aircraft,
     trim: Option<TrimAttitude>,
-) -> Result<ModelStructure, StructureError> {
-    let file = match vehicle {
-        bo105::Vehicle::Bo105 => &models::BO105_9DOF_HYBRID,
-        bo105::Vehicle::Trex700l => &models::TREX700L_9DOF_HYBRID,
-    };
-    with_vehicle_data(file, vehicle, trim, &BTreeMap::new())
+) -> Result<ModelStructure, Error> {
+    let name = &aircraft.identification.structure;
+    let file = hybrid_structures()
+        .find(|file| file.name == name)
+        .ok_or_else(|| Error::UnknownStructure(name.clone()))?;
+    Ok(with_vehicle_data(file, aircraft, trim, &BTreeMap::new())?)
 }
 
-/// A shipped structure with the data of `vehicle` in it: of the constants `hub_height`,
+/// The shipped structures an aircraft can be identified with: the 9-DOF hybrids, whose
+/// files declare the vehicle's geometry (`hub_height`) for [`with_vehicle_data`] to put in.
+pub fn hybrid_structures() -> impl Iterator<Item = &'static ShippedStructure> {
+    models::SHIPPED.iter().filter(|file| {
+        file.parse()
+            .is_ok_and(|structure| structure.constants.contains_key("hub_height"))
+    })
+}
+
+/// A shipped structure with the data of `aircraft` in it: of the constants `hub_height`,
 /// `hub_forward`, `shaft_tilt_sine`, `gravity`, `servo_natural_frequency`,
 /// `servo_damping`, `inertia_xz_over_zz`, `tail_arm`, `tail_height`, `izz_over_ixx`,
 /// `mass_over_iyy` and (with `trim`) the trim attitude's, those
@@ -59,17 +73,17 @@ pub fn nine_dof_hybrid(
 /// then `overrides` of its constants. A file without any of them (the 6-DOF) is unchanged.
 pub fn with_vehicle_data(
     shipped: &ShippedStructure,
-    vehicle: bo105::Vehicle,
+    aircraft: &Aircraft,
     trim: Option<TrimAttitude>,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<ModelStructure, StructureError> {
     let declared = shipped.parse()?.constants;
-    let helicopter = vehicle.helicopter();
+    let helicopter = Helicopter::from_aircraft(aircraft);
     // The hub is at body (x, z) = (hub[0], hub[2]) from the CG, z down: its height above
     // the CG is −hub[2].
     let hub = helicopter.main_rotor.hub;
     // The servos of the aircraft file, which `sweephold fly` flies with too.
-    let servo = bo105::ActuatorModel::from_aircraft(&vehicle.aircraft());
+    let servo = ActuatorModel::from_aircraft(aircraft);
     let mut constants = BTreeMap::from([
         ("hub_height".to_string(), -hub[2]),
         ("hub_forward".to_string(), hub[0]),
@@ -116,9 +130,17 @@ pub fn with_vehicle_data(
 mod tests {
     use super::*;
 
+    fn bo105_aircraft() -> Aircraft {
+        aircraft::shipped("bo105").unwrap()
+    }
+
+    fn trex_aircraft() -> Aircraft {
+        aircraft::shipped("trex700l").unwrap()
+    }
+
     #[test]
     fn the_flap_cross_coupling_is_the_flown_vehicles_rotor_value() {
-        let kcs = |vehicle| {
+        let kcs = |vehicle: &Aircraft| {
             let structure = nine_dof_hybrid(vehicle, None).unwrap();
             let index = structure.parameter_index("Kcs").unwrap();
             assert_eq!(structure.parameters[index].kind, ParameterKind::Fixed);
@@ -132,9 +154,9 @@ mod tests {
             (in_file - bo105_rotor).abs() < 5e-5,
             "{in_file} vs {bo105_rotor}"
         );
-        assert_eq!(kcs(bo105::Vehicle::Bo105), bo105_rotor);
+        assert_eq!(kcs(&bo105_aircraft()), bo105_rotor);
         let trex = bo105::Helicopter::trex700l().flap_cross_coupling();
-        assert_eq!(kcs(bo105::Vehicle::Trex700l), trex);
+        assert_eq!(kcs(&trex_aircraft()), trex);
         assert!(
             (trex - bo105_rotor).abs() > 0.01,
             "TREX {trex}, Bo-105 {bo105_rotor}"
@@ -147,7 +169,7 @@ mod tests {
             phi: -0.1,
             theta: 0.2,
         };
-        let structure = nine_dof_hybrid(bo105::Vehicle::Bo105, Some(trim)).unwrap();
+        let structure = nine_dof_hybrid(&bo105_aircraft(), Some(trim)).unwrap();
         assert_eq!(structure.constants["sin_phi0"], (-0.1f64).sin());
         assert_eq!(structure.constants["tan_theta0"], 0.2f64.tan());
         let model = structure.model(&structure.values()).unwrap();
@@ -158,15 +180,15 @@ mod tests {
         let g = bo105::Helicopter::bo105().gravity;
         assert!((f("v", "phi") - g * 0.1f64.cos() * 0.2f64.cos()).abs() < 1e-12);
         // Without one, the file's Bo-105 hover trim stays.
-        let file = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
+        let file = nine_dof_hybrid(&bo105_aircraft(), None).unwrap();
         assert_eq!(file.constants["sin_phi0"], -0.0460);
     }
 
     #[test]
     fn the_geometry_constants_are_the_flown_vehicles() {
         let file = models::BO105_9DOF_HYBRID.parse().unwrap();
-        let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
-        let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l, None).unwrap();
+        let bo105 = nine_dof_hybrid(&bo105_aircraft(), None).unwrap();
+        let trex = nine_dof_hybrid(&trex_aircraft(), None).unwrap();
         // The file's numbers are the Bo-105's geometry (to the digits written).
         let bo105_data = bo105::Helicopter::bo105();
         for (name, value) in [
@@ -191,7 +213,7 @@ mod tests {
     fn the_trex_yaw_flap_coupling_follows_its_product_of_inertia() {
         let nb1s = |s: &ModelStructure| s.parameter_value("Nb1s", &s.values()).unwrap();
         let lb1s = |s: &ModelStructure| s.parameter_value("Lb1s", &s.values()).unwrap();
-        let trex = nine_dof_hybrid(bo105::Vehicle::Trex700l, None).unwrap();
+        let trex = nine_dof_hybrid(&trex_aircraft(), None).unwrap();
         let data = bo105::Helicopter::trex700l();
         assert_eq!(trex.constants["inertia_xz_over_zz"], data.ixz / data.izz);
         // Derived, not a base parameter the fit could move.
@@ -201,11 +223,11 @@ mod tests {
         // Another airframe's product of inertia reaches the model through the constant.
         let overrides = BTreeMap::from([("inertia_xz_over_zz".to_string(), 0.05)]);
         let file = &models::TREX700L_9DOF_HYBRID;
-        let tilted = with_vehicle_data(file, bo105::Vehicle::Trex700l, None, &overrides).unwrap();
+        let tilted = with_vehicle_data(file, &trex_aircraft(), None, &overrides).unwrap();
         assert!((nb1s(&tilted) - 0.05 * lb1s(&tilted)).abs() < 1e-12);
         assert!(nb1s(&tilted) > 0.0);
         // The Bo-105's file keeps N_b1s free and declares no such constant.
-        let bo105 = nine_dof_hybrid(bo105::Vehicle::Bo105, None).unwrap();
+        let bo105 = nine_dof_hybrid(&bo105_aircraft(), None).unwrap();
         assert!(!bo105.constants.contains_key("inertia_xz_over_zz"));
         let index = bo105.parameter_index("Nb1s").unwrap();
         assert_eq!(bo105.parameters[index].kind, ParameterKind::Free);
@@ -216,8 +238,8 @@ mod tests {
     /// nothing of those ties: each relation holds there within 5 %.
     #[test]
     fn the_trex_body_terms_are_its_tail_rotors_shafts_and_hubs_in_the_simulator() {
-        let truth = crate::VehicleTruth::at_hover(bo105::Vehicle::Trex700l).unwrap();
-        let structure = nine_dof_hybrid(bo105::Vehicle::Trex700l, None).unwrap();
+        let truth = crate::VehicleTruth::at_hover(&trex_aircraft()).unwrap();
+        let structure = nine_dof_hybrid(&trex_aircraft(), None).unwrap();
         let c = |name: &str| structure.constants[name];
         let a = |row: &str, column: &str| truth.a(row, column).unwrap();
         let b = |row: &str, control: &str| truth.b(row, control).unwrap();

@@ -1,7 +1,8 @@
 //! The simulator's linear truth: a vehicle trimmed in hover and linearized, its servos'
 //! equivalent delay, and the simulator's names for the body states and controls.
 
-use bo105::{linearize, trim, ActuatorModel, Linearization, Vehicle};
+use aircraft::Aircraft;
+use bo105::{linearize, trim, ActuatorModel, Helicopter, Linearization};
 use sysid::fit::Model;
 
 use crate::Error;
@@ -15,7 +16,7 @@ pub(crate) const CONTROLS: [&str; 4] = ["lat", "lon", "ped", "col"];
 #[derive(Clone, Debug)]
 pub struct VehicleTruth {
     /// Which vehicle.
-    pub vehicle: Vehicle,
+    pub aircraft: Aircraft,
     /// Linearization at hover trim (flapping states included, quasi-static derivatives).
     pub linearization: Linearization,
     /// Equivalent delay of the aircraft's servos: 2ζ/ω_n + transport delay \[s\].
@@ -28,11 +29,14 @@ pub struct VehicleTruth {
 impl VehicleTruth {
     /// Trim `vehicle` at hover and linearize it; the servos are its aircraft file's, the
     /// ones `sweephold fly` flies with.
-    pub fn at_hover(vehicle: Vehicle) -> Result<VehicleTruth, Error> {
-        let heli = vehicle.helicopter();
-        let trimmed = trim(&heli, 0.0).map_err(|source| Error::Trim { vehicle, source })?;
+    pub fn at_hover(aircraft: &Aircraft) -> Result<VehicleTruth, Error> {
+        let heli = Helicopter::from_aircraft(aircraft);
+        let trimmed = trim(&heli, 0.0).map_err(|source| Error::Trim {
+            vehicle: aircraft.name.clone(),
+            source,
+        })?;
         let linearization = linearize(&heli, &trimmed);
-        let actuator = ActuatorModel::from_aircraft(&vehicle.aircraft());
+        let actuator = ActuatorModel::from_aircraft(aircraft);
         let servo_lag = if actuator.natural_frequency_rad_s.is_finite()
             && actuator.natural_frequency_rad_s > 0.0
         {
@@ -41,7 +45,7 @@ impl VehicleTruth {
             0.0
         };
         Ok(VehicleTruth {
-            vehicle,
+            aircraft: aircraft.clone(),
             linearization,
             actuator_delay_s: servo_lag + actuator.transport_delay_s,
             actuator,

@@ -22,7 +22,6 @@ use crate::artifacts::summary::{
 };
 use crate::campaign::error::CampaignError;
 use crate::fit::FitArgs;
-use crate::fly::VehicleArg;
 use crate::output::{write_atomic, write_json};
 use crate::structures;
 use truth::TrimAttitude;
@@ -65,7 +64,7 @@ impl Campaign<'_> {
             argv.push(max_starts.to_string().into());
         }
         argv.push("--trim-balance".into());
-        let balance = self.args.trim_balance.for_vehicle(self.args.vehicle);
+        let balance = self.args.trim_balance.for_vehicle(&self.args.vehicle);
         argv.push(balance.as_arg().into());
         verb_args("fit", argv)
     }
@@ -77,7 +76,7 @@ impl Campaign<'_> {
             return Ok(None);
         }
         self.stage(Stage::TrimPoints, |run| {
-            let vehicle = run.args.vehicle.sim();
+            let vehicle = &run.args.vehicle;
             let points = crate::sim::simulator_trim_points(&vehicle.helicopter(), vehicle.name())?;
             write_atomic(
                 &run.dir().join(files::TRIM_POINTS),
@@ -138,13 +137,13 @@ impl Campaign<'_> {
         trim_points: &Option<TrimPoints>,
     ) -> anyhow::Result<(FitResult, String)> {
         // As `sweephold fit --start-from model6.json --reduce`.
-        let structure = match self.args.vehicle {
-            VehicleArg::Bo105 => models::BO105_9DOF_HYBRID.name,
-            VehicleArg::Trex700l => models::TREX700L_9DOF_HYBRID.name,
-        };
-        let args = self.fit_args(structure, files::MODEL_9DOF, true, None)?;
+        let structure = self.args.vehicle.structure().to_string();
+        let args = self.fit_args(&structure, files::MODEL_9DOF, true, None)?;
         // Kinematics and gravity about the trim the flight controller captured.
-        let hybrid = self.measured(structures::nine_dof_hybrid(self.args.vehicle.sim(), trim)?);
+        let hybrid = self.measured(structures::nine_dof_hybrid(
+            self.args.vehicle.aircraft(),
+            trim,
+        )?);
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
         let starts = [
             (files::MODEL_6DOF.to_string(), started),

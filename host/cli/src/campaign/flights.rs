@@ -90,7 +90,7 @@ impl Campaign<'_> {
         };
         let argv: Vec<OsString> = vec![
             "--vehicle".into(),
-            value_name(self.args.vehicle),
+            self.args.vehicle.given().into(),
             "--mode".into(),
             value_name(mode),
             "--input".into(),
@@ -293,10 +293,10 @@ mod tests {
     #[test]
     fn the_fly_stages_take_the_verbs_defaults() {
         use super::super::{CampaignArgs, CampaignLink, TrimPointsArg, QUICK_T_REC_S};
-        use crate::fly::VehicleArg;
+        use crate::vehicle::Vehicle;
         use std::path::Path;
         let args = CampaignArgs {
-            vehicle: VehicleArg::Trex700l,
+            vehicle: Vehicle::shipped("trex700l"),
             out: PathBuf::from("campaign"),
             seed: 7,
             quick: true,
@@ -310,7 +310,7 @@ mod tests {
         let sweeps = run
             .fly_args(ModeArg::Standard, InputArg::Sweep, 7, "fly-standard")
             .unwrap();
-        assert_eq!(sweeps.vehicle, VehicleArg::Trex700l);
+        assert_eq!(sweeps.vehicle, Vehicle::shipped("trex700l"));
         assert_eq!(sweeps.mode, ModeArg::Standard);
         assert_eq!(sweeps.amplitude, AmplitudeArg::Adaptive);
         assert_eq!((sweeps.seed, sweeps.t_rec_s), (7, QUICK_T_REC_S));

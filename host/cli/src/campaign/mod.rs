@@ -35,8 +35,10 @@ use crate::artifacts::stage::Stage;
 use crate::artifacts::summary::{CampaignSummary, Modes, StageFailure};
 use crate::fit::TrimBalanceArg;
 use crate::fly::plan::PAPER_T_REC_S;
-use crate::fly::{AmplitudeArg, ModeArg, VehicleArg};
+use crate::fly::{AmplitudeArg, ModeArg};
 use crate::output::{write_json, StagedFolder};
+use crate::vehicle::Vehicle;
+use aircraft::TrimBalance;
 use error::CampaignError;
 use flights::FlownMode;
 use progress::StageProgress;
@@ -58,9 +60,11 @@ the stopped one's files, with the error in its summary.json, are kept in DIR.fai
 DIR must be new, empty or an earlier campaign's folder."
 )]
 pub struct CampaignArgs {
-    /// Aircraft simulated.
-    #[arg(long, value_enum, default_value_t = VehicleArg::Bo105)]
-    pub vehicle: VehicleArg,
+    /// Aircraft flown: a shipped one (bo105, trex700l) or the path of an aircraft file
+    /// (docs/formats.md, "Aircraft files"); the file names its firmware preset, sweep
+    /// bands, 9-DOF structure, trim balance and valid-range source.
+    #[arg(long, value_name = "NAME|FILE", default_value = "bo105", value_parser = Vehicle::parse)]
+    pub vehicle: Vehicle,
     /// Output folder.
     #[arg(long, value_name = "DIR", default_value = "out/campaign")]
     pub out: PathBuf,
@@ -222,7 +226,8 @@ pub enum TrimPointsArg {
 /// `campaign --trim-balance`: the fit's [`TrimBalanceArg`], or the vehicle's default.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum CampaignTrimBalance {
-    /// `hold` for the Bo-105, `joint` for the TREX 700L.
+    /// The aircraft file's `identification.trim_balance` (`hold` for the Bo-105,
+    /// `joint` for the TREX 700L).
     Default,
     /// Derived from the balance and held (status `trim`).
     Hold,
@@ -232,13 +237,14 @@ pub enum CampaignTrimBalance {
 
 impl CampaignTrimBalance {
     /// The fit's setting for `vehicle`.
-    pub fn for_vehicle(self, vehicle: VehicleArg) -> TrimBalanceArg {
-        match (self, vehicle) {
-            (CampaignTrimBalance::Hold, _) | (CampaignTrimBalance::Default, VehicleArg::Bo105) => {
-                TrimBalanceArg::Hold
-            }
-            (CampaignTrimBalance::Joint, _)
-            | (CampaignTrimBalance::Default, VehicleArg::Trex700l) => TrimBalanceArg::Joint,
+    pub fn for_vehicle(self, vehicle: &Vehicle) -> TrimBalanceArg {
+        match self {
+            CampaignTrimBalance::Hold => TrimBalanceArg::Hold,
+            CampaignTrimBalance::Joint => TrimBalanceArg::Joint,
+            CampaignTrimBalance::Default => match vehicle.trim_balance() {
+                TrimBalance::Hold => TrimBalanceArg::Hold,
+                TrimBalance::Joint => TrimBalanceArg::Joint,
+            },
         }
     }
 }
@@ -431,15 +437,12 @@ mod tests {
     #[test]
     fn the_trim_balance_default_is_per_vehicle_and_an_explicit_one_wins() {
         use CampaignTrimBalance as C;
-        let balance = |c: C, v| c.for_vehicle(v);
-        assert_eq!(balance(C::Default, VehicleArg::Bo105), TrimBalanceArg::Hold);
-        assert_eq!(
-            balance(C::Default, VehicleArg::Trex700l),
-            TrimBalanceArg::Joint
-        );
-        for vehicle in [VehicleArg::Bo105, VehicleArg::Trex700l] {
-            assert_eq!(balance(C::Hold, vehicle), TrimBalanceArg::Hold);
-            assert_eq!(balance(C::Joint, vehicle), TrimBalanceArg::Joint);
+        let (bo105, trex) = (Vehicle::shipped("bo105"), Vehicle::shipped("trex700l"));
+        assert_eq!(C::Default.for_vehicle(&bo105), TrimBalanceArg::Hold);
+        assert_eq!(C::Default.for_vehicle(&trex), TrimBalanceArg::Joint);
+        for vehicle in [&bo105, &trex] {
+            assert_eq!(C::Hold.for_vehicle(vehicle), TrimBalanceArg::Hold);
+            assert_eq!(C::Joint.for_vehicle(vehicle), TrimBalanceArg::Joint);
         }
         let parsed: CampaignArgs = verb_args("campaign", Vec::<OsString>::new()).unwrap();
         assert_eq!(
@@ -457,7 +460,7 @@ mod tests {
         std::fs::write(out.join(files::SUMMARY), "previous").unwrap();
         std::fs::write(out.join(files::REPORT), "previous report").unwrap();
         let args = CampaignArgs {
-            vehicle: VehicleArg::Bo105,
+            vehicle: Vehicle::shipped("bo105"),
             out: out.clone(),
             seed: 7,
             quick: true,

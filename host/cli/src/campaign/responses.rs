@@ -7,12 +7,11 @@ use std::ffi::OsString;
 use anyhow::anyhow;
 use sysid::document::FrfDocument;
 use sysid::frf::analysis::CoherenceCurve;
-use sysid::frf::{analyse, group_by_primary, RangeSource, Record};
+use sysid::frf::{analyse, group_by_primary, Record};
 
 use super::{verb_args, Campaign};
 use crate::artifacts::files;
 use crate::artifacts::flown::LATERAL;
-use crate::fly::VehicleArg;
 use crate::frf::FrfArgs;
 use crate::output::write_json;
 
@@ -41,11 +40,10 @@ impl Campaign<'_> {
         argv.extend(records.iter().map(|r| OsString::from(&r.source)));
         let args: FrfArgs = verb_args("frf", argv)?;
         let mut options = args.options();
-        if self.args.vehicle == VehicleArg::Bo105 {
-            // The valid ranges leave out where the hold, not the sweep, drives the swept
-            // control (docs/decisions/2026-11-24-joint-trim-cost-and-reference-ranges.md).
-            options.ranges = RangeSource::SweepReference;
-        }
+        // The aircraft file says where the valid ranges come from: for the Bo-105 they
+        // leave out where the hold, not the sweep, drives the swept control
+        // (docs/decisions/2026-11-24-joint-trim-cost-and-reference-ranges.md).
+        options.ranges = self.args.vehicle.range_source();
         let analysis = analyse(&group_by_primary(records)?, &options)?;
         write_json(&args.out, &analysis.document)?;
         let valid = analysis

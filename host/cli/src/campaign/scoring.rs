@@ -15,8 +15,8 @@ use crate::output::write_json;
 impl Campaign<'_> {
     /// The truth stage for the final fit `nine`.
     pub(super) fn score(&mut self, nine: &FitResult) -> anyhow::Result<((), String)> {
-        let vehicle = self.args.vehicle.sim();
-        let truth = truth::VehicleTruth::at_hover(vehicle)?;
+        let vehicle = &self.args.vehicle;
+        let truth = truth::VehicleTruth::at_hover(vehicle.aircraft())?;
         let scored = truth::score_fit_with_modes(nine, &truth)?;
         let (section, mapped) = (scored.section, scored.mapped);
         write_json(

@@ -14,7 +14,7 @@ use sweephold_firmware::{Config, FlightController};
 use sweephold_protocol::codec::{encode_to_vec, DELIMITER};
 use sweephold_protocol::decoder::decode_frame;
 use sweephold_protocol::{
-    ActuatorOut, ConfigureResult, Event, Frame, FrameError, LinkConfig, SensorIn, VehicleId,
+    ActuatorOut, ConfigureResult, Event, Frame, FrameError, LinkConfig, SensorIn,
 };
 
 /// A byte stream to a flight controller.
@@ -35,10 +35,7 @@ pub trait ByteWire {
 /// frame carries exactly, i.e. the vehicle's preset for the primary axis with another
 /// rate and test (what the board image builds from it, `board/runner.rs`).
 pub fn link_config(config: &Config) -> anyhow::Result<LinkConfig> {
-    let mut preset = match config.vehicle {
-        VehicleId::Bo105 => Config::bo105_default(config.test.primary),
-        VehicleId::Trex700l => Config::trex700l_default(config.test.primary),
-    };
+    let mut preset = Config::preset(config.vehicle, config.test.primary);
     preset.rate_hz = config.rate_hz;
     preset.test = config.test;
     if preset != *config {
@@ -254,7 +251,7 @@ fn armed() -> anyhow::Error {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sweephold_protocol::Axis;
+    use sweephold_protocol::{Axis, VehicleId};
 
     /// A wire that answers with the bytes it was given, whatever is sent.
     struct Replay(Vec<u8>);

@@ -173,8 +173,6 @@ pub enum ImuFaultPlanError {
 /// What the board-sim link needs besides the record's configuration.
 #[derive(Clone, Debug)]
 pub struct BoardSimSettings {
-    /// `true` for the Bo-105 presets, `false` for the TREX 700L's.
-    pub bo105: bool,
     /// The simulated aircraft (the gimbal hover flies a copy).
     pub heli: Helicopter,
     /// Its hover trim.
@@ -304,11 +302,7 @@ impl BoardSimLink {
             );
         }
         let primary = config.test.primary;
-        let preset = if settings.bo105 {
-            AppConfig::bo105(primary)
-        } else {
-            AppConfig::trex700l(primary)
-        };
+        let preset = AppConfig::preset(config.vehicle, primary);
         let app = AppConfig {
             flight: *config,
             ..preset

@@ -24,6 +24,7 @@ use sysid::frf::Record;
 
 use crate::arg_values;
 use crate::output::{write_atomic, write_json, StagedFolder};
+use crate::vehicle::Vehicle;
 use link::{FlightControllerLink, InProcessLink};
 use plan::{plan_records, RecordPlan};
 use record::{fly_record, Disturbances};
@@ -111,49 +112,6 @@ impl AmplitudeArg {
     }
 }
 
-/// Vehicle on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum VehicleArg {
-    /// MBB Bo-105 (full scale).
-    Bo105,
-    /// TREX 700L-class model helicopter (approximate).
-    Trex700l,
-}
-
-impl VehicleArg {
-    /// The simulator's vehicle.
-    pub fn sim(self) -> bo105::Vehicle {
-        match self {
-            VehicleArg::Bo105 => bo105::Vehicle::Bo105,
-            VehicleArg::Trex700l => bo105::Vehicle::Trex700l,
-        }
-    }
-
-    /// Name in files and JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            VehicleArg::Bo105 => "bo105",
-            VehicleArg::Trex700l => "trex700l",
-        }
-    }
-
-    /// The two sweep bands flown per axis [rad/s].
-    pub fn sweep_bands(self) -> [(f64, f64); 2] {
-        match self {
-            VehicleArg::Bo105 => plan::PAPER_BANDS,
-            VehicleArg::Trex700l => plan::TREX700L_BANDS,
-        }
-    }
-
-    /// The firmware's preset for this vehicle, exciting `axis`.
-    pub fn firmware_config(self, axis: Axis) -> Config {
-        match self {
-            VehicleArg::Bo105 => Config::bo105_default(axis),
-            VehicleArg::Trex700l => Config::trex700l_default(axis),
-        }
-    }
-}
-
 /// Arguments of `sweephold fly`.
 #[derive(Args, Debug, Clone)]
 #[command(
@@ -166,9 +124,11 @@ DIR.partial, which replaces DIR whole when every record was written; a failed ru
 as it was and its own files in DIR.failed. DIR must be new, empty or an earlier run's folder."
 )]
 pub struct FlyArgs {
-    /// Aircraft simulated.
-    #[arg(long, value_enum, default_value_t = VehicleArg::Bo105)]
-    pub vehicle: VehicleArg,
+    /// Aircraft flown: a shipped one (bo105, trex700l) or the path of an aircraft file
+    /// (docs/formats.md, "Aircraft files"); its file names the firmware preset flown and
+    /// the sweep bands.
+    #[arg(long, value_name = "NAME|FILE", default_value = "bo105", value_parser = Vehicle::parse)]
+    pub vehicle: Vehicle,
     /// How the off-axis inputs are treated.
     #[arg(long, value_enum, default_value_t = ModeArg::Cah)]
     pub mode: ModeArg,
@@ -443,7 +403,7 @@ impl FlyArgs {
             let shortest = self
                 .plans()
                 .iter()
-                .map(|plan| expected_duration_s(&record_config(self.vehicle, plan, self.rate_hz)))
+                .map(|plan| expected_duration_s(&record_config(&self.vehicle, plan, self.rate_hz)))
                 .fold(f64::INFINITY, f64::min);
             if !(at >= 0.0 && at < shortest) {
                 bail!(
@@ -457,7 +417,7 @@ impl FlyArgs {
 }
 
 /// The firmware configuration of one record.
-pub fn record_config(vehicle: VehicleArg, plan: &RecordPlan, rate_hz: u16) -> Config {
+pub fn record_config(vehicle: &Vehicle, plan: &RecordPlan, rate_hz: u16) -> Config {
     let mut config = vehicle.firmware_config(plan.axis);
     config.rate_hz = rate_hz;
     config.test.mode = plan.mode;
@@ -600,11 +560,10 @@ pub fn fly_board_sim(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
 
 /// The board-sim link's settings for `args`.
 pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::BoardSimSettings> {
-    let heli = args.vehicle.sim().helicopter();
+    let heli = args.vehicle.helicopter();
     let trim = bo105::trim(&heli, 0.0)
         .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
     Ok(link_board_sim::BoardSimSettings {
-        bo105: args.vehicle == VehicleArg::Bo105,
         heli,
         trim,
         sim_options: sim_options(args),
@@ -617,7 +576,7 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
 /// The simulator's options for `args` (before the seed and the disturbances).
 fn sim_options(args: &FlyArgs) -> bo105::SimOptions {
     let mut sim_options = bo105::SimOptions {
-        actuator: bo105::ActuatorModel::from_aircraft(&args.vehicle.sim().aircraft()),
+        actuator: args.vehicle.servos(),
         ..bo105::SimOptions::default()
     };
     if args.perfect_sensors {
@@ -634,7 +593,7 @@ pub fn validate(args: &FlyArgs) -> anyhow::Result<()> {
     args.check()?;
     let plans = args.plans();
     for plan in &plans {
-        let config = record_config(args.vehicle, plan, args.rate_hz);
+        let config = record_config(&args.vehicle, plan, args.rate_hz);
         sweephold_firmware::FlightController::new(config).map_err(|e| {
             anyhow::anyhow!(
                 "record {}: the firmware refuses this configuration: {}",
@@ -663,7 +622,7 @@ pub fn fly_with_workers(
     max_workers: usize,
 ) -> anyhow::Result<FlyOutcome> {
     validate(args)?;
-    let heli = args.vehicle.sim().helicopter();
+    let heli = args.vehicle.helicopter();
     let trim = bo105::trim(&heli, 0.0)
         .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
     let plans = args.plans();
@@ -709,7 +668,7 @@ pub fn fly_with_workers(
                         i
                     };
                     let Some(plan) = plans.get(i) else { break };
-                    let config = record_config(args.vehicle, plan, args.rate_hz);
+                    let config = record_config(&args.vehicle, plan, args.rate_hz);
                     let max_s = expected_duration_s(&config) + 10.0;
                     let bar = bars.add(ProgressBar::new(max_s as u64));
                     bar.set_style(style.clone());
