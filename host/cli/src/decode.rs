@@ -10,7 +10,7 @@ use sweephold_protocol::{
     tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, RefusedCheck, TickStep,
 };
 
-use crate::output::{refuse_inputs_as_outputs, AtomicFile};
+use crate::output::{refuse_inputs_as_outputs, AtomicFile, StdoutWriter};
 use crate::table::{axis_name, phase_name, RowWriter};
 
 /// Output format of `decode`.
@@ -255,12 +255,12 @@ pub fn event_text(event: &Event) -> String {
 }
 
 /// Where the rows go: standard output, or a file that appears only when complete.
-enum Sink<'a> {
-    Stdout(io::StdoutLock<'a>),
+enum Sink {
+    Stdout(StdoutWriter),
     File(AtomicFile),
 }
 
-impl Write for Sink<'_> {
+impl Write for Sink {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         match self {
             Sink::Stdout(out) => out.write(buf),
@@ -298,7 +298,7 @@ pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
     // The output file appears only when decoding succeeded (see `crate::output`).
     let sink = match &args.output {
         Some(path) => Sink::File(AtomicFile::create(path)?),
-        None => Sink::Stdout(io::stdout().lock()),
+        None => Sink::Stdout(StdoutWriter::lock()),
     };
     let sink = BufWriter::with_capacity(CHUNK, sink);
     let mut rows = match args.format {

@@ -66,8 +66,13 @@ pub enum Command {
     Verify(verify::VerifyArgs),
 }
 
-/// Run one parsed command line.
+/// Run one parsed command line. Whatever the verb, a failed write to standard output
+/// ends as one line (`output::stdout_outcome`).
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    output::stdout_outcome(run_verb(cli))
+}
+
+fn run_verb(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Campaign(args) => campaign::run(&args),
         Command::Decode(args) => decode::run(&args),

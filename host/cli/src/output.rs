@@ -11,12 +11,86 @@
 //!    beside the destination (`DIR.partial`) and swaps it in only when the run completes,
 //!    so a failed run leaves the previous complete one readable; the failed run's files
 //!    are kept as `DIR.failed` for inspection.
+//!
+//! Standard output takes one path too: [`print`] or [`StdoutWriter`], whose write
+//! errors [`stdout_outcome`] (applied by `crate::run` to every verb) turns into a
+//! one-line `cannot write to standard output: …` (exit 1), never a panic. A reader that
+//! went away (`| head`, a broken pipe) is not a failure of the work: the verb stops
+//! writing and exits 0, as `head` expects.
 
 use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
+
+/// A write to standard output failed. Kept apart from the other I/O errors (reading an
+/// input is one too) so that [`stdout_outcome`] can recognise it under any context.
+#[derive(Debug)]
+pub struct StdoutFailed(io::Error);
+
+impl std::fmt::Display for StdoutFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot write to standard output: {}", io_reason(&self.0))
+    }
+}
+
+impl std::error::Error for StdoutFailed {}
+
+/// Standard output, locked, with its write errors marked as [`StdoutFailed`]. Every byte
+/// a verb sends to standard output goes through one of these (or [`print`]).
+pub struct StdoutWriter(io::StdoutLock<'static>);
+
+impl StdoutWriter {
+    /// Lock standard output for this writer.
+    pub fn lock() -> StdoutWriter {
+        StdoutWriter(io::stdout().lock())
+    }
+}
+
+impl Write for StdoutWriter {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.write(buf).map_err(mark_stdout)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.0.flush().map_err(mark_stdout)
+    }
+}
+
+fn mark_stdout(error: io::Error) -> io::Error {
+    io::Error::new(error.kind(), StdoutFailed(error))
+}
+
+/// Write `text` to standard output and flush it.
+pub fn print(text: &str) -> anyhow::Result<()> {
+    let mut out = StdoutWriter::lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(anyhow::Error::from)
+}
+
+/// A verb's result with its standard-output failures made plain: a closed reader (broken
+/// pipe) is success, any other write error becomes the one line `cannot write to
+/// standard output: …` whatever context was added above it; other errors pass as they are.
+pub fn stdout_outcome(result: anyhow::Result<()>) -> anyhow::Result<()> {
+    let Err(error) = result else {
+        return Ok(());
+    };
+    let failed = error.chain().find_map(|cause| {
+        cause.downcast_ref::<StdoutFailed>().or_else(|| {
+            cause
+                .downcast_ref::<io::Error>()
+                .and_then(|e| e.get_ref())
+                .and_then(|inner| inner.downcast_ref::<StdoutFailed>())
+        })
+    });
+    match failed {
+        Some(failed) if failed.0.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+        Some(failed) => Err(anyhow::anyhow!("{failed}")),
+        None => Err(error),
+    }
+}
 
 /// Refuse, before anything is written, an output that is one of the inputs.
 ///

@@ -160,8 +160,7 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
             }
         }
     };
-    print!("{text}");
-    Ok(())
+    crate::output::print(&text)
 }
 
 /// Parse the vehicle and speed and trim.

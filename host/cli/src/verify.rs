@@ -83,8 +83,7 @@ fn bias_line(bias: BiasMode) -> &'static str {
 /// Run `sweephold verify`: the report on stdout.
 pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
     let report = report(args)?;
-    print!("{report}");
-    Ok(())
+    crate::output::print(&report)
 }
 
 /// Verify and write the plots; the report's text.

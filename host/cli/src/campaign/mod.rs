@@ -132,8 +132,7 @@ pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
     if !args.quiet {
         eprint!("{}", headline(&outcome.summary));
     }
-    println!("report: {}", outcome.report.display());
-    Ok(())
+    crate::output::print(&format!("report: {}\n", outcome.report.display()))
 }
 
 /// The figures a user looks at first, for stderr.

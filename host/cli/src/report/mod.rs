@@ -33,8 +33,7 @@ pub struct ReportArgs {
 /// Run `sweephold report`: write DIR/report.html and print its path.
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let path = write_report(&args.dir)?;
-    println!("report: {}", path.display());
-    Ok(())
+    crate::output::print(&format!("report: {}\n", path.display()))
 }
 
 /// Read the campaign folder `dir` (decoding its dumps), write `dir/report.html`, return its
