@@ -43,7 +43,8 @@ pub struct FrfArgs {
     #[arg(long, value_name = "FILE", default_value = "frf.json")]
     pub out: PathBuf,
     /// Also write SVG plots (one Bode plot per pair, one cross-control coherence plot per
-    /// swept axis) into this directory.
+    /// swept axis) into this directory. A plot's name there that is a symbolic link to an
+    /// input is refused; any other link is replaced, never written through.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
     /// Frequency band [rad/s] of the grid; default: the sweep band of the dump Header
@@ -298,7 +299,12 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
 
     // Plots first: the document is the result, written last and whole.
     let plots = match &args.plots {
-        Some(dir) => write_files_into("--plots", dir, &crate::plot::frf::frf_plots(&analysis)?)?,
+        Some(dir) => write_files_into(
+            "--plots",
+            dir,
+            &crate::plot::frf::frf_plots(&analysis)?,
+            &inputs,
+        )?,
         None => 0,
     };
     write_json(&args.out, &analysis.document)?;

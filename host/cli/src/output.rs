@@ -2,7 +2,14 @@
 //!
 //! 1. **No input is ever an output.** [`refuse_inputs_as_outputs`] runs before any work:
 //!    an output path that names one of the inputs (by path, symbolic link or hard link)
-//!    is refused, so `decode X.bin -o X.bin` cannot truncate the telemetry it reads.
+//!    is refused, naming both, so `decode X.bin -o X.bin` cannot truncate the telemetry
+//!    it reads. The files a verb names itself inside an output folder (`--plots DIR`,
+//!    `report DIR`'s report.html) are checked the same way ([`write_files_into`],
+//!    [`write_file_in_folder`]), and are never written *through* a symbolic link: the
+//!    rename replaces a link found there, never its target. A path given on the command
+//!    line (`-o FILE`, `--out FILE`) that is a link is written through, to its target (so
+//!    `-o /dev/stdout` and a link to another disk work), once that target was checked
+//!    against the inputs.
 //! 2. **Files appear whole or not at all.** [`AtomicFile`] writes into a temporary file
 //!    in the destination's folder and renames it over the destination only when
 //!    everything was written and synced; a failure or an interruption leaves the earlier
@@ -99,18 +106,28 @@ pub fn stdout_outcome(result: anyhow::Result<()>) -> anyhow::Result<()> {
 /// (every input is opened before this is called) and are compared by their would-be
 /// canonical path. Hard links are caught by device and inode number.
 pub fn refuse_inputs_as_outputs(inputs: &[&Path], outputs: &[(&str, &Path)]) -> anyhow::Result<()> {
-    let inputs: Vec<(PathBuf, Option<FileId>)> = inputs
+    let inputs: Vec<(&Path, PathBuf, Option<FileId>)> = inputs
         .iter()
-        .map(|p| (absolute(p), FileId::of(p)))
+        .map(|p| (*p, absolute(p), FileId::of(p)))
         .collect();
     for (role, output) in outputs {
         let (path, id) = (absolute(output), FileId::of(output));
-        for (input, input_id) in &inputs {
+        for (given, input, input_id) in &inputs {
             let same_id = matches!((&id, input_id), (Some(a), Some(b)) if a == b);
             if *input == path || same_id {
+                let is_link = fs::symlink_metadata(output).is_ok_and(|m| m.is_symlink());
+                if is_link {
+                    bail!(
+                        "{role} {} is a symbolic link to {}, one of the inputs: refusing to \
+                         write through it",
+                        output.display(),
+                        given.display()
+                    );
+                }
                 bail!(
-                    "{role} {} is one of the inputs: refusing to overwrite it",
-                    output.display()
+                    "{role} {} is one of the inputs ({}): refusing to overwrite it",
+                    output.display(),
+                    given.display()
                 );
             }
         }
@@ -166,7 +183,8 @@ impl FileId {
 /// (same file system, so the final rename is atomic) and replace the destination only on
 /// [`AtomicFile::commit`]. Dropped without a commit, the temporary file is removed and
 /// the destination is untouched. A destination that is a symbolic link has its target
-/// replaced (the link stays); one that is a device, pipe or socket (`/dev/null`,
+/// replaced, the link staying ([`AtomicFile::create`]), or the link itself replaced
+/// ([`AtomicFile::create_not_through_links`]); one that is a device, pipe or socket (`/dev/null`,
 /// `/dev/stdout`, a FIFO) is written in place, since a rename would put a plain file
 /// where the device was.
 pub struct AtomicFile {
@@ -208,8 +226,12 @@ enum Destination {
 }
 
 impl Destination {
-    /// Classify `path` without touching it.
-    fn of(path: &Path) -> anyhow::Result<Destination> {
+    /// Classify `path` without touching it. With `Links::Replace` a symbolic link is
+    /// itself the destination (the rename replaces the link, not its target).
+    fn of(path: &Path, links: Links) -> anyhow::Result<Destination> {
+        if links == Links::Replace && fs::symlink_metadata(path).is_ok_and(|m| m.is_symlink()) {
+            return Ok(Destination::Replace(path.to_path_buf()));
+        }
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => bail!("cannot write {}: it is a folder", path.display()),
             Ok(meta) if meta.is_file() => Ok(Destination::Replace(
@@ -224,10 +246,31 @@ impl Destination {
     }
 }
 
+/// What an [`AtomicFile`] does with a destination that is a symbolic link.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Links {
+    /// Write the link's target (a path the user named: `-o /dev/stdout`).
+    Follow,
+    /// Replace the link itself (a file the verb names inside an output folder).
+    Replace,
+}
+
 impl AtomicFile {
-    /// Start writing `destination` (its folder must exist).
+    /// Start writing `destination` (its folder must exist); a symbolic link there has its
+    /// target written (for paths given on the command line, checked by
+    /// [`refuse_inputs_as_outputs`]).
     pub fn create(destination: &Path) -> anyhow::Result<AtomicFile> {
-        let target = match Destination::of(destination)? {
+        AtomicFile::create_with(destination, Links::Follow)
+    }
+
+    /// Start writing `destination`, never through a link: a symbolic link at that path is
+    /// replaced by the new file on commit, its target left alone.
+    pub fn create_not_through_links(destination: &Path) -> anyhow::Result<AtomicFile> {
+        AtomicFile::create_with(destination, Links::Replace)
+    }
+
+    fn create_with(destination: &Path, links: Links) -> anyhow::Result<AtomicFile> {
+        let target = match Destination::of(destination, links)? {
             Destination::InPlace => {
                 let file = fs::OpenOptions::new()
                     .write(true)
@@ -314,18 +357,33 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result
 }
 
 /// Write `files` (`(name, text)`, e.g. rendered plots) into the folder `dir`, creating it;
-/// each file atomically. Returns how many were written.
+/// each file atomically and never through a symbolic link. Before anything is written, a
+/// file that would land on one of `inputs` (a link to an input placed in `dir`) is
+/// refused, naming both. Returns how many were written.
 pub fn write_files_into(
     role: &str,
     dir: &Path,
     files: &[(String, String)],
+    inputs: &[&Path],
 ) -> anyhow::Result<usize> {
     check_output_folder(role, dir)?;
+    let paths: Vec<PathBuf> = files.iter().map(|(name, _)| dir.join(name)).collect();
+    let outputs: Vec<(&str, &Path)> = paths.iter().map(|p| (role, p.as_path())).collect();
+    refuse_inputs_as_outputs(inputs, &outputs)?;
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, text) in files {
-        write_atomic(&dir.join(name), text.as_bytes())?;
+    for (path, (_, text)) in paths.iter().zip(files) {
+        write_file_in_folder(path, text.as_bytes())?;
     }
     Ok(files.len())
+}
+
+/// Write `bytes` to `path`, a file a verb names inside an output folder: atomically, and
+/// never through a symbolic link (a link at `path` is replaced, its target untouched).
+pub fn write_file_in_folder(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let mut file = AtomicFile::create_not_through_links(path)?;
+    file.write_all(bytes)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    file.commit()
 }
 
 /// Refuse a `--plots`-style output folder that exists as something else than a folder,
@@ -561,7 +619,7 @@ mod tests {
     fn a_device_is_written_in_place_and_a_link_keeps_pointing_at_its_target() {
         // Classified only: a rename over /dev/null would replace the device with a file.
         assert_eq!(
-            Destination::of(Path::new("/dev/null")).unwrap(),
+            Destination::of(Path::new("/dev/null"), Links::Follow).unwrap(),
             Destination::InPlace
         );
         let dir = scratch("link");
@@ -576,6 +634,11 @@ mod tests {
                 .unwrap()
                 .file_type()
                 .is_symlink());
+            assert_eq!(fs::read(&target).unwrap(), b"new");
+            // Inside an output folder the link itself is replaced; its target is kept.
+            write_file_in_folder(&link, b"plot").unwrap();
+            assert!(fs::symlink_metadata(&link).unwrap().is_file());
+            assert_eq!(fs::read(&link).unwrap(), b"plot");
             assert_eq!(fs::read(&target).unwrap(), b"new");
         }
         fs::remove_dir_all(&dir).unwrap();
