@@ -33,7 +33,7 @@ names (no --swept, no primary column) and `swept` otherwise (dumps, decoded CSV)
 groups give the same pair, the one from the group that sweeps its input is kept, else the \
 one with the higher mean partial coherence.\n\nExit status: 0 when frf.json was written; 1 on an \
 unreadable file, a dump without a sweep, a record too short for the band, a swept input \
-without excitation, or a bad option."
+without excitation; 2 on an option out of range (checked before any file is read)."
 )]
 pub struct FrfArgs {
     /// Telemetry dumps or CSV files.
@@ -56,7 +56,8 @@ pub struct FrfArgs {
         long,
         value_name = "G2",
         default_value_t = 0.6,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::unit_interval
     )]
     pub coherence_threshold: f64,
     /// Largest random error ε_r = √(1−γ²)/(|γ|·√(2·n_d)) a valid frequency may have, besides
@@ -72,7 +73,8 @@ pub struct FrfArgs {
         long,
         value_name = "N",
         default_value_t = 5,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::count::<1, 20>
     )]
     pub windows: usize,
     /// Overlap of consecutive windows, 0–0.95.
@@ -80,7 +82,8 @@ pub struct FrfArgs {
         long,
         value_name = "FRACTION",
         default_value_t = 0.8,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::window_overlap
     )]
     pub overlap: f64,
     /// Number of log-spaced frequencies, 2–100000.
@@ -88,7 +91,8 @@ pub struct FrfArgs {
         long,
         value_name = "N",
         default_value_t = 200,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::count::<2, 100_000>
     )]
     pub points: usize,
     /// How the conditioned responses are estimated.

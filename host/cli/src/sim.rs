@@ -6,14 +6,14 @@
 //! sweephold sim trim-points --vehicle bo105 [--out FILE]
 //! ```
 //!
-//! Arguments are parsed here (not by clap's value parsers) so that a bad vehicle or speed
-//! is a one-line error returned to `main`.
+//! The vehicle and the speed are checked while the command line is read (clap's value
+//! parsers, `crate::arg_values`): out of range is exit status 2, like every other option.
 
 use std::fmt::Write as _;
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Context};
+use anyhow::Context;
 use bo105::{
     linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim, Vehicle,
 };
@@ -47,7 +47,7 @@ pub enum SimCommand {
 pub struct TrimPointsArgs {
     /// Vehicle: bo105 or trex700l.
     #[arg(long, default_value = "bo105", value_name = "NAME")]
-    pub vehicle: String,
+    pub vehicle: Vehicle,
     /// Write the CSV here (atomically) instead of to standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -101,15 +101,16 @@ pub fn simulator_trim_points(vehicle: Vehicle) -> anyhow::Result<TrimPoints> {
 pub struct CaseArgs {
     /// Vehicle: bo105 or trex700l.
     #[arg(long, default_value = "bo105", value_name = "NAME")]
-    pub vehicle: String,
-    /// Forward speed in knots (0 = hover).
+    pub vehicle: Vehicle,
+    /// Forward speed in knots, 0 (hover) to 120.
     #[arg(
         long,
         default_value = "0",
         value_name = "KT",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::trim_speed_kt
     )]
-    pub speed: String,
+    pub speed: f64,
     /// Machine-readable JSON on standard output instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -149,8 +150,7 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
             }
         }
         SimCommand::TrimPoints(points) => {
-            let vehicle: Vehicle = points.vehicle.parse().map_err(|e| anyhow!("{e}"))?;
-            let csv = simulator_trim_points(vehicle)?.to_csv();
+            let csv = simulator_trim_points(points.vehicle)?.to_csv();
             match &points.out {
                 Some(path) => {
                     crate::output::write_atomic(path, csv.as_bytes())?;
@@ -165,13 +165,7 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
 
 /// Parse the vehicle and speed and trim.
 fn trimmed_case(case: &CaseArgs) -> anyhow::Result<(Vehicle, Helicopter, Trim)> {
-    let vehicle: Vehicle = case.vehicle.parse().map_err(|e| anyhow!("{e}"))?;
-    let speed: f64 = case.speed.trim().parse().map_err(|_| {
-        anyhow!(
-            "invalid --speed `{}`: expected a number of knots",
-            case.speed
-        )
-    })?;
+    let (vehicle, speed) = (case.vehicle, case.speed);
     let heli = vehicle.helicopter();
     let trimmed =
         trim(&heli, speed).with_context(|| format!("{} at {speed} kt", vehicle.name()))?;
@@ -364,26 +358,35 @@ fn linearization_table(heli: &Helicopter, t: &Trim, lin: &Linearization) -> Stri
 mod tests {
     use super::*;
 
-    fn case(vehicle: &str, speed: &str) -> CaseArgs {
+    fn case(vehicle: Vehicle, speed: f64) -> CaseArgs {
         CaseArgs {
-            vehicle: vehicle.into(),
-            speed: speed.into(),
+            vehicle,
+            speed,
             json: true,
         }
     }
 
     #[test]
-    fn bad_vehicle_and_speed_are_one_line_errors() {
+    fn bad_vehicle_and_speed_are_refused_while_parsing() {
+        use clap::Parser;
         for (vehicle, speed) in [("ec135", "0"), ("bo105", "fast"), ("bo105", "-5")] {
-            let err = trimmed_case(&case(vehicle, speed)).unwrap_err();
-            let text = format!("{err:#}");
-            assert!(!text.contains('\n') && !text.is_empty(), "{text}");
+            let args = [
+                "sweephold",
+                "sim",
+                "trim",
+                "--vehicle",
+                vehicle,
+                "--speed",
+                speed,
+            ];
+            let error = crate::Cli::try_parse_from(args).unwrap_err();
+            assert_eq!(error.kind(), clap::error::ErrorKind::ValueValidation);
         }
     }
 
     #[test]
     fn json_documents_have_the_documented_keys() {
-        let (vehicle, heli, t) = trimmed_case(&case("bo105", "20")).unwrap();
+        let (vehicle, heli, t) = trimmed_case(&case(Vehicle::Bo105, 20.0)).unwrap();
         let doc = trim_json(vehicle, &heli, &t);
         for key in ["controls", "blade_pitch_deg", "attitude_deg", "residual"] {
             assert!(doc.get(key).is_some(), "{key}");

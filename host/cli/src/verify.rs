@@ -38,7 +38,7 @@ pub struct VerifyArgs {
     /// is replaced, never written through.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
-    /// Restart the simulation every SECONDS from the measured state (states named like
+    /// Restart the simulation every SECONDS (> 0) from the measured state (states named like
     /// recorded outputs; others at 0). Without it the model runs open loop over the whole
     /// record, which an unstable hover model cannot survive.
     #[arg(long, value_name = "SECONDS", value_parser = crate::arg_values::positive_seconds, allow_hyphen_values = true)]

@@ -215,7 +215,8 @@ pub struct FlyArgs {
         long = "pilot-noise",
         value_name = "RMS",
         default_value_t = 0.0,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = arg_values::below_half
     )]
     pub pilot_noise: f64,
     /// Perfect sensors (no noise, bias or latency).
