@@ -22,6 +22,7 @@ pub mod interrupt;
 pub mod output;
 pub mod plot;
 pub mod report;
+pub mod run_lock;
 pub mod sim;
 pub mod structures;
 pub mod table;

@@ -423,8 +423,9 @@ pub fn io_reason(error: &io::Error) -> String {
 /// [`StagedFolder::complete`] the previous `DIR` (if any) is moved aside, `DIR.partial`
 /// renamed to `DIR`, and the previous one removed. On [`StagedFolder::fail`] the staging
 /// folder becomes `DIR.failed` (replacing an older one) and `DIR` is left as it was.
-/// A staging folder left by a run that was killed is cleared by the next run: one run
-/// at a time per destination.
+/// One run at a time per destination: `DIR.lock` ([`crate::run_lock`]) is taken before
+/// anything is touched, so a second run on DIR is refused while the first runs; a
+/// staging folder left by a run that was killed is cleared by the next run.
 ///
 /// Only a folder that holds a previous run (its `summary.json`) or nothing is replaced:
 /// a destination holding other files is refused, so a mistyped `--out ~` cannot remove
@@ -432,6 +433,8 @@ pub fn io_reason(error: &io::Error) -> String {
 pub struct StagedFolder {
     destination: PathBuf,
     staging: PathBuf,
+    /// `DIR.lock`, held until the run is swapped in or kept as failed.
+    _lock: crate::run_lock::RunLock,
 }
 
 /// The file whose presence marks a folder as a previous run's.
@@ -440,6 +443,7 @@ const RUN_MARKER: &str = "summary.json";
 impl StagedFolder {
     /// Prepare `DIR.partial` (empty) for a run whose results go to `destination`.
     pub fn begin(destination: &Path) -> anyhow::Result<StagedFolder> {
+        let lock = crate::run_lock::RunLock::acquire(destination, &sibling(destination, "lock")?)?;
         if destination.exists() {
             if !destination.is_dir() {
                 bail!(
@@ -466,6 +470,7 @@ impl StagedFolder {
         Ok(StagedFolder {
             destination: destination.to_path_buf(),
             staging,
+            _lock: lock,
         })
     }
 

@@ -61,7 +61,8 @@ pub struct CampaignArgs {
     /// Aircraft simulated.
     #[arg(long, value_enum, default_value_t = VehicleArg::Bo105)]
     pub vehicle: VehicleArg,
-    /// Output folder.
+    /// Output folder (built in DIR.partial, swapped in when complete; DIR.lock held
+    /// meanwhile: a second run on DIR is refused).
     #[arg(long, value_name = "DIR", default_value = "out/campaign")]
     pub out: PathBuf,
     /// Campaign seed (the held-out doublets use SEED + 1).

@@ -194,7 +194,8 @@ pub struct FlyArgs {
     #[arg(long = "rate", value_name = "HZ", default_value_t = 200, allow_hyphen_values = true,
           value_parser = clap::value_parser!(u16).range(50..=1000))]
     pub rate_hz: u16,
-    /// Output folder.
+    /// Output folder (built in DIR.partial, swapped in when complete; DIR.lock held
+    /// meanwhile: a second run on DIR is refused).
     #[arg(long, value_name = "DIR", default_value = "out/fly")]
     pub out: PathBuf,
     /// Turbulence level [m/s RMS of the body-axis gust], >= 0.
