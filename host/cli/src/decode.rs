@@ -91,7 +91,14 @@ pub fn decode_stream<R: Read, W: Write>(
     let mut decoder = Decoder::new();
     let mut summary = DumpSummary::default();
     let mut chunk = vec![0u8; CHUNK];
+    let mut first = true;
     loop {
+        // A safe point between chunks: a signal stops the decoding, and the output file
+        // (an `AtomicFile`) is dropped, its temporary file removed.
+        crate::interrupt::check()?;
+        if !std::mem::take(&mut first) {
+            crate::interrupt::pause_point("decode");
+        }
         let n = match input.read(&mut chunk) {
             Ok(0) => break,
             Ok(n) => n,

@@ -70,6 +70,14 @@ pub enum Command {
 /// Run one parsed command line. Whatever the verb, a failed write to standard output
 /// ends as one line (`output::stdout_outcome`).
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    // Verbs with safe points stop there on a signal; the others end at once (`interrupt`).
+    let handling = match cli.command {
+        Command::Campaign(_) | Command::Fly(_) | Command::Decode(_) => {
+            interrupt::Handling::Deferred
+        }
+        _ => interrupt::Handling::AtOnce,
+    };
+    interrupt::install(handling);
     output::stdout_outcome(run_verb(cli))
 }
 

@@ -190,6 +190,8 @@ impl FileId {
 pub struct AtomicFile {
     destination: PathBuf,
     file: BufWriter<Output>,
+    /// The temporary file, removed by a run ended at once by a signal (`interrupt`).
+    _registration: Option<crate::interrupt::Registration>,
 }
 
 /// Where an [`AtomicFile`]'s bytes go until the commit.
@@ -279,6 +281,7 @@ impl AtomicFile {
                 return Ok(AtomicFile {
                     destination: destination.to_path_buf(),
                     file: BufWriter::with_capacity(256 * 1024, Output::InPlace(file)),
+                    _registration: None,
                 });
             }
             Destination::Replace(target) => target,
@@ -303,14 +306,17 @@ impl AtomicFile {
         let file = builder
             .tempfile_in(folder)
             .with_context(|| format!("cannot create {}", destination.display()))?;
+        let registration = crate::interrupt::register_file(file.path());
         Ok(AtomicFile {
             destination: target,
             file: BufWriter::with_capacity(256 * 1024, Output::Temporary(file)),
+            _registration: Some(registration),
         })
     }
 
     /// Flush, sync and rename over the destination (or, in place, flush).
     pub fn commit(self) -> anyhow::Result<()> {
+        crate::interrupt::pause_point("write");
         let destination = self.destination;
         let context = || format!("cannot write {}", destination.display());
         let output = self
@@ -433,6 +439,8 @@ pub fn io_reason(error: &io::Error) -> String {
 pub struct StagedFolder {
     destination: PathBuf,
     staging: PathBuf,
+    /// `DIR.partial`, removed by a run ended at once by a signal (`interrupt`).
+    _registration: crate::interrupt::Registration,
     /// `DIR.lock`, held until the run is swapped in or kept as failed.
     _lock: crate::run_lock::RunLock,
 }
@@ -469,6 +477,7 @@ impl StagedFolder {
             .with_context(|| format!("cannot create output folder {}", staging.display()))?;
         Ok(StagedFolder {
             destination: destination.to_path_buf(),
+            _registration: crate::interrupt::register_folder(&staging),
             staging,
             _lock: lock,
         })

@@ -22,6 +22,8 @@ use nix::fcntl::{Flock, FlockArg};
 /// The lock of one output folder, released (and its file removed) when dropped.
 pub struct RunLock {
     path: PathBuf,
+    /// The file, removed by a run ended at once by a signal (`interrupt`).
+    _registration: crate::interrupt::Registration,
     /// Field order matters: dropped after [`Drop::drop`] removed the file.
     _lock: Flock<File>,
 }
@@ -70,6 +72,7 @@ impl RunLock {
                 .with_context(|| format!("cannot write {}", lock_path.display()))?;
             return Ok(RunLock {
                 path: lock_path.to_path_buf(),
+                _registration: crate::interrupt::register_file(lock_path),
                 _lock: locked,
             });
         }

@@ -509,7 +509,12 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let staged = StagedFolder::begin(&args.out)?;
     let mut staged_args = args.clone();
     staged_args.out = staged.path().to_path_buf();
-    let outcome = match fly_on_link(&staged_args, image.as_deref()) {
+    let flown = fly_on_link(&staged_args, image.as_deref()).and_then(|outcome| {
+        // The last safe point: a signal up to here leaves DIR as it was.
+        crate::interrupt::pause_point("complete");
+        crate::interrupt::check().map(|()| outcome)
+    });
+    let outcome = match flown {
         Ok(outcome) => {
             staged.complete()?;
             outcome
