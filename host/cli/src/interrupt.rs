@@ -22,6 +22,8 @@
 //! staged folder is swapped in, `fly` at the start of a record, `decode` after the first
 //! rows, `write` before an atomic file is committed), says `paused at POINT` on stderr and
 //! waits (at most 120 s) for a signal, so that tests can interrupt a run at an exact place.
+//! `POINT!` holds there through the first signal too, so that a second one meets a run
+//! that has not reached its next safe point.
 
 use std::collections::BTreeMap;
 use std::io::{IsTerminal, Write};
@@ -156,12 +158,21 @@ pub fn register_child(pid: u32) -> Registration {
 /// The test hook: pause at `point` when `SWEEPHOLD_TEST_PAUSE_AT` names it (see the
 /// module doc); otherwise nothing.
 pub fn pause_point(point: &str) {
-    if std::env::var(PAUSE_AT_VARIABLE).ok().as_deref() != Some(point) {
+    let Ok(wanted) = std::env::var(PAUSE_AT_VARIABLE) else {
+        return;
+    };
+    let (name, hold) = match wanted.strip_suffix('!') {
+        Some(name) => (name, true),
+        None => (wanted.as_str(), false),
+    };
+    if name != point {
         return;
     }
     let _ = writeln!(std::io::stderr(), "paused at {point}");
     let started = Instant::now();
-    while !REQUESTED.load(Ordering::SeqCst) && started.elapsed() < Duration::from_secs(120) {
+    while (hold || !REQUESTED.load(Ordering::SeqCst))
+        && started.elapsed() < Duration::from_secs(120)
+    {
         std::thread::sleep(Duration::from_millis(2));
     }
 }

@@ -34,6 +34,17 @@ fn run_ok(dir: &Path, args: &[&str]) {
 
 /// Run `args` paused at `point`, send `signal` there; the exit code and stderr.
 fn interrupted_at(dir: &Path, args: &[&str], point: &str, signal: Signal) -> (Option<i32>, String) {
+    interrupted_at_by(dir, args, point, &[signal])
+}
+
+/// Run `args` paused at `point` (`POINT!`: held there through the first signal), send
+/// `signals` there a tenth of a second apart; the exit code and stderr.
+fn interrupted_at_by(
+    dir: &Path,
+    args: &[&str],
+    point: &str,
+    signals: &[Signal],
+) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_sweephold"))
         .current_dir(dir)
         .args(args)
@@ -49,12 +60,17 @@ fn interrupted_at(dir: &Path, args: &[&str], point: &str, signal: Signal) -> (Op
         let n = stderr.read_line(&mut line).unwrap();
         assert!(n > 0, "{args:?} never paused at {point}: {seen}");
         seen += &line;
-        if line.trim() == format!("paused at {point}") {
+        if line.trim() == format!("paused at {}", point.trim_end_matches('!')) {
             break;
         }
     }
     let pid = Pid::from_raw(i32::try_from(child.id()).unwrap());
-    kill(pid, signal).unwrap();
+    for (i, signal) in signals.iter().enumerate() {
+        if i > 0 {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        kill(pid, *signal).unwrap();
+    }
     stderr.read_to_string(&mut seen).unwrap();
     let status = child.wait().unwrap();
     (status.code(), seen)
@@ -137,6 +153,28 @@ fn a_campaign_interrupted_at_any_stage_keeps_the_earlier_one() {
             assert!(failed.contains("interrupted"), "{case}: {failed}");
             std::fs::remove_dir_all(dir.join("c.failed")).unwrap();
         }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_second_signal_ends_a_campaign_at_once_leaving_nothing_behind() {
+    let dir = scratch("twice");
+    run_ok(&dir, &["campaign", "--quick", "--quiet", "--out", "c"]);
+    let before = snapshot(&dir.join("c"));
+    let second = [
+        "campaign", "--quick", "--quiet", "--seed", "5", "--out", "c",
+    ];
+    for (point, signals) in [
+        ("fly!", [Signal::SIGTERM, Signal::SIGINT]),
+        ("frf!", [Signal::SIGINT, Signal::SIGINT]),
+        ("write!", [Signal::SIGTERM, Signal::SIGTERM]),
+    ] {
+        let (code, stderr) = interrupted_at_by(&dir, &second, point, &signals);
+        assert_eq!(code, Some(130), "{point}: {stderr}");
+        assert!(snapshot(&dir.join("c")) == before, "{point}: c changed");
+        assert_eq!(leftovers(&dir), Vec::<PathBuf>::new(), "{point}");
+        assert!(!dir.join("c.failed").exists(), "{point}: ended at once");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
