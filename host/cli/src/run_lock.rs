@@ -32,6 +32,11 @@ impl RunLock {
     /// Lock `lock_path` (e.g. `DIR.lock`) for the folder `destination`, or refuse with a
     /// one-line error naming the run that holds it.
     pub fn acquire(destination: &Path, lock_path: &Path) -> anyhow::Result<RunLock> {
+        // The folder the results go in may not exist yet (`--out new/deep/DIR`).
+        if let Some(parent) = lock_path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create output folder {}", parent.display()))?;
+        }
         // A few rounds at most: each lost round means another run released its lock
         // between our open and our lock.
         for _ in 0..100 {
@@ -105,6 +110,9 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("sweephold-lock-{}", std::process::id()));
         let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(&dir).unwrap();
+        // Its folder is created, as the staging folder's would be.
+        let deep = dir.join("new/deep/c");
+        drop(RunLock::acquire(&deep, &dir.join("new/deep/c.lock")).unwrap());
         let (out, lock) = (dir.join("c"), dir.join("c.lock"));
         let first = RunLock::acquire(&out, &lock).unwrap();
         let held = fs::read_to_string(&lock).unwrap();
