@@ -33,7 +33,9 @@ events are listed there too. With -o FILE the file appears only when decoding \
 succeeded (an earlier FILE stays as it was otherwise); a FILE that is one of the dumps is \
 refused.\n\nExit status: 0 when at least one good frame was read; 1 on a missing or \
 unreadable file or a folder, an output that is an input, a dump of another protocol major \
-version, or no valid frame at all."
+version, no valid frame at all, a standard output that cannot be written, or SIGINT/SIGTERM \
+(decoding stops between chunks; FILE stays as it was); 130 on a second signal (ended at once, \
+the temporary file removed)."
 )]
 pub struct DecodeArgs {
     /// Telemetry dumps (raw frame streams as the flight controller sends them).

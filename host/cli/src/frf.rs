@@ -33,7 +33,8 @@ names (no --swept, no primary column) and `swept` otherwise (dumps, decoded CSV)
 groups give the same pair, the one from the group that sweeps its input is kept, else the \
 one with the higher mean partial coherence.\n\nExit status: 0 when frf.json was written; 1 on an \
 unreadable file, a dump without a sweep, a record too short for the band, a swept input \
-without excitation; 2 on an option out of range (checked before any file is read)."
+without excitation; 2 on an option out of range (checked before any file is read); 130 on \
+SIGINT or SIGTERM (ended at once, the temporary file removed, an earlier frf.json untouched)."
 )]
 pub struct FrfArgs {
     /// Telemetry dumps or CSV files.
