@@ -35,6 +35,38 @@ fn number_in(text: &str, min: Option<f64>, max: Option<f64>, what: &str) -> Resu
     Ok(value)
 }
 
+/// A finite number from 0 to 1 (coherence γ²).
+pub fn unit_interval(text: &str) -> Result<f64, String> {
+    number_in(text, Some(0.0), Some(1.0), "a number from 0 to 1")
+}
+
+/// The overlap of consecutive FRF windows: a fraction from 0 to 0.95.
+pub fn window_overlap(text: &str) -> Result<f64, String> {
+    number_in(text, Some(0.0), Some(0.95), "a fraction from 0 to 0.95")
+}
+
+/// A trim speed in knots, from 0 (hover) to the simulator's largest
+/// ([`bo105::trim::MAX_TRIM_SPEED_KT`]).
+pub fn trim_speed_kt(text: &str) -> Result<f64, String> {
+    let max = bo105::trim::MAX_TRIM_SPEED_KT;
+    number_in(
+        text,
+        Some(0.0),
+        Some(max),
+        &format!("a speed from 0 to {max} kt"),
+    )
+}
+
+/// A fraction of stick travel from 0 up to (not including) 0.5.
+pub fn below_half(text: &str) -> Result<f64, String> {
+    let what = "a fraction from 0 to below 0.5";
+    let value = number_in(text, Some(0.0), Some(0.5), what)?;
+    if value == 0.5 {
+        return Err(format!("expected {what}"));
+    }
+    Ok(value)
+}
+
 /// A finite number ≥ 0.
 pub fn non_negative(text: &str) -> Result<f64, String> {
     number_in(text, Some(0.0), None, "a finite number >= 0")
@@ -85,5 +117,17 @@ mod tests {
         }
         assert!(probability("1.01").is_err() && probability("1").is_ok());
         assert!(positive_seconds("0").is_err() && positive_seconds("0.5").is_ok());
+        for bad in ["nan", "-0.1", "1.5", "inf", ""] {
+            assert!(unit_interval(bad).is_err(), "{bad}");
+            assert!(window_overlap(bad).is_err(), "{bad}");
+            assert!(below_half(bad).is_err(), "{bad}");
+        }
+        for bad in ["nan", "-0.1", "120.01", "inf", "", "fast"] {
+            assert!(trim_speed_kt(bad).is_err(), "{bad}");
+        }
+        assert_eq!(unit_interval("1"), Ok(1.0));
+        assert!(window_overlap("0.96").is_err() && window_overlap("0.95").is_ok());
+        assert!(trim_speed_kt("200").is_err() && trim_speed_kt("120").is_ok());
+        assert!(below_half("0.5").is_err() && below_half("0.49").is_ok());
     }
 }

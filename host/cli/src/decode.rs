@@ -10,7 +10,7 @@ use sweephold_protocol::{
     tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, RefusedCheck, TickStep,
 };
 
-use crate::output::{refuse_inputs_as_outputs, AtomicFile};
+use crate::output::{refuse_inputs_as_outputs, AtomicFile, StdoutWriter};
 use crate::table::{axis_name, phase_name, RowWriter};
 
 /// Output format of `decode`.
@@ -33,7 +33,9 @@ events are listed there too. With -o FILE the file appears only when decoding \
 succeeded (an earlier FILE stays as it was otherwise); a FILE that is one of the dumps is \
 refused.\n\nExit status: 0 when at least one good frame was read; 1 on a missing or \
 unreadable file or a folder, an output that is an input, a dump of another protocol major \
-version, or no valid frame at all."
+version, no valid frame at all, a standard output that cannot be written, or SIGINT/SIGTERM \
+(decoding stops between chunks; FILE stays as it was); 130 on a second signal (ended at once, \
+the temporary file removed)."
 )]
 pub struct DecodeArgs {
     /// Telemetry dumps (raw frame streams as the flight controller sends them).
@@ -91,7 +93,14 @@ pub fn decode_stream<R: Read, W: Write>(
     let mut decoder = Decoder::new();
     let mut summary = DumpSummary::default();
     let mut chunk = vec![0u8; CHUNK];
+    let mut first = true;
     loop {
+        // A safe point between chunks: a signal stops the decoding, and the output file
+        // (an `AtomicFile`) is dropped, its temporary file removed.
+        crate::interrupt::check()?;
+        if !std::mem::take(&mut first) {
+            crate::interrupt::pause_point("decode");
+        }
         let n = match input.read(&mut chunk) {
             Ok(0) => break,
             Ok(n) => n,
@@ -255,12 +264,12 @@ pub fn event_text(event: &Event) -> String {
 }
 
 /// Where the rows go: standard output, or a file that appears only when complete.
-enum Sink<'a> {
-    Stdout(io::StdoutLock<'a>),
+enum Sink {
+    Stdout(StdoutWriter),
     File(AtomicFile),
 }
 
-impl Write for Sink<'_> {
+impl Write for Sink {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         match self {
             Sink::Stdout(out) => out.write(buf),
@@ -298,7 +307,7 @@ pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
     // The output file appears only when decoding succeeded (see `crate::output`).
     let sink = match &args.output {
         Some(path) => Sink::File(AtomicFile::create(path)?),
-        None => Sink::Stdout(io::stdout().lock()),
+        None => Sink::Stdout(StdoutWriter::lock()),
     };
     let sink = BufWriter::with_capacity(CHUNK, sink);
     let mut rows = match args.format {

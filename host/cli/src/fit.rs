@@ -5,7 +5,6 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs;
-use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use crate::arg_values;
@@ -330,19 +329,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         write_json(path, &document)?;
         let _ = writeln!(report, "\nwrote {}", path.display());
     }
-    emit(&report)
-}
-
-/// Print the report; a closed pipe (`| head`) is not an error of the fit.
-fn emit(report: &str) -> anyhow::Result<()> {
-    let mut stdout = io::stdout().lock();
-    match stdout
-        .write_all(report.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        Err(error) if error.kind() != io::ErrorKind::BrokenPipe => Err(error.into()),
-        _ => Ok(()),
-    }
+    crate::output::print(&report)
 }
 
 /// The modes of the fitted model, alone or against the truth's.

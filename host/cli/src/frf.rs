@@ -33,7 +33,8 @@ names (no --swept, no primary column) and `swept` otherwise (dumps, decoded CSV)
 groups give the same pair, the one from the group that sweeps its input is kept, else the \
 one with the higher mean partial coherence.\n\nExit status: 0 when frf.json was written; 1 on an \
 unreadable file, a dump without a sweep, a record too short for the band, a swept input \
-without excitation, or a bad option."
+without excitation; 2 on an option out of range (checked before any file is read); 130 on \
+SIGINT or SIGTERM (ended at once, the temporary file removed, an earlier frf.json untouched)."
 )]
 pub struct FrfArgs {
     /// Telemetry dumps or CSV files.
@@ -43,7 +44,8 @@ pub struct FrfArgs {
     #[arg(long, value_name = "FILE", default_value = "frf.json")]
     pub out: PathBuf,
     /// Also write SVG plots (one Bode plot per pair, one cross-control coherence plot per
-    /// swept axis) into this directory.
+    /// swept axis) into this directory. A plot's name there that is a symbolic link to an
+    /// input is refused; any other link is replaced, never written through.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
     /// Frequency band [rad/s] of the grid; default: the sweep band of the dump Header
@@ -55,7 +57,8 @@ pub struct FrfArgs {
         long,
         value_name = "G2",
         default_value_t = 0.6,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::unit_interval
     )]
     pub coherence_threshold: f64,
     /// Largest random error ε_r = √(1−γ²)/(|γ|·√(2·n_d)) a valid frequency may have, besides
@@ -71,7 +74,8 @@ pub struct FrfArgs {
         long,
         value_name = "N",
         default_value_t = 5,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::count::<1, 20>
     )]
     pub windows: usize,
     /// Overlap of consecutive windows, 0–0.95.
@@ -79,7 +83,8 @@ pub struct FrfArgs {
         long,
         value_name = "FRACTION",
         default_value_t = 0.8,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::window_overlap
     )]
     pub overlap: f64,
     /// Number of log-spaced frequencies, 2–100000.
@@ -87,7 +92,8 @@ pub struct FrfArgs {
         long,
         value_name = "N",
         default_value_t = 200,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::count::<2, 100_000>
     )]
     pub points: usize,
     /// How the conditioned responses are estimated.
@@ -298,7 +304,12 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
 
     // Plots first: the document is the result, written last and whole.
     let plots = match &args.plots {
-        Some(dir) => write_files_into("--plots", dir, &crate::plot::frf::frf_plots(&analysis)?)?,
+        Some(dir) => write_files_into(
+            "--plots",
+            dir,
+            &crate::plot::frf::frf_plots(&analysis)?,
+            &inputs,
+        )?,
         None => 0,
     };
     write_json(&args.out, &analysis.document)?;

@@ -22,6 +22,7 @@ pub mod interrupt;
 pub mod output;
 pub mod plot;
 pub mod report;
+pub mod run_lock;
 pub mod sim;
 pub mod structures;
 pub mod table;
@@ -67,8 +68,21 @@ pub enum Command {
     Verify(verify::VerifyArgs),
 }
 
-/// Run one parsed command line.
+/// Run one parsed command line. Whatever the verb, a failed write to standard output
+/// ends as one line (`output::stdout_outcome`).
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    // Verbs with safe points stop there on a signal; the others end at once (`interrupt`).
+    let handling = match cli.command {
+        Command::Campaign(_) | Command::Fly(_) | Command::Decode(_) => {
+            interrupt::Handling::Deferred
+        }
+        _ => interrupt::Handling::AtOnce,
+    };
+    interrupt::install(handling);
+    output::stdout_outcome(run_verb(cli))
+}
+
+fn run_verb(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Campaign(args) => campaign::run(&args),
         Command::Decode(args) => decode::run(&args),

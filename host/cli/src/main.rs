@@ -1,6 +1,7 @@
 //! `sweephold`: see `sweephold --help`. Without arguments: `sweephold campaign`.
 #![forbid(unsafe_code)]
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::error::ErrorKind;
@@ -24,24 +25,39 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             // One line: the error and its causes, outermost first.
-            eprintln!("error: {}", format!("{error:#}").replace('\n', " "));
+            report(&format!(
+                "error: {}",
+                format!("{error:#}").replace('\n', " ")
+            ));
             ExitCode::FAILURE
         }
     }
 }
 
-/// `--help` and `--version` as clap prints them; a command-line error on one line (clap's
-/// first line, without its tips and usage block) and exit status 2.
+/// One line on stderr; a stderr that cannot be written loses it (no panic).
+fn report(line: &str) {
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
+/// `--help` and `--version` as clap prints them (on standard output through the path
+/// every verb uses, so a full one is an error: exit 1); a command-line error on one line
+/// (clap's first line, without its tips and usage block) and exit status 2.
 fn usage_error(error: &clap::Error) -> ExitCode {
     match error.kind() {
         ErrorKind::DisplayHelp
         | ErrorKind::DisplayVersion
         | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-            let _ = error.print();
             if error.use_stderr() {
-                ExitCode::from(EXIT_USAGE)
-            } else {
-                ExitCode::SUCCESS
+                let _ = error.print();
+                return ExitCode::from(EXIT_USAGE);
+            }
+            let text = error.render().to_string();
+            match sweephold::output::stdout_outcome(sweephold::output::print(&text)) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(failed) => {
+                    report(&format!("error: {failed}"));
+                    ExitCode::FAILURE
+                }
             }
         }
         _ => {
@@ -59,7 +75,7 @@ fn usage_error(error: &clap::Error) -> ExitCode {
             } else {
                 message.join(" ")
             };
-            eprintln!("{message} (see --help)");
+            report(&format!("{message} (see --help)"));
             ExitCode::from(EXIT_USAGE)
         }
     }

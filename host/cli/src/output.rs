@@ -2,7 +2,14 @@
 //!
 //! 1. **No input is ever an output.** [`refuse_inputs_as_outputs`] runs before any work:
 //!    an output path that names one of the inputs (by path, symbolic link or hard link)
-//!    is refused, so `decode X.bin -o X.bin` cannot truncate the telemetry it reads.
+//!    is refused, naming both, so `decode X.bin -o X.bin` cannot truncate the telemetry
+//!    it reads. The files a verb names itself inside an output folder (`--plots DIR`,
+//!    `report DIR`'s report.html) are checked the same way ([`write_files_into`],
+//!    [`write_file_in_folder`]), and are never written *through* a symbolic link: the
+//!    rename replaces a link found there, never its target. A path given on the command
+//!    line (`-o FILE`, `--out FILE`) that is a link is written through, to its target (so
+//!    `-o /dev/stdout` and a link to another disk work), once that target was checked
+//!    against the inputs.
 //! 2. **Files appear whole or not at all.** [`AtomicFile`] writes into a temporary file
 //!    in the destination's folder and renames it over the destination only when
 //!    everything was written and synced; a failure or an interruption leaves the earlier
@@ -11,12 +18,86 @@
 //!    beside the destination (`DIR.partial`) and swaps it in only when the run completes,
 //!    so a failed run leaves the previous complete one readable; the failed run's files
 //!    are kept as `DIR.failed` for inspection.
+//!
+//! Standard output takes one path too: [`print`] or [`StdoutWriter`], whose write
+//! errors [`stdout_outcome`] (applied by `crate::run` to every verb) turns into a
+//! one-line `cannot write to standard output: …` (exit 1), never a panic. A reader that
+//! went away (`| head`, a broken pipe) is not a failure of the work: the verb stops
+//! writing and exits 0, as `head` expects.
 
 use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
+
+/// A write to standard output failed. Kept apart from the other I/O errors (reading an
+/// input is one too) so that [`stdout_outcome`] can recognise it under any context.
+#[derive(Debug)]
+pub struct StdoutFailed(io::Error);
+
+impl std::fmt::Display for StdoutFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot write to standard output: {}", io_reason(&self.0))
+    }
+}
+
+impl std::error::Error for StdoutFailed {}
+
+/// Standard output, locked, with its write errors marked as [`StdoutFailed`]. Every byte
+/// a verb sends to standard output goes through one of these (or [`print`]).
+pub struct StdoutWriter(io::StdoutLock<'static>);
+
+impl StdoutWriter {
+    /// Lock standard output for this writer.
+    pub fn lock() -> StdoutWriter {
+        StdoutWriter(io::stdout().lock())
+    }
+}
+
+impl Write for StdoutWriter {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.write(buf).map_err(mark_stdout)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.0.flush().map_err(mark_stdout)
+    }
+}
+
+fn mark_stdout(error: io::Error) -> io::Error {
+    io::Error::new(error.kind(), StdoutFailed(error))
+}
+
+/// Write `text` to standard output and flush it.
+pub fn print(text: &str) -> anyhow::Result<()> {
+    let mut out = StdoutWriter::lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(anyhow::Error::from)
+}
+
+/// A verb's result with its standard-output failures made plain: a closed reader (broken
+/// pipe) is success, any other write error becomes the one line `cannot write to
+/// standard output: …` whatever context was added above it; other errors pass as they are.
+pub fn stdout_outcome(result: anyhow::Result<()>) -> anyhow::Result<()> {
+    let Err(error) = result else {
+        return Ok(());
+    };
+    let failed = error.chain().find_map(|cause| {
+        cause.downcast_ref::<StdoutFailed>().or_else(|| {
+            cause
+                .downcast_ref::<io::Error>()
+                .and_then(|e| e.get_ref())
+                .and_then(|inner| inner.downcast_ref::<StdoutFailed>())
+        })
+    });
+    match failed {
+        Some(failed) if failed.0.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+        Some(failed) => Err(anyhow::anyhow!("{failed}")),
+        None => Err(error),
+    }
+}
 
 /// Refuse, before anything is written, an output that is one of the inputs.
 ///
@@ -25,18 +106,28 @@ use anyhow::{bail, Context};
 /// (every input is opened before this is called) and are compared by their would-be
 /// canonical path. Hard links are caught by device and inode number.
 pub fn refuse_inputs_as_outputs(inputs: &[&Path], outputs: &[(&str, &Path)]) -> anyhow::Result<()> {
-    let inputs: Vec<(PathBuf, Option<FileId>)> = inputs
+    let inputs: Vec<(&Path, PathBuf, Option<FileId>)> = inputs
         .iter()
-        .map(|p| (absolute(p), FileId::of(p)))
+        .map(|p| (*p, absolute(p), FileId::of(p)))
         .collect();
     for (role, output) in outputs {
         let (path, id) = (absolute(output), FileId::of(output));
-        for (input, input_id) in &inputs {
+        for (given, input, input_id) in &inputs {
             let same_id = matches!((&id, input_id), (Some(a), Some(b)) if a == b);
             if *input == path || same_id {
+                let is_link = fs::symlink_metadata(output).is_ok_and(|m| m.is_symlink());
+                if is_link {
+                    bail!(
+                        "{role} {} is a symbolic link to {}, one of the inputs: refusing to \
+                         write through it",
+                        output.display(),
+                        given.display()
+                    );
+                }
                 bail!(
-                    "{role} {} is one of the inputs: refusing to overwrite it",
-                    output.display()
+                    "{role} {} is one of the inputs ({}): refusing to overwrite it",
+                    output.display(),
+                    given.display()
                 );
             }
         }
@@ -92,12 +183,15 @@ impl FileId {
 /// (same file system, so the final rename is atomic) and replace the destination only on
 /// [`AtomicFile::commit`]. Dropped without a commit, the temporary file is removed and
 /// the destination is untouched. A destination that is a symbolic link has its target
-/// replaced (the link stays); one that is a device, pipe or socket (`/dev/null`,
+/// replaced, the link staying ([`AtomicFile::create`]), or the link itself replaced
+/// ([`AtomicFile::create_not_through_links`]); one that is a device, pipe or socket (`/dev/null`,
 /// `/dev/stdout`, a FIFO) is written in place, since a rename would put a plain file
 /// where the device was.
 pub struct AtomicFile {
     destination: PathBuf,
     file: BufWriter<Output>,
+    /// The temporary file, removed by a run ended at once by a signal (`interrupt`).
+    _registration: Option<crate::interrupt::Registration>,
 }
 
 /// Where an [`AtomicFile`]'s bytes go until the commit.
@@ -134,8 +228,12 @@ enum Destination {
 }
 
 impl Destination {
-    /// Classify `path` without touching it.
-    fn of(path: &Path) -> anyhow::Result<Destination> {
+    /// Classify `path` without touching it. With `Links::Replace` a symbolic link is
+    /// itself the destination (the rename replaces the link, not its target).
+    fn of(path: &Path, links: Links) -> anyhow::Result<Destination> {
+        if links == Links::Replace && fs::symlink_metadata(path).is_ok_and(|m| m.is_symlink()) {
+            return Ok(Destination::Replace(path.to_path_buf()));
+        }
         match fs::metadata(path) {
             Ok(meta) if meta.is_dir() => bail!("cannot write {}: it is a folder", path.display()),
             Ok(meta) if meta.is_file() => Ok(Destination::Replace(
@@ -150,10 +248,31 @@ impl Destination {
     }
 }
 
+/// What an [`AtomicFile`] does with a destination that is a symbolic link.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Links {
+    /// Write the link's target (a path the user named: `-o /dev/stdout`).
+    Follow,
+    /// Replace the link itself (a file the verb names inside an output folder).
+    Replace,
+}
+
 impl AtomicFile {
-    /// Start writing `destination` (its folder must exist).
+    /// Start writing `destination` (its folder must exist); a symbolic link there has its
+    /// target written (for paths given on the command line, checked by
+    /// [`refuse_inputs_as_outputs`]).
     pub fn create(destination: &Path) -> anyhow::Result<AtomicFile> {
-        let target = match Destination::of(destination)? {
+        AtomicFile::create_with(destination, Links::Follow)
+    }
+
+    /// Start writing `destination`, never through a link: a symbolic link at that path is
+    /// replaced by the new file on commit, its target left alone.
+    pub fn create_not_through_links(destination: &Path) -> anyhow::Result<AtomicFile> {
+        AtomicFile::create_with(destination, Links::Replace)
+    }
+
+    fn create_with(destination: &Path, links: Links) -> anyhow::Result<AtomicFile> {
+        let target = match Destination::of(destination, links)? {
             Destination::InPlace => {
                 let file = fs::OpenOptions::new()
                     .write(true)
@@ -162,6 +281,7 @@ impl AtomicFile {
                 return Ok(AtomicFile {
                     destination: destination.to_path_buf(),
                     file: BufWriter::with_capacity(256 * 1024, Output::InPlace(file)),
+                    _registration: None,
                 });
             }
             Destination::Replace(target) => target,
@@ -186,14 +306,17 @@ impl AtomicFile {
         let file = builder
             .tempfile_in(folder)
             .with_context(|| format!("cannot create {}", destination.display()))?;
+        let registration = crate::interrupt::register_file(file.path());
         Ok(AtomicFile {
             destination: target,
             file: BufWriter::with_capacity(256 * 1024, Output::Temporary(file)),
+            _registration: Some(registration),
         })
     }
 
     /// Flush, sync and rename over the destination (or, in place, flush).
     pub fn commit(self) -> anyhow::Result<()> {
+        crate::interrupt::pause_point("write");
         let destination = self.destination;
         let context = || format!("cannot write {}", destination.display());
         let output = self
@@ -240,18 +363,33 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result
 }
 
 /// Write `files` (`(name, text)`, e.g. rendered plots) into the folder `dir`, creating it;
-/// each file atomically. Returns how many were written.
+/// each file atomically and never through a symbolic link. Before anything is written, a
+/// file that would land on one of `inputs` (a link to an input placed in `dir`) is
+/// refused, naming both. Returns how many were written.
 pub fn write_files_into(
     role: &str,
     dir: &Path,
     files: &[(String, String)],
+    inputs: &[&Path],
 ) -> anyhow::Result<usize> {
     check_output_folder(role, dir)?;
+    let paths: Vec<PathBuf> = files.iter().map(|(name, _)| dir.join(name)).collect();
+    let outputs: Vec<(&str, &Path)> = paths.iter().map(|p| (role, p.as_path())).collect();
+    refuse_inputs_as_outputs(inputs, &outputs)?;
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, text) in files {
-        write_atomic(&dir.join(name), text.as_bytes())?;
+    for (path, (_, text)) in paths.iter().zip(files) {
+        write_file_in_folder(path, text.as_bytes())?;
     }
     Ok(files.len())
+}
+
+/// Write `bytes` to `path`, a file a verb names inside an output folder: atomically, and
+/// never through a symbolic link (a link at `path` is replaced, its target untouched).
+pub fn write_file_in_folder(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let mut file = AtomicFile::create_not_through_links(path)?;
+    file.write_all(bytes)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    file.commit()
 }
 
 /// Refuse a `--plots`-style output folder that exists as something else than a folder,
@@ -291,8 +429,9 @@ pub fn io_reason(error: &io::Error) -> String {
 /// [`StagedFolder::complete`] the previous `DIR` (if any) is moved aside, `DIR.partial`
 /// renamed to `DIR`, and the previous one removed. On [`StagedFolder::fail`] the staging
 /// folder becomes `DIR.failed` (replacing an older one) and `DIR` is left as it was.
-/// A staging folder left by a run that was killed is cleared by the next run: one run
-/// at a time per destination.
+/// One run at a time per destination: `DIR.lock` ([`crate::run_lock`]) is taken before
+/// anything is touched, so a second run on DIR is refused while the first runs; a
+/// staging folder left by a run that was killed is cleared by the next run.
 ///
 /// Only a folder that holds a previous run (its `summary.json`) or nothing is replaced:
 /// a destination holding other files is refused, so a mistyped `--out ~` cannot remove
@@ -300,6 +439,10 @@ pub fn io_reason(error: &io::Error) -> String {
 pub struct StagedFolder {
     destination: PathBuf,
     staging: PathBuf,
+    /// `DIR.partial`, removed by a run ended at once by a signal (`interrupt`).
+    _registration: crate::interrupt::Registration,
+    /// `DIR.lock`, held until the run is swapped in or kept as failed.
+    _lock: crate::run_lock::RunLock,
 }
 
 /// The file whose presence marks a folder as a previous run's.
@@ -308,6 +451,7 @@ const RUN_MARKER: &str = "summary.json";
 impl StagedFolder {
     /// Prepare `DIR.partial` (empty) for a run whose results go to `destination`.
     pub fn begin(destination: &Path) -> anyhow::Result<StagedFolder> {
+        let lock = crate::run_lock::RunLock::acquire(destination, &sibling(destination, "lock")?)?;
         if destination.exists() {
             if !destination.is_dir() {
                 bail!(
@@ -333,7 +477,9 @@ impl StagedFolder {
             .with_context(|| format!("cannot create output folder {}", staging.display()))?;
         Ok(StagedFolder {
             destination: destination.to_path_buf(),
+            _registration: crate::interrupt::register_folder(&staging),
             staging,
+            _lock: lock,
         })
     }
 
@@ -487,7 +633,7 @@ mod tests {
     fn a_device_is_written_in_place_and_a_link_keeps_pointing_at_its_target() {
         // Classified only: a rename over /dev/null would replace the device with a file.
         assert_eq!(
-            Destination::of(Path::new("/dev/null")).unwrap(),
+            Destination::of(Path::new("/dev/null"), Links::Follow).unwrap(),
             Destination::InPlace
         );
         let dir = scratch("link");
@@ -502,6 +648,11 @@ mod tests {
                 .unwrap()
                 .file_type()
                 .is_symlink());
+            assert_eq!(fs::read(&target).unwrap(), b"new");
+            // Inside an output folder the link itself is replaced; its target is kept.
+            write_file_in_folder(&link, b"plot").unwrap();
+            assert!(fs::symlink_metadata(&link).unwrap().is_file());
+            assert_eq!(fs::read(&link).unwrap(), b"plot");
             assert_eq!(fs::read(&target).unwrap(), b"new");
         }
         fs::remove_dir_all(&dir).unwrap();

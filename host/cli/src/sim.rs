@@ -7,14 +7,14 @@
 //! sweephold sim trim-points --vehicle bo105 [--out FILE]
 //! ```
 //!
-//! Arguments are parsed here (not by clap's value parsers) so that a bad vehicle or speed
-//! is a one-line error returned to `main`.
+//! The vehicle and the speed are checked while the command line is read (clap's value
+//! parsers, `crate::arg_values`): out of range is exit status 2, like every other option.
 
 use std::fmt::Write as _;
 
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Context};
+use anyhow::Context;
 
 use crate::vehicle::Vehicle;
 use bo105::{linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim};
@@ -46,7 +46,7 @@ pub enum SimCommand {
 /// Arguments of `sim trim-points`.
 #[derive(Args, Debug)]
 pub struct TrimPointsArgs {
-    /// Vehicle: a shipped aircraft (bo105, trex700l) or the path of an aircraft file.
+    /// Vehicle: a shipped aircraft (bo105, trex700l, fbl700) or the path of an aircraft file.
     #[arg(long, default_value = "bo105", value_name = "NAME|FILE", value_parser = Vehicle::parse)]
     pub vehicle: Vehicle,
     /// Write the CSV here (atomically) instead of to standard output.
@@ -100,17 +100,18 @@ pub fn simulator_trim_points(heli: &Helicopter, name: &str) -> anyhow::Result<Tr
 /// Which aircraft and flight condition.
 #[derive(Args, Debug)]
 pub struct CaseArgs {
-    /// Vehicle: a shipped aircraft (bo105, trex700l) or the path of an aircraft file.
+    /// Vehicle: a shipped aircraft (bo105, trex700l, fbl700) or the path of an aircraft file.
     #[arg(long, default_value = "bo105", value_name = "NAME|FILE", value_parser = Vehicle::parse)]
     pub vehicle: Vehicle,
-    /// Forward speed in knots (0 = hover).
+    /// Forward speed in knots, 0 (hover) to 120.
     #[arg(
         long,
         default_value = "0",
         value_name = "KT",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = crate::arg_values::trim_speed_kt
     )]
-    pub speed: String,
+    pub speed: f64,
     /// Machine-readable JSON on standard output instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -161,19 +162,12 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
             }
         }
     };
-    print!("{text}");
-    Ok(())
+    crate::output::print(&text)
 }
 
 /// Parse the vehicle and speed and trim.
 fn trimmed_case(case: &CaseArgs) -> anyhow::Result<(&Vehicle, Helicopter, Trim)> {
-    let vehicle = &case.vehicle;
-    let speed: f64 = case.speed.trim().parse().map_err(|_| {
-        anyhow!(
-            "invalid --speed `{}`: expected a number of knots",
-            case.speed
-        )
-    })?;
+    let (vehicle, speed) = (&case.vehicle, case.speed);
     let heli = vehicle.helicopter();
     let trimmed = trim(&heli, speed).with_context(|| format!("{vehicle} at {speed} kt"))?;
     Ok((vehicle, heli, trimmed))
@@ -365,20 +359,29 @@ fn linearization_table(heli: &Helicopter, t: &Trim, lin: &Linearization) -> Stri
 mod tests {
     use super::*;
 
-    fn case(vehicle: &str, speed: &str) -> CaseArgs {
+    fn case(vehicle: &str, speed: f64) -> CaseArgs {
         CaseArgs {
             vehicle: Vehicle::shipped(vehicle),
-            speed: speed.into(),
+            speed,
             json: true,
         }
     }
 
     #[test]
-    fn bad_vehicle_and_speed_are_one_line_errors() {
-        for (vehicle, speed) in [("bo105", "fast"), ("bo105", "-5")] {
-            let err = trimmed_case(&case(vehicle, speed)).unwrap_err();
-            let text = format!("{err:#}");
-            assert!(!text.contains('\n') && !text.is_empty(), "{text}");
+    fn bad_vehicle_and_speed_are_refused_while_parsing() {
+        use clap::Parser;
+        for (vehicle, speed) in [("ec135", "0"), ("bo105", "fast"), ("bo105", "-5")] {
+            let args = [
+                "sweephold",
+                "sim",
+                "trim",
+                "--vehicle",
+                vehicle,
+                "--speed",
+                speed,
+            ];
+            let error = crate::Cli::try_parse_from(args).unwrap_err();
+            assert_eq!(error.kind(), clap::error::ErrorKind::ValueValidation);
         }
         let unknown = Vehicle::parse("ec135").unwrap_err();
         assert!(
@@ -389,7 +392,7 @@ mod tests {
 
     #[test]
     fn json_documents_have_the_documented_keys() {
-        let case = case("bo105", "20");
+        let case = case("bo105", 20.0);
         let (vehicle, heli, t) = trimmed_case(&case).unwrap();
         let doc = trim_json(vehicle, &heli, &t);
         for key in ["controls", "blade_pitch_deg", "attitude_deg", "residual"] {

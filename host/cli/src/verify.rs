@@ -33,10 +33,12 @@ pub struct VerifyArgs {
     /// the firmware flies — doublet, 3-2-1-1 or sweep (`sweephold fly --input doublet`).
     #[arg(value_name = "DUMP", required = true)]
     pub dumps: Vec<PathBuf>,
-    /// Write one SVG per dump and output (measured vs predicted) into this folder.
+    /// Write one SVG per dump and output (measured vs predicted) into this folder. A plot's
+    /// name there that is a symbolic link to the model or a dump is refused; any other link
+    /// is replaced, never written through.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
-    /// Restart the simulation every SECONDS from the measured state (states named like
+    /// Restart the simulation every SECONDS (> 0) from the measured state (states named like
     /// recorded outputs; others at 0). Without it the model runs open loop over the whole
     /// record, which an unstable hover model cannot survive.
     #[arg(long, value_name = "SECONDS", value_parser = crate::arg_values::positive_seconds, allow_hyphen_values = true)]
@@ -83,8 +85,7 @@ fn bias_line(bias: BiasMode) -> &'static str {
 /// Run `sweephold verify`: the report on stdout.
 pub fn run(args: &VerifyArgs) -> anyhow::Result<()> {
     let report = report(args)?;
-    print!("{report}");
-    Ok(())
+    crate::output::print(&report)
 }
 
 /// Verify and write the plots; the report's text.
@@ -145,10 +146,13 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
         write_verification(&mut report, &verification);
         all_theil.extend(verification.outputs.iter().map(|o| o.theil));
         if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {
+            let mut inputs = vec![args.model.as_path()];
+            inputs.extend(args.dumps.iter().map(PathBuf::as_path));
             let written = write_files_into(
                 "--plots",
                 dir,
                 &crate::plot::verification::verification_plots(&verification)?,
+                &inputs,
             )?;
             let _ = writeln!(report, "wrote {written} plots to {}", dir.display());
         }

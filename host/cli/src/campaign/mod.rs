@@ -54,8 +54,9 @@ pub const QUICK_T_REC_S: f64 = 20.0;
 dumps and fly's summary.json per mode), verify-doublet/ (held-out doublets), frf.json, \
 model6.json, model9.json, truth-model9.json, verify.json, summary.json (layout in \
 docs/formats.md) and report.html. The campaign is built in DIR.partial and replaces DIR only \
-when it completes. A failing stage, or Ctrl-C (the campaign stops after the current \
-stage), stops it with the stage's name: DIR keeps the previous complete campaign, and \
+when it completes. A failing stage, or SIGINT (Ctrl-C) or SIGTERM (the campaign stops \
+after the current stage, or within a second in a flight; a second signal quits at once, \
+removing DIR.partial), stops it with the stage's name and exit status 1: DIR keeps the previous complete campaign, and \
 the stopped one's files, with the error in its summary.json, are kept in DIR.failed. \
 DIR must be new, empty or an earlier campaign's folder."
 )]
@@ -65,7 +66,8 @@ pub struct CampaignArgs {
     /// bands, 9-DOF structure, trim balance and valid-range source.
     #[arg(long, value_name = "NAME|FILE", default_value = "bo105", value_parser = Vehicle::parse)]
     pub vehicle: Vehicle,
-    /// Output folder.
+    /// Output folder (built in DIR.partial, swapped in when complete; DIR.lock held
+    /// meanwhile: a second run on DIR is refused).
     #[arg(long, value_name = "DIR", default_value = "out/campaign")]
     pub out: PathBuf,
     /// Campaign seed (the held-out doublets use SEED + 1).
@@ -131,13 +133,11 @@ pub struct CampaignOutcome {
 
 /// Run `sweephold campaign`: the campaign, then the path of the report on stdout.
 pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
-    crate::interrupt::install();
     let outcome = campaign(args)?;
     if !args.quiet {
         eprint!("{}", headline(&outcome.summary));
     }
-    println!("report: {}", outcome.report.display());
-    Ok(())
+    crate::output::print(&format!("report: {}\n", outcome.report.display()))
 }
 
 /// The figures a user looks at first, for stderr.
@@ -273,10 +273,17 @@ impl Campaign<'_> {
         work: impl FnOnce(&mut Self) -> anyhow::Result<(T, String)>,
     ) -> Result<T, CampaignError> {
         let progress = StageProgress::start(stage, self.args.quiet);
-        // A Ctrl-C is honoured between stages: before this one and after it.
-        let result = crate::interrupt::check()
-            .and_then(|()| work(self))
-            .and_then(|done| crate::interrupt::check().map(|()| done));
+        // A signal is honoured between stages: before this one and after it (and inside
+        // the flights, every second of a record). After the stage that swapped the folder
+        // in (the report's), nothing is left to stop.
+        let result = crate::interrupt::check().and_then(|()| {
+            crate::interrupt::pause_point(stage.name());
+            work(self)
+        });
+        let result = result.and_then(|done| match self.staged {
+            Some(_) => crate::interrupt::check().map(|()| done),
+            None => Ok(done),
+        });
         match result {
             Ok((value, outcome)) => {
                 let seconds = progress.finish(&outcome);
@@ -412,6 +419,9 @@ impl Campaign<'_> {
             }
             crate::report::write_report_with(run.dir(), FlownRecords { sweep, coherence })?;
             run.write_summary()?;
+            // The last safe point: a signal up to here leaves DIR as it was.
+            crate::interrupt::pause_point("complete");
+            crate::interrupt::check()?;
             let staged = run
                 .staged
                 .take()

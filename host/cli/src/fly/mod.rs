@@ -154,7 +154,8 @@ pub struct FlyArgs {
     #[arg(long = "rate", value_name = "HZ", default_value_t = 200, allow_hyphen_values = true,
           value_parser = clap::value_parser!(u16).range(50..=1000))]
     pub rate_hz: u16,
-    /// Output folder.
+    /// Output folder (built in DIR.partial, swapped in when complete; DIR.lock held
+    /// meanwhile: a second run on DIR is refused).
     #[arg(long, value_name = "DIR", default_value = "out/fly")]
     pub out: PathBuf,
     /// Turbulence level [m/s RMS of the body-axis gust], >= 0.
@@ -175,7 +176,8 @@ pub struct FlyArgs {
         long = "pilot-noise",
         value_name = "RMS",
         default_value_t = 0.0,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = arg_values::below_half
     )]
     pub pilot_noise: f64,
     /// Perfect sensors (no noise, bias or latency).
@@ -467,7 +469,12 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     let staged = StagedFolder::begin(&args.out)?;
     let mut staged_args = args.clone();
     staged_args.out = staged.path().to_path_buf();
-    let outcome = match fly_on_link(&staged_args, image.as_deref()) {
+    let flown = fly_on_link(&staged_args, image.as_deref()).and_then(|outcome| {
+        // The last safe point: a signal up to here leaves DIR as it was.
+        crate::interrupt::pause_point("complete");
+        crate::interrupt::check().map(|()| outcome)
+    });
+    let outcome = match flown {
         Ok(outcome) => {
             staged.complete()?;
             outcome

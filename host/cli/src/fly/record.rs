@@ -227,6 +227,7 @@ pub fn fly_record(
     let mut pilot_rng = SplitMix64::new(u64::from(config.test.seed) ^ 0x9170_7D15_7A2B);
 
     link.begin_record(config)?;
+    crate::interrupt::pause_point("fly");
     let mut dump = Vec::with_capacity((max_s * rate) as usize * 140);
     let mut monitor = TelemetryMonitor::default();
     let mut reading = sim.step(dt, trim.controls);
@@ -238,7 +239,12 @@ pub fn fly_record(
     let mut ended: Option<(u64, Phase)> = None;
     let mut after = AttitudeDeg::default();
     let mut ticks = 0;
+    let ticks_per_second = u64::from(config.rate_hz).max(1);
     while ticks < max_ticks + fly_on_ticks {
+        // A safe point every second of flight: a signal stops the record (and the run).
+        if ticks % ticks_per_second == 0 {
+            crate::interrupt::check()?;
+        }
         let armed_s = ticks.saturating_sub(IDLE_TICKS) as f64 * dt;
         let mut sticks = trim_sticks;
         if ended.is_some() {

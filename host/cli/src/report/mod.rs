@@ -33,8 +33,7 @@ pub struct ReportArgs {
 /// Run `sweephold report`: write DIR/report.html and print its path.
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let path = write_report(&args.dir)?;
-    println!("report: {}", path.display());
-    Ok(())
+    crate::output::print(&format!("report: {}\n", path.display()))
 }
 
 /// Read the campaign folder `dir` (decoding its dumps), write `dir/report.html`, return its
@@ -53,11 +52,34 @@ fn write(inputs: &ReportInputs) -> Result<PathBuf, ReportError> {
     let dir = &inputs.dir;
     let html = render(inputs);
     let path = dir.join(files::REPORT);
-    crate::output::write_atomic(&path, html.as_bytes()).map_err(|e| ReportError::Write {
+    let write_error = |e: anyhow::Error| ReportError::Write {
         path: path.clone(),
         message: e.root_cause().to_string(),
-    })?;
+    };
+    refuse_link_into_folder(dir, &path).map_err(write_error)?;
+    crate::output::write_file_in_folder(&path, html.as_bytes()).map_err(write_error)?;
     Ok(path)
+}
+
+/// The report's inputs are the campaign folder's files: a `report.html` that is a link
+/// resolving into the folder (to `model9.json`, `frf.json`, `summary.json`, a dump) is
+/// refused, naming both. Any other link is replaced by the report, never written through.
+fn refuse_link_into_folder(dir: &Path, report: &Path) -> anyhow::Result<()> {
+    let is_link = std::fs::symlink_metadata(report).is_ok_and(|m| m.is_symlink());
+    if !is_link {
+        return Ok(());
+    }
+    let (Ok(target), Ok(folder)) = (report.canonicalize(), dir.canonicalize()) else {
+        return Ok(());
+    };
+    if target.starts_with(&folder) {
+        anyhow::bail!(
+            "it is a symbolic link to {}, one of the report's inputs: refusing to write \
+             through it",
+            target.display()
+        );
+    }
+    Ok(())
 }
 
 /// The whole page.

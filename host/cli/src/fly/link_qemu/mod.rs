@@ -23,9 +23,10 @@
 //! image logs to RTT only (no log file).
 //!
 //! QEMU is killed when the link is dropped — at the end of the run, on an error, and when
-//! the thread unwinds — and a failed record boots a fresh one for the next. On Ctrl-C the
-//! terminal's SIGINT reaches QEMU too (same foreground process group), which terminates
-//! on it; over semihosting the image also asks QEMU to exit when the host's end of the
+//! the thread unwinds — and a failed record boots a fresh one for the next. SIGINT or
+//! SIGTERM stops the run within a second of flight (`crate::interrupt`), which drops the
+//! link; a second signal ends the run at once, killing every registered QEMU first. On
+//! Ctrl-C the terminal's SIGINT reaches QEMU too (same foreground process group); over semihosting the image also asks QEMU to exit when the host's end of the
 //! FIFO closes, so even a killed host leaves no emulator behind (only its FIFO folder in
 //! the temporary directory, which Drop removes otherwise).
 //!

@@ -84,6 +84,8 @@ const SEMIHOSTING_MAILBOX: [(u32, u32); 2] =
 /// One QEMU process running the image, and the byte stream to it.
 pub(super) struct QemuProcess {
     child: Child,
+    /// Killed by a run ended at once by a signal (`crate::interrupt`); otherwise on drop.
+    _registration: crate::interrupt::Registration,
     wire: Wire,
     stderr: Arc<Mutex<Vec<u8>>>,
 }
@@ -178,6 +180,7 @@ pub(super) fn start_session(
         .stderr(Stdio::piped())
         .spawn()
         .with_context(|| format!("cannot start {QEMU}"))?;
+    let registration = crate::interrupt::register_child(child.id());
     let stderr = Arc::new(Mutex::new(Vec::new()));
     if let Some(mut pipe) = child.stderr.take() {
         let keep = Arc::clone(&stderr);
@@ -197,6 +200,7 @@ pub(super) fn start_session(
         (None, None) => bail!("no transport"),
     };
     let mut session = FrameChannel::new(QemuProcess {
+        _registration: registration,
         child,
         wire,
         stderr,
