@@ -9,8 +9,8 @@ use crate::output::{
 use anyhow::bail;
 use clap::Args;
 use sysid::frf::{
-    analyse, group_by_primary, load_csv, load_dump, CsvColumns, FrfAnalysis, FrfOptions, Record,
-    ResponseEstimator, ResponseInputs,
+    analyse, group_by_primary, load_csv_records, load_dump, CsvColumns, FrfAnalysis, FrfOptions,
+    Record, ResponseEstimator, ResponseInputs, TimeUnit, Unit,
 };
 
 /// Arguments of `sweephold frf`.
@@ -20,8 +20,18 @@ use sysid::frf::{
 to zero at the joins). The response of output y to control x comes from the records in \
 which x is swept (or, see --excited, in which x moves with the swept control), conditioned \
 on the other controls excited there. Files ending in .csv \
-are read as CSV with a header row (columns chosen with --time, --inputs, --outputs); \
-anything else as a telemetry dump.\n\nThe swept input of a CSV file is, in this order: \
+are read as CSV (columns chosen with --time, --inputs, --outputs, --reference, by header \
+name or by position, 1 = first; a file whose first row is all numbers has no header); \
+anything else as a telemetry dump.\n\nCSV rows: --window keeps the rows in a time span; \
+a row with an empty or non-finite field is a missing sample. Timestamps within 5 % of a \
+step of a uniform grid are used as they are; jittered ones are resampled onto a uniform \
+grid by linear interpolation; gaps of up to 5 missing samples are filled the same way; a \
+longer gap splits the file into records of the same axis, joined as records are (parts \
+under 20 samples left out). Each is said in a note. Units (--units): time in s, ms or us \
+(not given: a median step above 0.5 is read as ms, above 500 as us, with a note); \
+channels in rad/s, deg/s, rad or deg, converted to rad/s and rad; a body-rate channel \
+(p, q, r, gx, gy, gz, or a name holding `rate` or `gyro`) without a unit that peaks above \
+15 gets a note that it looks like deg/s.\n\nThe swept input of a CSV file is, in this order: \
 --swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
 must be the same on every row kept; else the input with the largest RMS about its trend \
 line. A dump's Header names its swept axis.\n\nWhich inputs get responses \
@@ -96,7 +106,7 @@ pub struct FrfArgs {
     /// Which inputs get responses (see below).
     #[arg(long, value_enum, default_value_t = ExcitedArg::Auto)]
     pub excited: ExcitedArg,
-    /// CSV: the time column in s.
+    /// CSV: the time column (a header name, or a position: 1 = first).
     #[arg(long, value_name = "COLUMN", default_value = "time_s")]
     pub time: String,
     /// CSV: input columns, `NAME=COLUMN` or `COLUMN`, comma-separated.
@@ -113,6 +123,20 @@ pub struct FrfArgs {
         default_value = "u,v,w,p,q,r,ax,ay,az,phi,theta"
     )]
     pub output_columns: String,
+    /// CSV: the excitation injected into an input (the sweep), `NAME=COLUMN` with NAME
+    /// from --inputs, comma-separated: the instrument of `--estimator sweep-reference`.
+    #[arg(long = "reference", value_name = "LIST")]
+    pub reference_columns: Option<String>,
+    /// CSV: units, `NAME=UNIT` comma-separated: NAME from --inputs or --outputs with
+    /// rad/s, deg/s, rad or deg (converted to rad/s, rad), or `time` with s, ms or us.
+    /// Channels not named are used as written. May be given more than once; a later unit
+    /// for the same name wins.
+    #[arg(long, value_name = "LIST")]
+    pub units: Vec<String>,
+    /// CSV: keep only the rows whose time lies in [T0, T1] seconds (on the file's time
+    /// axis, after its unit).
+    #[arg(long, value_name = "T0,T1", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: Option<Window>,
     /// CSV: the swept input (a name from --inputs); overrides the file's primary column.
     /// Default: the primary column, else the most active input. `--primary` is an alias.
     #[arg(long = "swept", alias = "primary", value_name = "NAME")]
@@ -138,7 +162,7 @@ pub enum EstimatorArg {
     Cross,
     /// The recorded sweep as instrument of the swept control: free of the bias an engaged
     /// hold puts into the cross-spectral estimate by feeding sensor noise into the stick,
-    /// but more scattered (see docs/cli.md, frf); dumps only
+    /// but more scattered (see docs/cli.md, frf); dumps, or CSV with --reference
     SweepReference,
 }
 
@@ -190,6 +214,52 @@ fn parse_band(text: &str) -> Result<Band, String> {
         return Err(format!("`{text}`: need 0 < WMIN < WMAX"));
     }
     Ok(Band([lo, hi]))
+}
+
+/// A time window [s] as given on the command line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Window(pub [f64; 2]);
+
+fn parse_window(text: &str) -> Result<Window, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [t0, t1] = parts.as_slice() else {
+        return Err(format!("`{text}`: expected T0,T1"));
+    };
+    let number = |s: &str| {
+        s.parse::<f64>()
+            .map_err(|_| format!("`{s}` is not a number"))
+    };
+    let (t0, t1) = (number(t0)?, number(t1)?);
+    if !(t0.is_finite() && t1.is_finite() && t1 > t0) {
+        return Err(format!("`{text}`: need T0 < T1"));
+    }
+    Ok(Window([t0, t1]))
+}
+
+/// The units `--units` gives: the time column's, if given, and the channels'.
+type Units = (Option<TimeUnit>, Vec<(String, Unit)>);
+
+/// `--units`: the time column's unit and the channels' units.
+fn parse_units(list: &str) -> anyhow::Result<Units> {
+    let mut time = None;
+    let mut channels = Vec::new();
+    for (name, unit) in parse_columns(list, "--units")? {
+        if name == "time" {
+            let Some(unit) = TimeUnit::parse(&unit) else {
+                bail!("--units `time={unit}`: the time unit is s, ms or us");
+            };
+            time = Some(unit);
+        } else {
+            let Some(unit) = Unit::parse(&unit) else {
+                bail!(
+                    "--units `{name}={unit}`: a unit is rad/s, deg/s, rad or deg (time: s, ms, us)"
+                );
+            };
+            channels.retain(|(n, _): &(String, Unit)| *n != name);
+            channels.push((name, unit));
+        }
+    }
+    Ok((time, channels))
 }
 
 /// `--max-random-error`: a bound, or none.
@@ -252,9 +322,31 @@ impl FrfArgs {
                 );
             }
         }
+        let references = match &self.reference_columns {
+            Some(list) => parse_columns(list, "--reference")?,
+            None => Vec::new(),
+        };
+        for (name, _) in &references {
+            if !inputs.iter().any(|(input, _)| input == name) {
+                let names: Vec<&str> = inputs.iter().map(|(name, _)| name.as_str()).collect();
+                bail!(
+                    "--reference `{name}`: not one of the --inputs names ({})",
+                    names.join(", ")
+                );
+            }
+        }
+        let (time_unit, units) = if self.units.is_empty() {
+            (None, Vec::new())
+        } else {
+            parse_units(&self.units.join(","))?
+        };
         Ok(CsvColumns {
             time: self.time.clone(),
             inputs,
+            references,
+            units,
+            time_unit,
+            window_s: self.window.map(|w| w.0),
             outputs: parse_columns(&self.output_columns, "--outputs")?,
             primary: self.swept.clone(),
             primary_column: Some(self.primary_column.clone()),
@@ -282,17 +374,14 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     for path in &inputs {
         check_input_file("input", path)?;
     }
-    let records: Vec<Record> = args
-        .files
-        .iter()
-        .map(|path| {
-            if is_csv(path) {
-                load_csv(path, &columns)
-            } else {
-                load_dump(path)
-            }
-        })
-        .collect::<Result<_, _>>()?;
+    let mut records: Vec<Record> = Vec::new();
+    for path in &args.files {
+        if is_csv(path) {
+            records.extend(load_csv_records(path, &columns)?);
+        } else {
+            records.push(load_dump(path)?);
+        }
+    }
     let groups = group_by_primary(records)?;
     let analysis = analyse(&groups, &opts)?;
 
@@ -574,6 +663,20 @@ mod tests {
         }
         assert!(!out.exists());
         assert!(parse_band("3,1").is_err() && parse_band("0.5,20").is_ok());
+        assert_eq!(parse_window("-1,5"), Ok(Window([-1.0, 5.0])));
+        for bad in ["5,1", "1", "a,2", "0,inf"] {
+            assert!(parse_window(bad).is_err(), "{bad}");
+        }
+        let (time, channels) = parse_units("p=deg/s,time=ms,p=rad/s,phi=deg").unwrap();
+        assert_eq!(time, Some(TimeUnit::Milliseconds));
+        assert_eq!(
+            channels,
+            [
+                ("p".to_string(), Unit::RadPerS),
+                ("phi".to_string(), Unit::Deg)
+            ]
+        );
+        assert!(parse_units("time=h").is_err() && parse_units("p").is_err());
         assert_eq!(parse_max_random_error("none"), Ok(MaxRandomError(None)));
         assert_eq!(
             parse_max_random_error("0.15"),
