@@ -2,8 +2,8 @@
 //!
 //! One row per sample, fields separated by commas (surrounding spaces and double quotes
 //! around a field are ignored; quoted fields may not contain commas). The first row
-//! names the columns, unless every field of it is a number: then the file has no header
-//! and its columns are named by position. Which columns are time, inputs, outputs and
+//! names the columns, unless every field of it is a number (or empty): then the file has
+//! no header and its columns are named by position. Which columns are time, inputs, outputs and
 //! references is given by [`CsvColumns`]; a column is given by its header name or by
 //! its position, 1 for the first (a header name that is itself a number wins).
 //!
@@ -362,11 +362,14 @@ pub fn parse_csv_records(
 }
 
 /// The columns found in the first line: its header names, or `None` when every field
-/// of it is a number (no header), and how many fields it has.
+/// of it is a number or empty (no header: a first data row with a missing value), and
+/// how many fields it has.
 fn header(first: &str) -> (Option<Vec<&str>>, usize) {
     let fields: Vec<&str> = first.split(',').map(field).collect();
     let width = fields.len();
-    let numbers = fields.iter().all(|f| f.parse::<f64>().is_ok());
+    let numbers = fields
+        .iter()
+        .all(|f| f.is_empty() || f.parse::<f64>().is_ok());
     ((!numbers).then_some(fields), width)
 }
 

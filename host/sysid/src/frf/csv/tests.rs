@@ -204,6 +204,15 @@ fn columns_by_position_and_units_converted() {
     };
     let record = parse_csv(&text, "x.csv", &deg).unwrap();
     assert_eq!(record.len(), 100);
+    // A first row with a missing value is a data row, not a header.
+    let gap_first = format!("0,,1\n{}", text.split_once('\n').unwrap().1);
+    let gap_record = parse_csv(&gap_first, "x.csv", &deg).unwrap();
+    assert_eq!(gap_record.len(), 99);
+    assert!(
+        gap_record.notes.iter().any(|n| n.contains("line(s) 1)")),
+        "{:?}",
+        gap_record.notes
+    );
     assert!((record.sample_rate_hz - 100.0).abs() < 1e-9);
     assert!((record.output("p").unwrap()[0] - 57.3f64.to_radians()).abs() < 1e-12);
     assert_eq!(
