@@ -555,7 +555,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
                     error(
                         line_number,
                         format!(
-                            "`{text}` in column `{}` is not a number",
+                            "`{text}` in column `{}` is not a number (write a missing value as an empty field or nan)",
                             column_name(index)
                         ),
                     )

@@ -151,7 +151,7 @@ fn clear_errors() {
     let err = parse_csv("t,d_lat,d_lon,p\n0,1,2,3\n0.1,1,x,3\n", "b.csv", &columns()).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "b.csv:3: `x` in column `d_lon` is not a number"
+        "b.csv:3: `x` in column `d_lon` is not a number (write a missing value as an empty field or nan)"
     );
     let err = parse_csv("", "e.csv", &columns()).unwrap_err();
     assert!(err.to_string().contains("empty"), "{err}");
