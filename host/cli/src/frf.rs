@@ -3,13 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::csv_args::CsvArgs;
 use crate::output::{
     check_input_file, check_output_folder, refuse_inputs_as_outputs, write_files_into, write_json,
 };
-use anyhow::bail;
 use clap::Args;
 use sysid::frf::{
-    analyse, group_by_primary, load_csv, load_dump, CsvColumns, FrfAnalysis, FrfOptions, Record,
+    analyse, group_by_primary, load_csv_records, load_dump, FrfAnalysis, FrfOptions, Record,
     ResponseEstimator, ResponseInputs,
 };
 
@@ -20,8 +20,18 @@ use sysid::frf::{
 to zero at the joins). The response of output y to control x comes from the records in \
 which x is swept (or, see --excited, in which x moves with the swept control), conditioned \
 on the other controls excited there. Files ending in .csv \
-are read as CSV with a header row (columns chosen with --time, --inputs, --outputs); \
-anything else as a telemetry dump.\n\nThe swept input of a CSV file is, in this order: \
+are read as CSV (columns chosen with --time, --inputs, --outputs, --reference, by header \
+name or by position, 1 = first; a file whose first row is all numbers has no header); \
+anything else as a telemetry dump.\n\nCSV rows: --window keeps the rows in a time span; \
+a row with an empty or non-finite field is a missing sample. Timestamps within 5 % of a \
+step of a uniform grid are used as they are; jittered ones are resampled onto a uniform \
+grid by linear interpolation; gaps of up to 5 missing samples are filled the same way; a \
+longer gap splits the file into records of the same axis, joined as records are (parts \
+under 20 samples left out). Each is said in a note. Units (--units): time in s, ms or us \
+(not given: a median step above 0.5 is read as ms, above 500 as us, with a note); \
+channels in rad/s, deg/s, rad or deg, converted to rad/s and rad; a body-rate channel \
+(p, q, r, gx, gy, gz, or a name holding `rate` or `gyro`) without a unit that peaks above \
+15 gets a note that it looks like deg/s.\n\nThe swept input of a CSV file is, in this order: \
 --swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
 must be the same on every row kept; else the input with the largest RMS about its trend \
 line. A dump's Header names its swept axis.\n\nWhich inputs get responses \
@@ -102,36 +112,9 @@ pub struct FrfArgs {
     /// Which inputs get responses (see below).
     #[arg(long, value_enum, default_value_t = ExcitedArg::Auto)]
     pub excited: ExcitedArg,
-    /// CSV: the time column in s.
-    #[arg(long, value_name = "COLUMN", default_value = "time_s")]
-    pub time: String,
-    /// CSV: input columns, `NAME=COLUMN` or `COLUMN`, comma-separated.
-    #[arg(
-        long = "inputs",
-        value_name = "LIST",
-        default_value = "lat=cmd_lat,lon=cmd_lon,ped=cmd_ped,col=cmd_col"
-    )]
-    pub input_columns: String,
-    /// CSV: output columns, `NAME=COLUMN` or `COLUMN`, comma-separated.
-    #[arg(
-        long = "outputs",
-        value_name = "LIST",
-        default_value = "u,v,w,p,q,r,ax,ay,az,phi,theta"
-    )]
-    pub output_columns: String,
-    /// CSV: the swept input (a name from --inputs); overrides the file's primary column.
-    /// Default: the primary column, else the most active input. `--primary` is an alias.
-    #[arg(long = "swept", alias = "primary", value_name = "NAME")]
-    pub swept: Option<String>,
-    /// CSV: column naming the swept axis on each row (`decode` writes `primary`), by an
-    /// input name or the axis of a `cmd_AXIS` input column; read when the file has it and
-    /// --swept is not given.
-    #[arg(long, value_name = "COLUMN", default_value = "primary")]
-    pub primary_column: String,
-    /// CSV: column whose value keeps a row only in the fade_in, sweep and fade_out
-    /// phases (ignored when the file has no such column).
-    #[arg(long, value_name = "COLUMN", default_value = "phase")]
-    pub phase_column: String,
+    /// The CSV options.
+    #[command(flatten)]
+    pub csv: CsvArgs,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -144,7 +127,7 @@ pub enum EstimatorArg {
     Cross,
     /// The recorded sweep as instrument of the swept control: free of the bias an engaged
     /// hold puts into the cross-spectral estimate by feeding sensor noise into the stick,
-    /// but more scattered (see docs/cli.md, frf); dumps only
+    /// but more scattered (see docs/cli.md, frf); dumps, or CSV with --reference
     SweepReference,
 }
 
@@ -214,23 +197,6 @@ fn parse_max_random_error(text: &str) -> Result<MaxRandomError, String> {
     }
 }
 
-/// `NAME=COLUMN` or `COLUMN` (name = column), comma-separated.
-fn parse_columns(list: &str, option: &str) -> anyhow::Result<Vec<(String, String)>> {
-    let columns: Vec<(String, String)> = list
-        .split(',')
-        .map(str::trim)
-        .filter(|s| !s.is_empty())
-        .map(|item| match item.split_once('=') {
-            Some((name, column)) => (name.trim().to_string(), column.trim().to_string()),
-            None => (item.to_string(), item.to_string()),
-        })
-        .collect();
-    if columns.is_empty() || columns.iter().any(|(n, c)| n.is_empty() || c.is_empty()) {
-        bail!("{option} `{list}`: expected NAME=COLUMN or COLUMN, comma-separated");
-    }
-    Ok(columns)
-}
-
 impl FrfArgs {
     /// The analysis options these arguments give.
     pub fn options(&self) -> FrfOptions {
@@ -246,28 +212,6 @@ impl FrfArgs {
             ..FrfOptions::default()
         }
     }
-
-    fn csv_columns(&self) -> anyhow::Result<CsvColumns> {
-        let inputs = parse_columns(&self.input_columns, "--inputs")?;
-        if let Some(swept) = &self.swept {
-            if !inputs.iter().any(|(name, _)| name == swept) {
-                let names: Vec<&str> = inputs.iter().map(|(name, _)| name.as_str()).collect();
-                bail!(
-                    "--swept `{swept}`: not one of the --inputs names ({})",
-                    names.join(", ")
-                );
-            }
-        }
-        Ok(CsvColumns {
-            time: self.time.clone(),
-            inputs,
-            outputs: parse_columns(&self.output_columns, "--outputs")?,
-            primary: self.swept.clone(),
-            primary_column: Some(self.primary_column.clone()),
-            phase_column: Some(self.phase_column.clone()),
-            sweep_band: self.band.map(|b| b.0),
-        })
-    }
 }
 
 fn is_csv(path: &Path) -> bool {
@@ -279,7 +223,7 @@ fn is_csv(path: &Path) -> bool {
 pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     let opts = args.options();
     opts.validate()?;
-    let columns = args.csv_columns()?;
+    let columns = args.csv.columns(args.band.map(|b| b.0))?;
     let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
     refuse_inputs_as_outputs(&inputs, &[("--out", &args.out)])?;
     if let Some(dir) = &args.plots {
@@ -288,17 +232,14 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     for path in &inputs {
         check_input_file("input", path)?;
     }
-    let records: Vec<Record> = args
-        .files
-        .iter()
-        .map(|path| {
-            if is_csv(path) {
-                load_csv(path, &columns)
-            } else {
-                load_dump(path)
-            }
-        })
-        .collect::<Result<_, _>>()?;
+    let mut records: Vec<Record> = Vec::new();
+    for path in &args.files {
+        if is_csv(path) {
+            records.extend(load_csv_records(path, &columns)?);
+        } else {
+            records.push(load_dump(path)?);
+        }
+    }
     let groups = group_by_primary(records)?;
     let analysis = analyse(&groups, &opts)?;
 

@@ -14,6 +14,7 @@ use clap::{Parser, Subcommand};
 pub mod arg_values;
 pub mod artifacts;
 pub mod campaign;
+pub mod csv_args;
 pub mod decode;
 pub mod fit;
 pub mod fly;

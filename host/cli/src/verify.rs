@@ -1,5 +1,5 @@
 //! `sweephold verify`: simulate an identified model (`model.json`) on the inputs recorded
-//! in telemetry dumps and score its prediction of the recorded outputs with Theil's
+//! in telemetry dumps or CSV logs and score its prediction of the recorded outputs with Theil's
 //! inequality coefficient (the time-domain check of CIFER's VERIFID; method in
 //! `sysid::fit::verify`).
 
@@ -7,12 +7,13 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::PathBuf;
 
+use crate::csv_args::CsvArgs;
 use crate::output::{check_input_file, check_output_folder, write_files_into};
 use anyhow::{anyhow, Context};
 use clap::Args;
 use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification, VerifyError};
 use sysid::fit::ModelDocument;
-use sysid::frf::load_test_dump;
+use sysid::frf::{load_csv_records, load_test_dump, Record};
 
 /// Arguments of `sweephold verify`.
 #[derive(Args, Debug)]
@@ -23,15 +24,20 @@ of each input and the bias b of each output is its mean over the dump's trim-cap
 before the excitation; a dump without them is refused. With --bias fitted b is fitted by \
 least squares, b = mean(y - ŷ), and the inputs are taken from their first sample (this also \
 removes any constant error of the prediction). TIC = rms(y - b - ŷ) / (rms(y - b) + rms(ŷ)): \
-0 perfect, 1 worst; <= 0.25-0.3 is the usual acceptance guideline."
+0 perfect, 1 worst; <= 0.25-0.3 is the usual acceptance guideline.\n\nFiles ending in .csv \
+are read as frf reads them (--time, --inputs, --outputs, --units, --window; see \
+`sweephold frf --help`), with the inputs and outputs named as the model names its controls \
+and outputs; a CSV log has no trim-capture samples, so it needs --bias fitted. The reader's \
+notes (resampling, gaps, units) are printed under the record's table."
 )]
 pub struct VerifyArgs {
     /// The identified model (`model.json` as `sweephold fit --out` writes it).
     #[arg(long, value_name = "model.json")]
     pub model: PathBuf,
-    /// Telemetry dumps to verify against (ideally records not used in the fit): any test
-    /// the firmware flies — doublet, 3-2-1-1 or sweep (`sweephold fly --input doublet`).
-    #[arg(value_name = "DUMP", required = true)]
+    /// Telemetry dumps or CSV logs to verify against (ideally records not used in the
+    /// fit): any test the firmware flies — doublet, 3-2-1-1 or sweep (`sweephold fly
+    /// --input doublet`).
+    #[arg(value_name = "DUMP|CSV", required = true)]
     pub dumps: Vec<PathBuf>,
     /// Write one SVG per dump and output (measured vs predicted) into this folder. A plot's
     /// name there that is a symbolic link to the model or a dump is refused; any other link
@@ -47,6 +53,9 @@ pub struct VerifyArgs {
     /// excitation (`trim`), or least squares over the record (`fitted`).
     #[arg(long, value_enum, default_value_t = BiasArg::Trim)]
     pub bias: BiasArg,
+    /// How to read CSV logs.
+    #[command(flatten)]
+    pub csv: CsvArgs,
 }
 
 /// `--bias`: the values of [`BiasMode`].
@@ -126,10 +135,24 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
     let bias = args.bias.mode();
     let _ = writeln!(report, "{}", bias_line(bias));
     let mut all_theil = Vec::new();
-    for dump in &args.dumps {
-        let record = load_test_dump(dump).map_err(|e| anyhow!("{e}"))?;
+    let columns = args.csv.columns(None)?;
+    let mut records: Vec<(&PathBuf, Record)> = Vec::new();
+    let mut columns_read = false;
+    for file in &args.dumps {
+        let is_csv = file
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+        columns_read |= is_csv;
+        if is_csv {
+            let read = load_csv_records(file, &columns).map_err(|e| anyhow!("{e}"))?;
+            records.extend(read.into_iter().map(|record| (file, record)));
+        } else {
+            records.push((file, load_test_dump(file).map_err(|e| anyhow!("{e}"))?));
+        }
+    }
+    for (dump, record) in &records {
         let verification =
-            verify_record_in_segments(&model, &record, args.segment, bias).map_err(|e| {
+            verify_record_in_segments(&model, record, args.segment, bias).map_err(|e| {
                 // Record errors name the dump already; model errors get it in front.
                 let message = e.to_string();
                 if let VerifyError::NoTrim { record: source } = &e {
@@ -144,6 +167,9 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
                 }
             })?;
         write_verification(&mut report, &verification);
+        for note in &record.notes {
+            let _ = writeln!(report, "note: {note}");
+        }
         all_theil.extend(verification.outputs.iter().map(|o| o.theil));
         if let (Some(dir), None) = (&args.plots, verification.diverged_at_s) {
             let mut inputs = vec![args.model.as_path()];
@@ -157,11 +183,17 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
             let _ = writeln!(report, "wrote {written} plots to {}", dir.display());
         }
     }
-    if args.dumps.len() > 1 && !all_theil.is_empty() {
+    if records.len() > 1 && !all_theil.is_empty() {
+        // Dumps give one record each; CSV logs may give several (split at long gaps).
+        let what = if records.len() == args.dumps.len() && !columns_read {
+            "dumps"
+        } else {
+            "records"
+        };
         let _ = writeln!(
             report,
-            "\nmean TIC over {} dumps: {:.4}",
-            args.dumps.len(),
+            "\nmean TIC over {} {what}: {:.4}",
+            records.len(),
             all_theil.iter().sum::<f64>() / all_theil.len() as f64
         );
     }
@@ -240,6 +272,7 @@ mod tests {
             plots: None,
             segment: None,
             bias: BiasArg::Trim,
+            csv: CsvArgs::default(),
         }
     }
 
@@ -464,6 +497,80 @@ mean TIC over 2 dumps: 0.3638
             "{trim}"
         );
         assert!(!trim.contains("p          0.7191"), "{trim}");
+        fs::remove_dir_all(&directory).ok();
+    }
+
+    /// The score table of a report: (output, TIC, rms error, rms meas., rms pred., bias).
+    fn table(report: &str) -> Vec<(String, Vec<f64>)> {
+        report
+            .lines()
+            .skip_while(|l| !l.starts_with("output"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("mean"))
+            .map(|l| {
+                let mut cells = l.split_whitespace();
+                let name = cells.next().unwrap().to_string();
+                (name, cells.map(|c| c.parse().unwrap()).collect())
+            })
+            .collect()
+    }
+
+    /// A dump decoded to CSV verifies as the dump does (fitted bias: a CSV log has no
+    /// trim samples), and the CSV with the default trim bias is refused with the remedy.
+    #[test]
+    fn a_decoded_csv_verifies_as_its_dump() {
+        use sweephold_protocol::{codec, synthetic, Frame};
+        let directory =
+            std::env::temp_dir().join(format!("sweephold-verify-csv-{}", std::process::id()));
+        let (model, _) = trimmed_files(&directory);
+        let dump = directory.join("sweep.bin");
+        let mut bytes = codec::encode_to_vec(&Frame::Header(synthetic::header()))
+            .unwrap()
+            .to_vec();
+        for tick in 0..2000 {
+            bytes.extend(
+                codec::encode_to_vec(&Frame::Sample(synthetic::sample(tick)))
+                    .unwrap()
+                    .to_vec(),
+            );
+        }
+        fs::write(&dump, bytes).unwrap();
+        let csv = directory.join("sweep.csv");
+        crate::decode::run(&crate::decode::DecodeArgs {
+            dumps: vec![dump.clone()],
+            format: crate::decode::Format::Csv,
+            output: Some(csv.clone()),
+            quiet: true,
+        })
+        .unwrap();
+        let fitted = |file: &PathBuf| {
+            report(&VerifyArgs {
+                bias: BiasArg::Fitted,
+                segment: Some(2.0),
+                ..args(model.clone(), vec![file.clone()])
+            })
+            .unwrap()
+        };
+        let (from_dump, from_csv) = (fitted(&dump), fitted(&csv));
+        assert!(
+            from_csv.contains("sweep.csv: 2000 samples at 200"),
+            "{from_csv}"
+        );
+        let (a, b) = (table(&from_dump), table(&from_csv));
+        assert_eq!(a.len(), 2, "{from_dump}");
+        for ((name_a, a), (name_b, b)) in a.iter().zip(&b) {
+            assert_eq!(name_a, name_b);
+            for (x, y) in a.iter().zip(b) {
+                // Decode prints the dump's f32 values in their shortest form.
+                assert!((x - y).abs() <= 1e-5, "{name_a}: {x} vs {y}");
+            }
+        }
+        let error = report(&args(model.clone(), vec![csv.clone()])).unwrap_err();
+        let message = format!("{error:#}");
+        assert!(
+            message.contains("sweep.csv: no trim samples") && message.contains("--bias fitted"),
+            "{message}"
+        );
         fs::remove_dir_all(&directory).ok();
     }
 }

@@ -1,10 +1,26 @@
 //! Records from CSV files, so data logged by other systems can be analysed too.
 //!
-//! The file has one header row naming the columns, then one row per sample, fields
-//! separated by commas (surrounding spaces and double quotes around a field are
-//! ignored; quoted fields may not contain commas). Which columns are time, inputs and
-//! outputs is given by [`CsvColumns`]. The time column must be uniformly sampled (each
-//! step within 25 % of the mean step); it sets the sample rate.
+//! One row per sample, fields separated by commas (surrounding spaces and double quotes
+//! around a field are ignored; quoted fields may not contain commas). The first row
+//! names the columns, unless every field of it is a number (or empty): then the file has
+//! no header and its columns are named by position. Which columns are time, inputs, outputs and
+//! references is given by [`CsvColumns`]; a column is given by its header name or by
+//! its position, 1 for the first (a header name that is itself a number wins).
+//!
+//! **Units** ([`units`]): the time column in s, ms or µs ([`CsvColumns::time_unit`];
+//! not given, a median step above 0.5 is read as ms, above 500 as µs, with a note);
+//! channels in rad/s, deg/s, rad or deg ([`CsvColumns::units`], converted to SI); a
+//! body-rate channel without a unit that peaks above 15 gets a note that it looks like
+//! deg/s.
+//!
+//! **Rows**: [`CsvColumns::window_s`] keeps only the rows whose time (in seconds) lies
+//! in it. A row with an empty or non-finite field (`nan`, `inf`) in a column read is
+//! left out, as a missing sample; a field that is not a number is an error naming its
+//! line. Then the samples are put on a uniform grid ([`timing`]): uniform timestamps
+//! (within 5 % of a step) are used as they are; jitter is resampled by linear
+//! interpolation; gaps of up to 5 missing samples are filled; a longer gap splits the
+//! file into several records of the same swept axis ([`parse_csv_records`]), joined as
+//! records are. Each of these is said in a note. Time that steps back is refused.
 //!
 //! A CSV written by `sweephold decode` holds every phase of a test; when the file has a
 //! column named by [`CsvColumns::phase_column`] (default `phase`), only rows whose phase
@@ -16,20 +32,28 @@
 //! row; else the input with the largest RMS about its trend line, and the record is
 //! marked [`Record::primary_guessed`].
 
+pub mod timing;
+pub mod units;
+
 use std::path::Path;
 
 use super::records::{remove_line, rms, Channel, Record};
 use super::FrfError;
+use timing::{median, uniform_samples};
+use units::{deg_per_s_note, detected_time_unit, TimeUnit, Unit};
 
-/// Which CSV columns to read.
+/// Which CSV columns to read, and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CsvColumns {
-    /// Time column \[s\].
+    /// Time column: a header name or a position (1 = first).
     pub time: String,
-    /// Inputs as (channel name, column name).
+    /// Inputs as (channel name, column).
     pub inputs: Vec<(String, String)>,
-    /// Outputs as (channel name, column name).
+    /// Outputs as (channel name, column).
     pub outputs: Vec<(String, String)>,
+    /// References as (input name, column): the excitation injected into that input (the
+    /// sweep), for [`ResponseEstimator::SweepReference`](super::ResponseEstimator::SweepReference).
+    pub references: Vec<(String, String)>,
     /// The swept input (a channel name, `frf --swept`); it overrides the file's primary
     /// column. `None`: the primary column names it, else the input with the largest RMS
     /// about its trend line does.
@@ -43,6 +67,13 @@ pub struct CsvColumns {
     pub phase_column: Option<String>,
     /// Sweep band [rad/s], if known.
     pub sweep_band: Option<[f64; 2]>,
+    /// Units of channels, by channel name (a reference takes its input's); channels not
+    /// named are used as written.
+    pub units: Vec<(String, Unit)>,
+    /// Unit of the time column; `None`: told from its median step ([`units`]).
+    pub time_unit: Option<TimeUnit>,
+    /// Keep only the rows whose time \[s\] lies in [t0, t1].
+    pub window_s: Option<[f64; 2]>,
 }
 
 impl Default for CsvColumns {
@@ -65,10 +96,14 @@ impl Default for CsvColumns {
             outputs: same(&[
                 "u", "v", "w", "p", "q", "r", "ax", "ay", "az", "phi", "theta",
             ]),
+            references: Vec::new(),
             primary: None,
             primary_column: Some(PRIMARY_COLUMN.into()),
             phase_column: Some("phase".into()),
             sweep_band: None,
+            units: Vec::new(),
+            time_unit: None,
+            window_s: None,
         }
     }
 }
@@ -83,18 +118,263 @@ fn field(raw: &str) -> &str {
     raw.trim().trim_matches('"').trim()
 }
 
-/// Load a record from a CSV file.
-pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, FrfError> {
-    let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|error| FrfError::Io {
+fn read(path: &Path) -> Result<String, FrfError> {
+    std::fs::read_to_string(path).map_err(|error| FrfError::Io {
         path: path.to_path_buf(),
         error,
-    })?;
-    parse_csv(&text, &path.display().to_string(), columns)
+    })
 }
 
-/// Parse CSV text; `source` names it in messages.
+/// Load a record from a CSV file; a file that long gaps split into several records is
+/// refused (read it with [`load_csv_records`]).
+pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, FrfError> {
+    let path = path.as_ref();
+    parse_csv(&read(path)?, &path.display().to_string(), columns)
+}
+
+/// Load the records of a CSV file: one, or several when long gaps split it.
+pub fn load_csv_records(
+    path: impl AsRef<Path>,
+    columns: &CsvColumns,
+) -> Result<Vec<Record>, FrfError> {
+    let path = path.as_ref();
+    parse_csv_records(&read(path)?, &path.display().to_string(), columns)
+}
+
+/// Parse CSV text into one record; `source` names it in messages. A file that long gaps
+/// split into several records is refused (read it with [`parse_csv_records`]).
 pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Record, FrfError> {
+    let mut records = parse_csv_records(text, source, columns)?;
+    if records.len() > 1 {
+        return Err(FrfError::Csv {
+            path: source.into(),
+            line: 0,
+            message: format!(
+                "gaps split this file into {} records; read it as several (parse_csv_records)",
+                records.len()
+            ),
+        });
+    }
+    Ok(records.remove(0))
+}
+
+/// The rows read: times and channel values (inputs, outputs, references, in the order
+/// of [`CsvColumns`]), and the rows left out for a missing value.
+struct Rows {
+    times: Vec<f64>,
+    channels: Vec<Vec<f64>>,
+    /// (line, time if it was read) of each row left out for an empty or non-finite field.
+    missing: Vec<(usize, Option<f64>)>,
+    /// The primary column's value and the first and last kept lines that carried it.
+    named_axis: Option<(String, usize, usize)>,
+    /// The primary column's name, when read.
+    primary_column: Option<String>,
+    /// Whether the file has a phase column.
+    phased: bool,
+}
+
+/// Parse CSV text into records (one, or several when long gaps split it); `source`
+/// names the file in messages.
+pub fn parse_csv_records(
+    text: &str,
+    source: &str,
+    columns: &CsvColumns,
+) -> Result<Vec<Record>, FrfError> {
+    let error = |line: usize, message: String| FrfError::Csv {
+        path: source.into(),
+        line,
+        message,
+    };
+    let mut rows = read_rows(text, source, columns)?;
+    let fewer_than_two = |rows: &Rows| {
+        let missing = if rows.missing.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " ({} row(s) with an empty or non-finite field left out)",
+                rows.missing.len()
+            )
+        };
+        error(
+            0,
+            if rows.phased {
+                format!("fewer than two rows in the fade-in, sweep or fade-out phases: no sweep{missing}")
+            } else {
+                format!("fewer than two data rows{missing}")
+            },
+        )
+    };
+    if rows.times.len() < 2 {
+        return Err(fewer_than_two(&rows));
+    }
+    let mut notes = Vec::new();
+
+    // Time in seconds.
+    let steps: Vec<f64> = rows.times.windows(2).map(|t| t[1] - t[0]).collect();
+    let time_unit = match columns.time_unit {
+        Some(unit) => unit,
+        None => {
+            let step = median(&steps);
+            let unit = detected_time_unit(step);
+            if unit != TimeUnit::Seconds {
+                notes.push(format!(
+                    "{source}: time column `{}` read in {}: its median step, {step}, would be a rate below 2 Hz in seconds (give its unit: --units time=s|ms|us)",
+                    columns.time,
+                    unit.symbol()
+                ));
+            }
+            unit
+        }
+    };
+    if time_unit != TimeUnit::Seconds {
+        let factor = time_unit.to_seconds();
+        rows.times.iter_mut().for_each(|t| *t *= factor);
+        for (_, t) in &mut rows.missing {
+            if let Some(t) = t {
+                *t *= factor;
+            }
+        }
+    }
+
+    if let Some([t0, t1]) = columns.window_s {
+        let inside = |t: f64| (t0..=t1).contains(&t);
+        let (first, last) = (rows.times[0], rows.times[rows.times.len() - 1]);
+        let keep: Vec<bool> = rows.times.iter().map(|&t| inside(t)).collect();
+        let filter = |values: &mut Vec<f64>| {
+            let mut k = keep.iter();
+            values.retain(|_| *k.next().unwrap());
+        };
+        filter(&mut rows.times);
+        rows.channels.iter_mut().for_each(filter);
+        rows.missing.retain(|(_, t)| t.is_none_or(inside));
+        if rows.times.len() < 2 {
+            return Err(error(
+                0,
+                format!(
+                    "window {t0}–{t1} s keeps {} row(s): the time column runs {first}–{last} s",
+                    rows.times.len()
+                ),
+            ));
+        }
+    }
+
+    let times = &rows.times;
+    let span = times[times.len() - 1] - times[0];
+    if span.is_nan() || span <= 0.0 {
+        return Err(error(
+            0,
+            format!("time column `{}` does not increase", columns.time),
+        ));
+    }
+    // Several records in one file (e.g. `decode a.bin b.bin -o x.csv`: its time restarts
+    // with each dump) are one record per file here.
+    if let Some(i) = times.windows(2).position(|t| t[1] <= t[0]) {
+        return Err(error(
+            0,
+            format!(
+                "time column `{}` steps back at kept row {} ({} s → {} s): a CSV file holds \
+                 one record here; decode each dump to its own file",
+                columns.time,
+                i + 1,
+                times[i],
+                times[i + 1]
+            ),
+        ));
+    }
+    if !rows.missing.is_empty() {
+        let lines: Vec<String> = rows
+            .missing
+            .iter()
+            .take(5)
+            .map(|(line, _)| line.to_string())
+            .collect();
+        let more = if rows.missing.len() > 5 { ", …" } else { "" };
+        notes.push(format!(
+            "{source}: {} row(s) with an empty or non-finite field left out as missing samples (line(s) {}{more})",
+            rows.missing.len(),
+            lines.join(", ")
+        ));
+    }
+
+    // Channels in SI units.
+    let channel_names: Vec<&str> = columns
+        .inputs
+        .iter()
+        .chain(&columns.outputs)
+        .chain(&columns.references)
+        .map(|(name, _)| name.as_str())
+        .collect();
+    for (name, values) in channel_names.iter().zip(&mut rows.channels) {
+        match columns.units.iter().find(|(n, _)| n == name) {
+            Some((_, unit)) if unit.to_si() != 1.0 => {
+                values.iter_mut().for_each(|v| *v *= unit.to_si());
+            }
+            Some(_) => {}
+            None => notes.extend(deg_per_s_note(source, name, values)),
+        }
+    }
+
+    let primary = swept_input(&rows, source, columns, &mut notes)?;
+    let primary_guessed = primary.1;
+    let (times, channels) = (rows.times, rows.channels);
+    let uniform = uniform_samples(&times, channels).map_err(|message| error(0, message))?;
+    notes.extend(uniform.notes.iter().map(|n| format!("{source}: {n}")));
+
+    let count = uniform.parts.len();
+    let (n_in, n_out) = (columns.inputs.len(), columns.outputs.len());
+    let named = |list: &[(String, String)], values: &[Vec<f64>]| -> Vec<Channel> {
+        list.iter()
+            .zip(values)
+            .map(|((name, _), v)| Channel::new(name.clone(), v.clone()))
+            .collect()
+    };
+    let mut records = Vec::with_capacity(count);
+    for (k, part) in uniform.parts.iter().enumerate() {
+        let record = Record {
+            source: if count == 1 {
+                source.into()
+            } else {
+                format!(
+                    "{source} (part {} of {count}, from {:.3} s)",
+                    k + 1,
+                    part.start_s
+                )
+            },
+            sample_rate_hz: 1.0 / uniform.step_s,
+            primary: primary.0.clone(),
+            primary_guessed,
+            sweep_band: columns.sweep_band,
+            inputs: named(&columns.inputs, &part.channels[..n_in]),
+            outputs: named(&columns.outputs, &part.channels[n_in..n_in + n_out]),
+            references: named(&columns.references, &part.channels[n_in + n_out..]),
+            // The file's notes once, with its first record.
+            notes: if k == 0 {
+                std::mem::take(&mut notes)
+            } else {
+                Vec::new()
+            },
+            trim_samples: 0,
+        };
+        record.validate()?;
+        records.push(record);
+    }
+    Ok(records)
+}
+
+/// The columns found in the first line: its header names, or `None` when every field
+/// of it is a number or empty (no header: a first data row with a missing value), and
+/// how many fields it has.
+fn header(first: &str) -> (Option<Vec<&str>>, usize) {
+    let fields: Vec<&str> = first.split(',').map(field).collect();
+    let width = fields.len();
+    let numbers = fields
+        .iter()
+        .all(|f| f.is_empty() || f.parse::<f64>().is_ok());
+    ((!numbers).then_some(fields), width)
+}
+
+/// Read the rows of `text`: the kept rows' times and channel values.
+fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Rows, FrfError> {
     let error = |line: usize, message: String| FrfError::Csv {
         path: source.into(),
         line,
@@ -103,38 +383,51 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
     let mut lines = text
         .lines()
         .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    let (_, header) = lines.next().ok_or_else(|| error(0, "empty file".into()))?;
-    let names: Vec<&str> = header.split(',').map(field).collect();
-    let find = |column: &str| {
-        names.iter().position(|n| *n == column).ok_or_else(|| {
-            error(
+        .filter(|(_, l)| !l.trim().is_empty())
+        .peekable();
+    let &(_, first) = lines.peek().ok_or_else(|| error(0, "empty file".into()))?;
+    let (names, width) = header(first);
+    if names.is_some() {
+        lines.next();
+    }
+    let find = |column: &str| -> Result<usize, FrfError> {
+        if let Some(i) = names
+            .as_ref()
+            .and_then(|n| n.iter().position(|n| *n == column))
+        {
+            return Ok(i);
+        }
+        match column.parse::<usize>() {
+            Ok(position) if (1..=width).contains(&position) => Ok(position - 1),
+            _ => Err(error(
                 1,
-                format!("no column `{column}` (columns: {})", names.join(", ")),
-            )
-        })
+                match &names {
+                    Some(names) => format!("no column `{column}` (columns: {})", names.join(", ")),
+                    None => format!(
+                        "no column `{column}`: the file has no header row (its first row is all numbers); give columns by position, 1–{width} (e.g. --time 1 --inputs NAME=2 --outputs NAME=3)"
+                    ),
+                },
+            )),
+        }
+    };
+    let column_name = |index: usize| match &names {
+        Some(names) => names[index].to_string(),
+        None => (index + 1).to_string(),
     };
     let time_index = find(&columns.time)?;
-    let input_index = columns
+    let channel_index = columns
         .inputs
         .iter()
+        .chain(&columns.outputs)
+        .chain(&columns.references)
         .map(|(_, c)| find(c))
         .collect::<Result<Vec<_>, _>>()?;
-    let output_index = columns
-        .outputs
-        .iter()
-        .map(|(_, c)| find(c))
-        .collect::<Result<Vec<_>, _>>()?;
-    if input_index.is_empty() || output_index.is_empty() {
+    if columns.inputs.is_empty() || columns.outputs.is_empty() {
         return Err(error(
             0,
             "need at least one input and one output column".into(),
         ));
     }
-    let phase_index = columns
-        .phase_column
-        .as_deref()
-        .and_then(|c| names.iter().position(|n| *n == c));
     let input_names = || {
         columns
             .inputs
@@ -143,6 +436,35 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
             .collect::<Vec<_>>()
             .join(", ")
     };
+    for (name, _) in &columns.references {
+        if !columns.inputs.iter().any(|(n, _)| n == name) {
+            return Err(error(
+                0,
+                format!(
+                    "reference `{name}` is not named after an input ({})",
+                    input_names()
+                ),
+            ));
+        }
+    }
+    for (name, _) in &columns.units {
+        if !columns
+            .inputs
+            .iter()
+            .chain(&columns.outputs)
+            .any(|(n, _)| n == name)
+        {
+            let outputs: Vec<&str> = columns.outputs.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(error(
+                0,
+                format!(
+                    "unit given for `{name}`, which is neither an input ({}) nor an output ({})",
+                    input_names(),
+                    outputs.join(", ")
+                ),
+            ));
+        }
+    }
     if let Some(name) = &columns.primary {
         if !columns.inputs.iter().any(|(n, _)| n == name) {
             return Err(error(
@@ -154,26 +476,43 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
             ));
         }
     }
+    // Phase and primary columns are found by header name only.
+    let by_name = |column: Option<&'a str>| -> Option<(&'a str, usize)> {
+        column.and_then(|c| {
+            names
+                .as_ref()
+                .and_then(|n| n.iter().position(|n| *n == c))
+                .map(|i| (c, i))
+        })
+    };
+    let phase_index = by_name(columns.phase_column.as_deref()).map(|(_, i)| i);
     // The primary column, read only when no swept input was named.
-    let primary_column = columns
-        .primary
-        .is_none()
-        .then_some(columns.primary_column.as_deref())
-        .flatten()
-        .and_then(|c| names.iter().position(|n| *n == c).map(|i| (c, i)));
-    // Its value and the first and last kept lines that carried it.
-    let mut named_axis: Option<(String, usize, usize)> = None;
+    let primary_column = if columns.primary.is_none() {
+        by_name(columns.primary_column.as_deref())
+    } else {
+        None
+    };
 
-    let mut time = Vec::new();
-    let mut inputs = vec![Vec::new(); input_index.len()];
-    let mut outputs = vec![Vec::new(); output_index.len()];
+    let mut rows = Rows {
+        times: Vec::new(),
+        channels: vec![Vec::new(); channel_index.len()],
+        missing: Vec::new(),
+        named_axis: None,
+        primary_column: primary_column.map(|(c, _)| c.to_string()),
+        phased: phase_index.is_some(),
+    };
     for (number, line) in lines {
         let line_number = number + 1;
         let fields: Vec<&str> = line.split(',').map(field).collect();
-        if fields.len() != names.len() {
+        if fields.len() != width {
+            let first = if names.is_some() {
+                "the header"
+            } else {
+                "the first row"
+            };
             return Err(error(
                 line_number,
-                format!("{} fields, the header has {}", fields.len(), names.len()),
+                format!("{} fields, {first} has {width}", fields.len()),
             ));
         }
         if let Some(p) = phase_index {
@@ -183,11 +522,11 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
         }
         if let Some((column, index)) = primary_column {
             let value = fields[index];
-            match &mut named_axis {
+            match &mut rows.named_axis {
                 None if value.is_empty() => {
                     return Err(error(line_number, format!("column `{column}` is empty")));
                 }
-                None => named_axis = Some((value.to_string(), line_number, line_number)),
+                None => rows.named_axis = Some((value.to_string(), line_number, line_number)),
                 Some((axis, _, last)) if axis == value => *last = line_number,
                 Some((axis, first, last)) => {
                     let kept = if phase_index.is_some() {
@@ -204,81 +543,60 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
                 }
             }
         }
-        let number = |index: usize| {
-            fields[index]
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
+        // An empty or non-finite field is a missing sample; anything else must be a number.
+        let number = |index: usize| -> Result<Option<f64>, FrfError> {
+            let text = fields[index];
+            if text.is_empty() {
+                return Ok(None);
+            }
+            text.parse::<f64>()
+                .map(|v| v.is_finite().then_some(v))
+                .map_err(|_| {
                     error(
                         line_number,
                         format!(
-                            "`{}` in column `{}` is not a finite number",
-                            fields[index], names[index]
+                            "`{text}` in column `{}` is not a number (write a missing value as an empty field or nan)",
+                            column_name(index)
                         ),
                     )
                 })
         };
-        time.push(number(time_index)?);
-        for (values, &index) in inputs.iter_mut().zip(&input_index) {
-            values.push(number(index)?);
+        let time = number(time_index)?;
+        let values = channel_index
+            .iter()
+            .map(|&i| number(i))
+            .collect::<Result<Vec<_>, _>>()?;
+        match (time, values.iter().all(Option::is_some)) {
+            (Some(t), true) => {
+                rows.times.push(t);
+                for (channel, value) in rows.channels.iter_mut().zip(values) {
+                    channel.push(value.unwrap_or_default());
+                }
+            }
+            _ => rows.missing.push((line_number, time)),
         }
-        for (values, &index) in outputs.iter_mut().zip(&output_index) {
-            values.push(number(index)?);
-        }
     }
-    if time.len() < 2 {
-        return Err(error(
-            0,
-            if phase_index.is_some() {
-                "fewer than two rows in the fade-in, sweep or fade-out phases: no sweep".into()
-            } else {
-                "fewer than two data rows".into()
-            },
-        ));
-    }
-    let span = time[time.len() - 1] - time[0];
-    let step = span / (time.len() - 1) as f64;
-    if step.is_nan() || step <= 0.0 {
-        return Err(error(
-            0,
-            format!("time column `{}` does not increase", columns.time),
-        ));
-    }
-    // Several records in one file (e.g. `decode a.bin b.bin -o x.csv`: its time restarts
-    // with each dump) are one record per file here.
-    if let Some(i) = time.windows(2).position(|t| t[1] <= t[0]) {
-        return Err(error(
-            0,
-            format!(
-                "time column `{}` steps back at kept row {} ({} s → {} s): a CSV file holds \
-                 one record here; decode each dump to its own file",
-                columns.time,
-                i + 1,
-                time[i],
-                time[i + 1]
-            ),
-        ));
-    }
-    if let Some(i) = time
-        .windows(2)
-        .position(|t| ((t[1] - t[0]) - step).abs() > 0.25 * step)
-    {
-        return Err(error(
-            0,
-            format!(
-                "time column `{}` is not uniformly sampled: step {} s at row {} (mean {step} s)",
-                columns.time,
-                time[i + 1] - time[i],
-                i + 2
-            ),
-        ));
-    }
+    Ok(rows)
+}
 
-    let mut notes = Vec::new();
-    let named = match (&columns.primary, &named_axis, primary_column) {
+/// The swept input's name and whether it was only guessed (module docs).
+fn swept_input(
+    rows: &Rows,
+    source: &str,
+    columns: &CsvColumns,
+    notes: &mut Vec<String>,
+) -> Result<(String, bool), FrfError> {
+    let input_names = || {
+        columns
+            .inputs
+            .iter()
+            .map(|(name, _)| name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let named = match (&columns.primary, &rows.named_axis, &rows.primary_column) {
         (Some(name), _, _) => Some(name.clone()),
-        (None, Some((axis, _, _)), Some((column, _))) => {
+        (None, Some((axis, _, _)), Some(column)) => {
             // By channel name, or by the decode command column (`cmd_lat` for `lat`).
             let command_column = format!("cmd_{axis}");
             let input = columns
@@ -287,230 +605,37 @@ pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Recor
                 .find(|(name, _)| name == axis)
                 .or_else(|| columns.inputs.iter().find(|(_, c)| *c == command_column))
                 .map(|(name, _)| name.clone());
-            Some(input.ok_or_else(|| {
-                error(
-                    0,
-                    format!(
-                        "column `{column}` names `{axis}`, which is not among the inputs ({}); name the swept input (--swept)",
-                        input_names()
-                    ),
-                )
+            Some(input.ok_or_else(|| FrfError::Csv {
+                path: source.into(),
+                line: 0,
+                message: format!(
+                    "column `{column}` names `{axis}`, which is not among the inputs ({}); name the swept input (--swept)",
+                    input_names()
+                ),
             })?)
         }
         _ => None,
     };
-    let primary_guessed = named.is_none();
-    let primary = match named {
-        Some(name) => name,
-        None => {
-            // The most active input about its trend line.
-            let activity = |values: &Vec<f64>| {
-                let mut v = values.clone();
-                remove_line(&mut v);
-                rms(&v)
-            };
-            let best = inputs
-                .iter()
-                .enumerate()
-                .max_by(|a, b| activity(a.1).total_cmp(&activity(b.1)))
-                .map_or(0, |(i, _)| i);
-            let name = columns.inputs[best].0.clone();
-            notes.push(format!(
-                "{source}: swept input taken to be `{name}` (the most active)"
-            ));
-            name
-        }
+    if let Some(name) = named {
+        return Ok((name, false));
+    }
+    // The most active input about its trend line.
+    let activity = |values: &Vec<f64>| {
+        let mut v = values.clone();
+        remove_line(&mut v);
+        rms(&v)
     };
-    let record = Record {
-        source: source.into(),
-        sample_rate_hz: 1.0 / step,
-        primary,
-        primary_guessed,
-        sweep_band: columns.sweep_band,
-        inputs: columns
-            .inputs
-            .iter()
-            .zip(inputs)
-            .map(|((name, _), values)| Channel::new(name.clone(), values))
-            .collect(),
-        outputs: columns
-            .outputs
-            .iter()
-            .zip(outputs)
-            .map(|((name, _), values)| Channel::new(name.clone(), values))
-            .collect(),
-        references: Vec::new(),
-        notes,
-        trim_samples: 0,
-    };
-    record.validate()?;
-    Ok(record)
+    let best = rows.channels[..columns.inputs.len()]
+        .iter()
+        .enumerate()
+        .max_by(|a, b| activity(a.1).total_cmp(&activity(b.1)))
+        .map_or(0, |(i, _)| i);
+    let name = columns.inputs[best].0.clone();
+    notes.push(format!(
+        "{source}: swept input taken to be `{name}` (the most active)"
+    ));
+    Ok((name, true))
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn columns() -> CsvColumns {
-        CsvColumns {
-            time: "t".into(),
-            inputs: vec![
-                ("lat".into(), "d_lat".into()),
-                ("lon".into(), "d_lon".into()),
-            ],
-            outputs: vec![("p".into(), "p".into())],
-            primary: None,
-            primary_column: Some(PRIMARY_COLUMN.into()),
-            phase_column: Some("phase".into()),
-            sweep_band: Some([1.0, 10.0]),
-        }
-    }
-
-    #[test]
-    fn reads_named_columns_and_picks_the_swept_input() {
-        let mut text = String::from("t, d_lat ,\"d_lon\",p,extra\n");
-        for k in 0..50 {
-            let t = k as f64 * 0.02;
-            text += &format!("{t},{},{},{},x\n", (3.0 * t).sin(), 0.001 * t, 2.0 * t);
-        }
-        let record = parse_csv(&text, "log.csv", &columns()).unwrap();
-        assert_eq!(record.len(), 50);
-        assert!((record.sample_rate_hz - 50.0).abs() < 1e-9);
-        assert_eq!(record.primary, "lat");
-        assert!(record.primary_guessed);
-        assert_eq!(record.input("lon").unwrap()[10], 0.001 * 0.2);
-        assert_eq!(record.notes.len(), 1);
-    }
-
-    /// A lateral sweep as `decode` lays it out: idle rows, then excitation rows whose
-    /// `primary` is `lat`, while the longitudinal stick moves more than the lateral one.
-    fn decoded_lateral_sweep(primary_of_row: impl Fn(usize) -> &'static str) -> String {
-        let mut text = String::from("t,phase,primary,cmd_lat,cmd_lon,p\n");
-        for k in 0..60 {
-            let t = k as f64 * 0.02;
-            let phase = if k < 10 { "idle" } else { "sweep" };
-            let (lat, lon) = (0.01 * (3.0 * t).sin(), 0.2 * (1.3 * t).cos());
-            text += &format!("{t},{phase},{},{lat},{lon},{}\n", primary_of_row(k), lat);
-        }
-        text
-    }
-
-    fn decode_columns() -> CsvColumns {
-        CsvColumns {
-            inputs: vec![
-                ("lat".into(), "cmd_lat".into()),
-                ("lon".into(), "cmd_lon".into()),
-            ],
-            ..columns()
-        }
-    }
-
-    #[test]
-    fn the_swept_axis_comes_from_the_option_then_the_primary_column_then_activity() {
-        let text = decoded_lateral_sweep(|_| "lat");
-        // The primary column names `lat`, though `lon` is the most active.
-        let record = parse_csv(&text, "d.csv", &decode_columns()).unwrap();
-        assert_eq!(record.primary, "lat");
-        assert!(!record.primary_guessed && record.notes.is_empty());
-        // Without the column the most active input is taken.
-        let no_column = CsvColumns {
-            primary_column: None,
-            ..decode_columns()
-        };
-        let record = parse_csv(&text, "d.csv", &no_column).unwrap();
-        assert_eq!(record.primary, "lon");
-        assert!(record.primary_guessed);
-        // A named swept input overrides the column.
-        let named = CsvColumns {
-            primary: Some("lon".into()),
-            ..decode_columns()
-        };
-        let record = parse_csv(&text, "d.csv", &named).unwrap();
-        assert_eq!(
-            (record.primary.as_str(), record.primary_guessed),
-            ("lon", false)
-        );
-        // Inputs renamed: the column's `lat` still finds the input read from `cmd_lat`.
-        let renamed = CsvColumns {
-            inputs: vec![
-                ("roll".into(), "cmd_lat".into()),
-                ("pitch".into(), "cmd_lon".into()),
-            ],
-            ..decode_columns()
-        };
-        assert_eq!(parse_csv(&text, "d.csv", &renamed).unwrap().primary, "roll");
-        // Idle rows may name another axis: only the kept rows must agree.
-        let idle_other = decoded_lateral_sweep(|k| if k < 10 { "ped" } else { "lat" });
-        assert_eq!(
-            parse_csv(&idle_other, "d.csv", &decode_columns())
-                .unwrap()
-                .primary,
-            "lat"
-        );
-    }
-
-    #[test]
-    fn a_primary_column_that_changes_or_names_no_input_is_refused() {
-        let text = decoded_lateral_sweep(|k| if k < 40 { "lat" } else { "lon" });
-        let err = parse_csv(&text, "d.csv", &decode_columns()).unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            "d.csv:42: column `primary` names `lon` here but `lat` on lines 12–41: one swept axis per file (rows in the fade-in, sweep and fade-out phases); split the file or name the swept input (--swept)"
-        );
-        // Naming the swept input sets the column aside.
-        let named = CsvColumns {
-            primary: Some("lat".into()),
-            ..decode_columns()
-        };
-        assert_eq!(parse_csv(&text, "d.csv", &named).unwrap().primary, "lat");
-        let text = decoded_lateral_sweep(|_| "col");
-        let err = parse_csv(&text, "d.csv", &decode_columns()).unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            "d.csv: column `primary` names `col`, which is not among the inputs (lat, lon); name the swept input (--swept)"
-        );
-        let unknown = CsvColumns {
-            primary: Some("ped".into()),
-            ..decode_columns()
-        };
-        let err = parse_csv(&text, "d.csv", &unknown).unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            "d.csv: swept input `ped` is not among the inputs (lat, lon)"
-        );
-    }
-
-    #[test]
-    fn keeps_only_excitation_rows_when_there_is_a_phase_column() {
-        let mut text = String::from("t,phase,d_lat,d_lon,p\n");
-        for k in 0..30 {
-            let phase = ["idle", "fade_in", "sweep", "fade_out", "done"][k / 6];
-            text += &format!("{},{phase},{k},0,1\n", k as f64 * 0.1);
-        }
-        let record = parse_csv(&text, "d.csv", &columns()).unwrap();
-        assert_eq!(record.len(), 18);
-        assert_eq!(record.input("lat").unwrap()[0], 6.0);
-    }
-
-    #[test]
-    fn clear_errors() {
-        let err = parse_csv("t,d_lat,p\n0,1,2\n", "a.csv", &columns()).unwrap_err();
-        assert!(err.to_string().contains("no column `d_lon`"), "{err}");
-        let err = parse_csv(
-            "t,d_lat,d_lon,p\n0,1,2,3\n0.1,1,nan,3\n",
-            "b.csv",
-            &columns(),
-        )
-        .unwrap_err();
-        assert!(err.to_string().starts_with("b.csv:3:"), "{err}");
-        let err = parse_csv(
-            "t,d_lat,d_lon,p\n0,1,2,3\n0.1,1,2,3\n0.5,1,2,3\n",
-            "c.csv",
-            &columns(),
-        )
-        .unwrap_err();
-        assert!(err.to_string().contains("not uniformly sampled"), "{err}");
-        let err = parse_csv("", "e.csv", &columns()).unwrap_err();
-        assert!(err.to_string().contains("empty"), "{err}");
-    }
-}
+mod tests;

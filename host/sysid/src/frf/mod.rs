@@ -58,7 +58,8 @@ pub use analysis::{
 };
 pub use chirp_z::{chirp_z, ChirpZ};
 pub use coherence::{debiased_coherence, random_error, valid_range};
-pub use csv::{load_csv, CsvColumns};
+pub use csv::units::{TimeUnit, Unit};
+pub use csv::{load_csv, load_csv_records, parse_csv_records, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
 };

@@ -55,7 +55,8 @@ pub struct Record {
     pub outputs: Vec<Channel>,
     /// Reference channels: for an input, the excitation the flight controller injected
     /// into it (sweep and off-axis noise, not the hold controller's share), named after
-    /// that input. Empty when unknown (CSV records). Only the reference estimator
+    /// that input. Empty when unknown (CSV records without reference columns). Only the
+    /// reference estimator
     /// ([`ResponseEstimator::SweepReference`](super::ResponseEstimator::SweepReference)) reads them.
     pub references: Vec<Channel>,
     /// Remarks made while loading (gaps filled, …); copied into the document's notes.

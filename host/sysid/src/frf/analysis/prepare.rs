@@ -184,7 +184,7 @@ pub(super) fn prepare_group(
             .filter(|&r| rms(&joined.references[r].values) > 0.0)
             .ok_or_else(|| {
                 FrfError::InvalidOption(format!(
-                    "{axis} sweep: the sweep-reference estimator needs the excitation injected into `{axis}`, and these records carry none (telemetry dumps do; CSV records do not)"
+                    "{axis} sweep: the sweep-reference estimator needs the excitation injected into `{axis}`, and these records carry none (telemetry dumps do; a CSV file gives it with a reference column: frf --reference {axis}=COLUMN)"
                 ))
             })?;
         notes.push(format!(
