@@ -21,6 +21,10 @@ to zero at the joins). The response of output y to control x comes from the reco
 which x is swept (or, see --excited, in which x moves with the swept control), conditioned \
 on the other controls excited there. Files ending in .csv \
 are read as CSV with a header row (columns chosen with --time, --inputs, --outputs); \
+flight logs (PX4 ULog, ArduPilot DataFlash, recognised by their first bytes) with \
+--inputs/--outputs as NAME=TOPIC.FIELD (`p=vehicle_angular_velocity.xyz[0]`, `p=RATE.R`; \
+`TOPIC[k]` for instance k), resampled onto one time base (see --log-rate, --log-window, \
+--log-sweep; ArduPilot fields in degrees become radians; docs/formats.md); \
 anything else as a telemetry dump.\n\nThe swept input of a CSV file is, in this order: \
 --swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
 must be the same on every row kept; else the input with the largest RMS about its trend \
@@ -36,8 +40,8 @@ unreadable file, a dump without a sweep, a record too short for the band, a swep
 without excitation, or a bad option."
 )]
 pub struct FrfArgs {
-    /// Telemetry dumps or CSV files.
-    #[arg(required = true, value_name = "DUMP|CSV")]
+    /// Telemetry dumps, CSV files or flight logs (PX4 ULog, ArduPilot DataFlash).
+    #[arg(required = true, value_name = "DUMP|CSV|LOG")]
     pub files: Vec<PathBuf>,
     /// Where to write the frequency-response document.
     #[arg(long, value_name = "FILE", default_value = "frf.json")]
@@ -126,6 +130,9 @@ pub struct FrfArgs {
     /// phases (ignored when the file has no such column).
     #[arg(long, value_name = "COLUMN", default_value = "phase")]
     pub phase_column: String,
+    /// Flight-log options.
+    #[command(flatten)]
+    pub log: crate::logs::LogFrfArgs,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -285,14 +292,18 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     let records: Vec<Record> = args
         .files
         .iter()
-        .map(|path| {
-            if is_csv(path) {
-                load_csv(path, &columns)
+        .map(|path| -> anyhow::Result<Record> {
+            Ok(if crate::logs::log_format(path).is_some() {
+                let (inputs, outputs) = (columns.inputs.clone(), columns.outputs.clone());
+                let (swept, band) = (args.swept.clone(), columns.sweep_band);
+                crate::logs::frf_record(path, inputs, outputs, swept, band, &args.log)?
+            } else if is_csv(path) {
+                load_csv(path, &columns)?
             } else {
-                load_dump(path)
-            }
+                load_dump(path)?
+            })
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<anyhow::Result<_>>()?;
     let groups = group_by_primary(records)?;
     let analysis = analyse(&groups, &opts)?;
 
@@ -527,6 +538,7 @@ mod tests {
         let csv = dir.join("lat.csv");
         crate::decode::run(&crate::decode::DecodeArgs {
             dumps: vec![dump_path],
+            topic: None,
             format: crate::decode::Format::Csv,
             output: Some(csv.clone()),
             quiet: true,

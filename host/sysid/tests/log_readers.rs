@@ -126,7 +126,7 @@ fn ulog_values_equal_pyulogs() {
             .time_s
             .iter()
             .zip(stamps)
-            .all(|(t, us)| *t == us * 1e-6));
+            .all(|(t, us)| *t == us / 1e6));
     }
     assert!(compared > 1200, "{compared} values compared");
     // pyulog reports one dropout in this file; so does the reader.

@@ -99,7 +99,7 @@ struct Definition {
     topic: usize,
     length: usize,
     columns: Vec<Column>,
-    /// Index of the time column among the topic's fields, and its scale to seconds.
+    /// Index of the time column among the topic's fields, and its counts per second.
     time: Option<(usize, f64)>,
 }
 
@@ -239,8 +239,8 @@ fn define(
         }
     }
     let time = names.iter().enumerate().find_map(|(i, n)| match *n {
-        "TimeUS" => Some((i, 1e-6)),
-        "TimeMS" => Some((i, 1e-3)),
+        "TimeUS" => Some((i, 1e6)),
+        "TimeMS" => Some((i, 1e3)),
         _ => None,
     });
     // Field index of the time column (an `a` column before it would shift it).
@@ -325,10 +325,10 @@ fn append(payload: &[u8], definition: &Definition, topic: &mut Topic) {
             }
         }
     }
-    if let Some((k, scale)) = definition.time {
+    if let Some((k, per_second)) = definition.time {
         if let Some(Values::Numbers(v)) = topic.fields.get(k).map(|f| &f.values) {
             if let Some(t) = v.last() {
-                topic.time_s.push(t * scale);
+                topic.time_s.push(t / per_second);
             }
         }
     }

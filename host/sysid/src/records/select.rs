@@ -419,6 +419,7 @@ pub fn record_from_log(log: &Log, channels: &LogChannels) -> Result<Record, LogE
         grid[n - 1]
     ));
     notes.extend(all().filter_map(|s| s.note.clone()));
+    notes.extend(log.dropped.iter().map(|line| format!("not read: {line}")));
     let to_channels = |chosen: &[(String, String)], series: &[Series]| {
         chosen
             .iter()

@@ -312,7 +312,7 @@ pub fn parse(bytes: &[u8], source: &str) -> Result<Log, LogError> {
                         }
                         if let Some(i) = sub.timestamp {
                             let us = sub.layout[i].kind.read(&data[sub.layout[i].offset..]);
-                            topic.time_s.push(us.unwrap_or(f64::NAN) * 1e-6);
+                            topic.time_s.push(us.unwrap_or(f64::NAN) / 1e6);
                         }
                     }
                     Some(_) => short_data += 1,
