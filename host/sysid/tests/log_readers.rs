@@ -404,3 +404,43 @@ fn damaged_files_keep_what_is_whole() {
         }
     }
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+    /// Any bytes after a valid header: a log or an error, never a panic or a hang.
+    #[test]
+    fn arbitrary_bytes_after_a_header_never_panic(tail in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..4096)) {
+        let mut ulg = ulog::MAGIC.to_vec();
+        ulg.extend_from_slice(&[1, 0, 0, 0, 0, 0, 0, 0, 0]);
+        ulg.extend_from_slice(&tail);
+        let _ = ulog::parse(&ulg, "p.ulg");
+        let mut bin = vec![dataflash::HEAD1, dataflash::HEAD2, dataflash::FMT_ID];
+        bin.extend_from_slice(&tail);
+        let _ = dataflash::parse(&bin, "p.bin");
+    }
+
+    /// Random ULog format definitions and data for them: flattened and read without a
+    /// panic or a hang, whatever they nest.
+    #[test]
+    fn arbitrary_ulog_formats_never_panic(
+        definitions in proptest::collection::vec("[a-c]:((u?int(8|16|32|64)_t|float|double|bool|char|[a-c])(\\[[0-9]{1,5}\\])? [a-z_]{1,3};){0,4}", 1..5),
+        data in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..64),
+    ) {
+        let mut b = ulog::MAGIC.to_vec();
+        b.extend_from_slice(&[1, 0, 0, 0, 0, 0, 0, 0, 0]);
+        let mut message = |kind: u8, payload: &[u8]| {
+            b.extend_from_slice(&(payload.len() as u16).to_le_bytes());
+            b.push(kind);
+            b.extend_from_slice(payload);
+        };
+        for d in &definitions {
+            message(b'F', d.as_bytes());
+        }
+        message(b'A', b"\x00\x01\x00a");
+        let mut d = vec![1u8, 0];
+        d.extend_from_slice(&data);
+        message(b'D', &d);
+        let _ = ulog::parse(&b, "p.ulg");
+    }
+}

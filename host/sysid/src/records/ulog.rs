@@ -32,6 +32,9 @@ const SYNC: [u8; 8] = [0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12];
 const KNOWN_TYPES: &[u8] = b"BFIMPQADLCSOR";
 /// The largest payload a message can have (its size is a u16).
 const MAX_MESSAGE: usize = u16::MAX as usize;
+/// Fields visited while flattening one format, at most (a message holds at most 65535
+/// bytes, so a real format has fewer).
+const MAX_WORK: usize = 1 << 20;
 /// Nesting depth of formats at which a definition is taken as circular.
 const MAX_DEPTH: usize = 16;
 
@@ -121,6 +124,7 @@ fn flatten(
     prefix: &str,
     base: usize,
     depth: usize,
+    work: &mut usize,
     out: &mut Vec<FlatField>,
 ) -> Result<usize, String> {
     if depth > MAX_DEPTH {
@@ -135,6 +139,11 @@ fn flatten(
     for field in fields {
         let count = field.array.unwrap_or(1);
         for i in 0..count {
+            // Empty nested formats in arrays would otherwise cost time without bytes.
+            *work += 1;
+            if *work > MAX_WORK {
+                return Err(format!("format `{format}` has too many fields to flatten"));
+            }
             if offset - base > MAX_MESSAGE {
                 return Err(format!("format `{format}` is longer than a message can be"));
             }
@@ -152,8 +161,15 @@ fn flatten(
                     offset += p.size();
                 }
                 FieldType::Nested(inner) => {
-                    let size =
-                        flatten(formats, inner, &format!("{name}."), offset, depth + 1, out)?;
+                    let size = flatten(
+                        formats,
+                        inner,
+                        &format!("{name}."),
+                        offset,
+                        depth + 1,
+                        work,
+                        out,
+                    )?;
                     offset += size;
                 }
             }
@@ -251,7 +267,7 @@ pub fn parse(bytes: &[u8], source: &str) -> Result<Log, LogError> {
                 };
                 let name = text(p.rest());
                 let mut layout = Vec::new();
-                match flatten(&formats, &name, "", 0, 0, &mut layout) {
+                match flatten(&formats, &name, "", 0, 0, &mut 0, &mut layout) {
                     Ok(_) => {
                         // The logger leaves out the padding at the end of a message.
                         while layout
@@ -480,7 +496,7 @@ mod tests {
         let mut formats = HashMap::new();
         formats.insert("a".to_string(), parse_format("a:b x;").unwrap().1);
         formats.insert("b".to_string(), parse_format("b:a y;").unwrap().1);
-        let message = flatten(&formats, "a", "", 0, 0, &mut Vec::new()).unwrap_err();
+        let message = flatten(&formats, "a", "", 0, 0, &mut 0, &mut Vec::new()).unwrap_err();
         assert!(message.contains("nests deeper"), "{message}");
     }
 }
