@@ -92,6 +92,9 @@ fn find_topic<'a>(log: &'a Log, name: &str) -> anyhow::Result<&'a Topic> {
         },
         None => (name, 0),
     };
+    if log.format == LogFormat::DataFlash && base != name {
+        bail!("--topic `{name}`: a DataFlash type is written whole, every instance (its instance column says which): use --topic {base}");
+    }
     log.topic_instance(base, instance).with_context(|| {
         format!(
             "{}: no topic `{name}` (run `sweephold decode {}` for the list)",

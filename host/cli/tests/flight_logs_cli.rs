@@ -94,6 +94,7 @@ fn decode_lists_a_logs_topics_and_writes_one_as_csv() {
             "no topic `nope`",
         ),
         (vec!["decode", &ulg, &bin], "a flight log is decoded alone"),
+        (vec!["decode", &bin, "--topic", "IMU[1]"], "use --topic IMU"),
         (vec!["decode", &ulg, "-o", &ulg], "--output"),
     ] {
         let out = sweephold(&args);
