@@ -1,4 +1,5 @@
-//! `sweephold decode`: telemetry dumps → CSV or JSON lines, streaming.
+//! `sweephold decode`: telemetry dumps → CSV or JSON lines, streaming; flight logs (PX4 ULog,
+//! ArduPilot DataFlash) go to [`crate::logs`].
 
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
@@ -35,12 +36,22 @@ refused.\n\nExit status: 0 when at least one good frame was read; 1 on a missing
 unreadable file or a folder, an output that is an input, a dump of another protocol major \
 version, no valid frame at all, a standard output that cannot be written, or SIGINT/SIGTERM \
 (decoding stops between chunks; FILE stays as it was); 130 on a second signal (ended at once, \
-the temporary file removed)."
+the temporary file removed).\n\nA flight log (PX4 ULog `.ulg`, ArduPilot DataFlash `.bin`; \
+recognised by its first bytes, decoded alone) gives the list of its topics, one row each: \
+topic (`NAME[k]` for ULog instance k > 0), messages, median rate [Hz], first and last time \
+[s], field names; with --topic NAME, that topic's messages, one row each (time_s, then \
+every field as the log holds it). The summary on stderr names what could not be read \
+(a cut-off last message, skipped bytes), with byte offsets."
 )]
 pub struct DecodeArgs {
-    /// Telemetry dumps (raw frame streams as the flight controller sends them).
-    #[arg(required = true, value_name = "DUMP")]
+    /// Telemetry dumps (raw frame streams as the flight controller sends them), or one
+    /// flight log (PX4 ULog, ArduPilot DataFlash; recognised by its first bytes).
+    #[arg(required = true, value_name = "DUMP|LOG")]
     pub dumps: Vec<PathBuf>,
+    /// Flight logs: write this topic's messages (`NAME`, or `NAME[k]` for ULog instance
+    /// k) instead of the list of topics.
+    #[arg(long, value_name = "NAME")]
+    pub topic: Option<String>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
@@ -294,6 +305,32 @@ fn open(path: &Path) -> anyhow::Result<File> {
 
 /// Run `sweephold decode`.
 pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
+    if let Some(log) = args
+        .dumps
+        .iter()
+        .find(|p| crate::logs::log_format(p).is_some())
+    {
+        if args.dumps.len() > 1 {
+            bail!(
+                "{}: a flight log is decoded alone, not with other files",
+                log.display()
+            );
+        }
+        if let Some(path) = &args.output {
+            refuse_inputs_as_outputs(&[log.as_path()], &[("--output", path)])?;
+        }
+        let jsonl = args.format == Format::Jsonl;
+        return crate::logs::decode(
+            log,
+            args.topic.as_deref(),
+            jsonl,
+            args.output.as_deref(),
+            args.quiet,
+        );
+    }
+    if args.topic.is_some() {
+        bail!("--topic reads flight logs (PX4 ULog, ArduPilot DataFlash), not telemetry dumps");
+    }
     // Open every input before writing anything, so a typo loses no output.
     let inputs = args
         .dumps

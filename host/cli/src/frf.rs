@@ -22,6 +22,10 @@ which x is swept (or, see --excited, in which x moves with the swept control), c
 on the other controls excited there. Files ending in .csv \
 are read as CSV (columns chosen with --time, --inputs, --outputs, --reference, by header \
 name or by position, 1 = first; a file whose first row is all numbers has no header); \
+flight logs (PX4 ULog, ArduPilot DataFlash, recognised by their first bytes) with \
+--inputs/--outputs as NAME=TOPIC.FIELD (`p=vehicle_angular_velocity.xyz[0]`, `p=RATE.R`; \
+`TOPIC[k]` for instance k), resampled onto one time base (see --log-rate, --log-window, \
+--log-sweep; ArduPilot fields in degrees become radians; docs/formats.md); \
 anything else as a telemetry dump.\n\nCSV rows: --window keeps the rows in a time span; \
 a row with an empty or non-finite field is a missing sample. Timestamps within 5 % of a \
 step of a uniform grid are used as they are; jittered ones are resampled onto a uniform \
@@ -47,8 +51,8 @@ without excitation; 2 on an option out of range (checked before any file is read
 SIGINT or SIGTERM (ended at once, the temporary file removed, an earlier frf.json untouched)."
 )]
 pub struct FrfArgs {
-    /// Telemetry dumps or CSV files.
-    #[arg(required = true, value_name = "DUMP|CSV")]
+    /// Telemetry dumps, CSV files or flight logs (PX4 ULog, ArduPilot DataFlash).
+    #[arg(required = true, value_name = "DUMP|CSV|LOG")]
     pub files: Vec<PathBuf>,
     /// Where to write the frequency-response document.
     #[arg(long, value_name = "FILE", default_value = "frf.json")]
@@ -115,6 +119,9 @@ pub struct FrfArgs {
     /// The CSV options.
     #[command(flatten)]
     pub csv: CsvArgs,
+    /// Flight-log options.
+    #[command(flatten)]
+    pub log: crate::logs::LogFrfArgs,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -234,7 +241,13 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     }
     let mut records: Vec<Record> = Vec::new();
     for path in &args.files {
-        if is_csv(path) {
+        if crate::logs::log_format(path).is_some() {
+            let (inputs, outputs) = (columns.inputs.clone(), columns.outputs.clone());
+            let (swept, band) = (args.csv.swept.clone(), columns.sweep_band);
+            records.push(crate::logs::frf_record(
+                path, inputs, outputs, swept, band, &args.log,
+            )?);
+        } else if is_csv(path) {
             records.extend(load_csv_records(path, &columns)?);
         } else {
             records.push(load_dump(path)?);
@@ -479,6 +492,7 @@ mod tests {
         let csv = dir.join("lat.csv");
         crate::decode::run(&crate::decode::DecodeArgs {
             dumps: vec![dump_path],
+            topic: None,
             format: crate::decode::Format::Csv,
             output: Some(csv.clone()),
             quiet: true,

@@ -20,6 +20,7 @@ pub mod fit;
 pub mod fly;
 pub mod frf;
 pub mod interrupt;
+pub mod logs;
 pub mod output;
 pub mod plot;
 pub mod report;

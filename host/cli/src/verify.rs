@@ -541,6 +541,7 @@ mean TIC over 2 dumps: 0.3638
             format: crate::decode::Format::Csv,
             output: Some(csv.clone()),
             quiet: true,
+            topic: None,
         })
         .unwrap();
         let fitted = |file: &PathBuf| {

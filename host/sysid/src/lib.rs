@@ -10,7 +10,9 @@
 //! * [`fit`] — state-space model structures fitted to those responses, with their
 //!   accuracy, modes, trim-derived parameters and time-domain verification;
 //! * [`models`] — the structure files shipped with the crate, by name;
-//! * [`random`] — the one small deterministic generator (seeded restarts, test noise).
+//! * [`random`] — the one small deterministic generator (seeded restarts, test noise);
+//! * [`records`] — other tools' flight logs (PX4 ULog, ArduPilot DataFlash) and the
+//!   step from a log to a sweep record.
 //!
 //! Inside the crate the dependencies run one way: `models` → `fit` → `frf` → `document`
 //! (`random` is a leaf that any of them may use).
@@ -29,3 +31,4 @@ pub mod fit;
 pub mod frf;
 pub mod models;
 pub mod random;
+pub mod records;
