@@ -64,7 +64,7 @@ pub enum Command {
     Frf(frf::FrfArgs),
     /// Regenerate report.html of a campaign folder from its files.
     Report(report::ReportArgs),
-    /// Trim and linearize the simulated helicopters (bo105, trex700l).
+    /// Trim and linearize a simulated helicopter (a shipped aircraft or an aircraft file).
     Sim(sim::SimArgs),
     /// Simulate an identified model on recorded inputs and score it (Theil's inequality coefficient).
     Verify(verify::VerifyArgs),

@@ -1,5 +1,5 @@
 //! The flown aircraft, and everything the command line takes from it: a shipped aircraft
-//! (`bo105`, `trex700l`) or an aircraft file (`docs/formats.md`, "Aircraft files"), read
+//! (`bo105`, `trex700l`, `fbl700`) or an aircraft file (`docs/formats.md`, "Aircraft files"), read
 //! once when the command line is. The simulator flies its physical description; the
 //! flight controller flies the firmware preset it names; the campaign takes its sweep
 //! bands, 9-DOF structure, trim balance and valid-range source from it. This is the one
@@ -54,7 +54,7 @@ impl Vehicle {
         })
     }
 
-    /// A shipped aircraft (`bo105`, `trex700l`).
+    /// A shipped aircraft (`bo105`, `trex700l`, `fbl700`).
     ///
     /// # Panics
     /// When `name` is not shipped: for names written in the code.

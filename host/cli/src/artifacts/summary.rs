@@ -245,7 +245,7 @@ fn in_process() -> String {
 /// The whole `summary.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CampaignSummary {
-    /// Vehicle name (`bo105`, `trex700l`).
+    /// Vehicle name: the aircraft file's `name` (`bo105`, `trex700l`, `fbl700`, …).
     pub vehicle: String,
     /// The flight controller the records were flown with: `in-process` (the flight
     /// logic on the simulator's exact states) or `board-sim` (the board application on

@@ -61,7 +61,7 @@ the stopped one's files, with the error in its summary.json, are kept in DIR.fai
 DIR must be new, empty or an earlier campaign's folder."
 )]
 pub struct CampaignArgs {
-    /// Aircraft flown: a shipped one (bo105, trex700l) or the path of an aircraft file
+    /// Aircraft flown: a shipped one (bo105, trex700l, fbl700) or the path of an aircraft file
     /// (docs/formats.md, "Aircraft files"); the file names its firmware preset, sweep
     /// bands, 9-DOF structure, trim balance and valid-range source.
     #[arg(long, value_name = "NAME|FILE", default_value = "bo105", value_parser = Vehicle::parse)]

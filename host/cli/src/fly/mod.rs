@@ -124,7 +124,7 @@ DIR.partial, which replaces DIR whole when every record was written; a failed ru
 as it was and its own files in DIR.failed. DIR must be new, empty or an earlier run's folder."
 )]
 pub struct FlyArgs {
-    /// Aircraft flown: a shipped one (bo105, trex700l) or the path of an aircraft file
+    /// Aircraft flown: a shipped one (bo105, trex700l, fbl700) or the path of an aircraft file
     /// (docs/formats.md, "Aircraft files"); its file names the firmware preset flown and
     /// the sweep bands.
     #[arg(long, value_name = "NAME|FILE", default_value = "bo105", value_parser = Vehicle::parse)]

@@ -112,7 +112,7 @@ pub struct RunSummary {
 /// The whole `summary.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FlySummary {
-    /// Vehicle name (`bo105`, `trex700l`).
+    /// Vehicle name: the aircraft file's `name` (`bo105`, `trex700l`, `fbl700`, …).
     pub vehicle: String,
     /// Excitation mode (`cah`, `standard`, `noise`).
     pub mode: String,
