@@ -125,7 +125,7 @@ pub struct Airframe {
     pub izz: Quantity,
     /// Product of inertia I_xz [kg·m²] (positive: principal axis nose-down of x).
     pub ixz: Quantity,
-    /// Equivalent flat-plate drag areas along x, y, z [m²].
+    /// Equivalent flat-plate drag areas along x, y, z \[m²\].
     pub drag_area: [Quantity; 3],
 }
 
@@ -189,7 +189,7 @@ pub struct TailRotor {
 /// A lifting surface.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Surface {
-    /// Area [m²].
+    /// Area \[m²\].
     pub area: Quantity,
     /// Incidence \[rad\].
     pub incidence: Quantity,

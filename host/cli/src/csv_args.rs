@@ -54,7 +54,7 @@ pub struct CsvArgs {
     pub phase_column: String,
 }
 
-/// A time window [s] as given on the command line.
+/// A time window \[s\] as given on the command line.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Window(pub [f64; 2]);
 

@@ -19,7 +19,7 @@
 //!    so a failed run leaves the previous complete one readable; the failed run's files
 //!    are kept as `DIR.failed` for inspection.
 //!
-//! Standard output takes one path too: [`print`] or [`StdoutWriter`], whose write
+//! Standard output takes one path too: [`print()`] or [`StdoutWriter`], whose write
 //! errors [`stdout_outcome`] (applied by `crate::run` to every verb) turns into a
 //! one-line `cannot write to standard output: …` (exit 1), never a panic. A reader that
 //! went away (`| head`, a broken pipe) is not a failure of the work: the verb stops
@@ -45,7 +45,7 @@ impl std::fmt::Display for StdoutFailed {
 impl std::error::Error for StdoutFailed {}
 
 /// Standard output, locked, with its write errors marked as [`StdoutFailed`]. Every byte
-/// a verb sends to standard output goes through one of these (or [`print`]).
+/// a verb sends to standard output goes through one of these (or [`print()`]).
 pub struct StdoutWriter(io::StdoutLock<'static>);
 
 impl StdoutWriter {

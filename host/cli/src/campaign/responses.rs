@@ -1,6 +1,6 @@
 //! The frequency-response stage: `sweephold frf` on the `cah` sweeps (its arguments, on
 //! the records the fly stage decoded), `frf.json`. For the Bo-105 the valid ranges come
-//! from the sweep-reference estimate's random error ([`RangeSource::SweepReference`]).
+//! from the sweep-reference estimate's random error ([`RangeSource::SweepReference`](sysid::frf::RangeSource::SweepReference)).
 
 use std::ffi::OsString;
 

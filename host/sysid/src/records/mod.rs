@@ -1,4 +1,4 @@
-//! Readers of other tools' flight logs, and the step from a log to a sweep [`Record`].
+//! Readers of other tools' flight logs, and the step from a log to a sweep [`Record`](crate::frf::Record).
 //!
 //! * [`ulog`] — PX4 ULog files (`.ulg`);
 //! * [`dataflash`] — ArduPilot DataFlash binary logs (`.bin`, `.BIN`);
