@@ -315,6 +315,19 @@ fn parse_axis(text: &str) -> Result<Axis, String> {
 }
 
 impl FlyArgs {
+    /// The board-sim fault planned during the record, as given on the command line
+    /// (`--rc-loss 0`, `--imu-fault stuck@0`); `None` when none is.
+    fn board_fault(&self) -> Option<String> {
+        if let Some(at) = self.rc_loss_at_s {
+            return Some(format!("--rc-loss {at}"));
+        }
+        let plan = self.imu_fault?;
+        Some(match plan.at_s {
+            Some(at) => format!("--imu-fault {}@{at}", plan.kind.name()),
+            None => format!("--imu-fault {}", plan.kind.name()),
+        })
+    }
+
     /// The records these arguments fly, in flying order.
     pub fn plans(&self) -> Vec<RecordPlan> {
         let input = match self.input {
@@ -764,6 +777,14 @@ fn finish_record(
     flown: record::FlownRecord,
 ) -> anyhow::Result<FinishedRecord> {
     write_atomic(&args.out.join(plan.file_name()), &flown.dump)?;
+    if !flown.began {
+        if let Some(fault) = args.board_fault() {
+            let mode = flown
+                .first_mode_change
+                .map_or_else(String::new, |change| format!(": the board went {change}"));
+            bail!("{fault} ended the record before it began (no test started{mode})");
+        }
+    }
     let record = if plan.input.is_sweep() && flown.abort.is_none() {
         Some(sysid::frf::load_dump_bytes(&flown.dump, &plan.file_name())?)
     } else {
