@@ -480,6 +480,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         _ => None,
     };
     let staged = StagedFolder::begin(&args.out)?;
+    // The test hook's first point: the lock held and the staging folder made, nothing flown.
+    crate::interrupt::pause_point("setup");
     let mut staged_args = args.clone();
     staged_args.out = staged.path().to_path_buf();
     let flown = fly_on_link(&staged_args, image.as_deref()).and_then(|outcome| {
@@ -749,6 +751,8 @@ pub fn fly_with_workers(
         runs,
     };
     let path = args.out.join("summary.json");
+    // The test hook: every record written, the summary not yet.
+    crate::interrupt::pause_point("summary");
     write_json(&path, &summary)?;
     let dumps = plans.iter().map(|p| args.out.join(p.file_name())).collect();
     Ok(FlyOutcome {
