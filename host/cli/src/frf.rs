@@ -9,8 +9,8 @@ use crate::output::{
 };
 use clap::Args;
 use sysid::frf::{
-    analyse, group_by_primary, load_csv_records, load_dump, FrfAnalysis, FrfOptions, Record,
-    ResponseEstimator, ResponseInputs,
+    analyse, check_one_origin, group_by_primary, load_csv_records, load_dump_with_origin,
+    FrfAnalysis, FrfOptions, Record, ResponseEstimator, ResponseInputs,
 };
 
 /// Arguments of `sweephold frf`.
@@ -240,6 +240,7 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
         check_input_file("input", path)?;
     }
     let mut records: Vec<Record> = Vec::new();
+    let mut origins = Vec::new();
     for path in &args.files {
         if crate::logs::log_format(path).is_some() {
             let (inputs, outputs) = (columns.inputs.clone(), columns.outputs.clone());
@@ -250,9 +251,14 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
         } else if is_csv(path) {
             records.extend(load_csv_records(path, &columns)?);
         } else {
-            records.push(load_dump(path)?);
+            let (record, origin) = load_dump_with_origin(path)?;
+            records.push(record);
+            origins.push(origin);
         }
     }
+    // Before any work: dumps of two vehicles (or flight controllers, or rates) are not
+    // one aircraft's responses.
+    check_one_origin(&origins)?;
     let groups = group_by_primary(records)?;
     let analysis = analyse(&groups, &opts)?;
 

@@ -19,7 +19,8 @@
 //!
 //! **Test hook.** With `SWEEPHOLD_TEST_PAUSE_AT=POINT` in the environment the run pauses
 //! at the named point ([`pause_point`]: a campaign stage's name, `complete` just before a
-//! staged folder is swapped in, `fly` at the start of a record, `decode` after the first
+//! staged folder is swapped in, `fly` at the start of a record, `setup` and `summary` in
+//! `sweephold fly` (its staging folder made; its records written), `decode` after the first
 //! rows, `write` before an atomic file is committed), says `paused at POINT` on stderr and
 //! waits (at most 120 s) for a signal, so that tests can interrupt a run at an exact place.
 //! `POINT!` holds there through the first signal too, so that a second one meets a run

@@ -315,6 +315,19 @@ fn parse_axis(text: &str) -> Result<Axis, String> {
 }
 
 impl FlyArgs {
+    /// The board-sim fault planned during the record, as given on the command line
+    /// (`--rc-loss 0`, `--imu-fault stuck@0`); `None` when none is.
+    fn board_fault(&self) -> Option<String> {
+        if let Some(at) = self.rc_loss_at_s {
+            return Some(format!("--rc-loss {at}"));
+        }
+        let plan = self.imu_fault?;
+        Some(match plan.at_s {
+            Some(at) => format!("--imu-fault {}@{at}", plan.kind.name()),
+            None => format!("--imu-fault {}", plan.kind.name()),
+        })
+    }
+
     /// The records these arguments fly, in flying order.
     pub fn plans(&self) -> Vec<RecordPlan> {
         let input = match self.input {
@@ -467,6 +480,8 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         _ => None,
     };
     let staged = StagedFolder::begin(&args.out)?;
+    // The test hook's first point: the lock held and the staging folder made, nothing flown.
+    crate::interrupt::pause_point("setup");
     let mut staged_args = args.clone();
     staged_args.out = staged.path().to_path_buf();
     let flown = fly_on_link(&staged_args, image.as_deref()).and_then(|outcome| {
@@ -736,6 +751,8 @@ pub fn fly_with_workers(
         runs,
     };
     let path = args.out.join("summary.json");
+    // The test hook: every record written, the summary not yet.
+    crate::interrupt::pause_point("summary");
     write_json(&path, &summary)?;
     let dumps = plans.iter().map(|p| args.out.join(p.file_name())).collect();
     Ok(FlyOutcome {
@@ -764,6 +781,14 @@ fn finish_record(
     flown: record::FlownRecord,
 ) -> anyhow::Result<FinishedRecord> {
     write_atomic(&args.out.join(plan.file_name()), &flown.dump)?;
+    if !flown.began {
+        if let Some(fault) = args.board_fault() {
+            let mode = flown
+                .first_mode_change
+                .map_or_else(String::new, |change| format!(": the board went {change}"));
+            bail!("{fault} ended the record before it began (no test started{mode})");
+        }
+    }
     let record = if plan.input.is_sweep() && flown.abort.is_none() {
         Some(sysid::frf::load_dump_bytes(&flown.dump, &plan.file_name())?)
     } else {

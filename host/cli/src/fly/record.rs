@@ -39,6 +39,11 @@ pub struct FlownRecord {
     pub ticks: u64,
     /// Abort reason, if the firmware aborted.
     pub abort: Option<sweephold_protocol::AbortReason>,
+    /// The flight controller streamed a Header: its test began.
+    pub began: bool,
+    /// The board application's first mode change (`pilot → rc_failsafe at tick 3520`),
+    /// if any: what stopped a test that never began.
+    pub first_mode_change: Option<String>,
     /// Peak attitude excursions over the excitation.
     pub max_abs_deg: MaxAbsDeg,
     /// Peak excursions from the captured trim over the excitation (None without a trim
@@ -79,6 +84,10 @@ struct TelemetryMonitor {
     engaged_ticks: [u64; 3],
     /// The last Sample seen.
     last: Option<Sample>,
+    /// A Header was streamed: the test began.
+    began: bool,
+    /// The board application's first mode change, as `pilot → rc_failsafe at tick 3520`.
+    first_mode_change: Option<String>,
 }
 
 impl TelemetryMonitor {
@@ -108,6 +117,12 @@ impl TelemetryMonitor {
                     self.last = Some(sample);
                 }
                 Frame::Event(Event::Abort { reason, .. }) => self.abort = Some(reason),
+                Frame::Header(_) => self.began = true,
+                Frame::Event(Event::ModeChange { tick, from, to }) => {
+                    self.first_mode_change.get_or_insert_with(|| {
+                        format!("{} → {} at tick {tick}", from.name(), to.name())
+                    });
+                }
                 Frame::Event(Event::TrimCaptured { phi, theta, .. }) => {
                     self.trim_captured.get_or_insert([phi, theta]);
                 }
@@ -323,6 +338,8 @@ pub fn fly_record(
         frames: monitor.decoder.stats().good_frames,
         ticks: test_ticks,
         abort: monitor.abort,
+        began: monitor.began,
+        first_mode_change: monitor.first_mode_change.clone(),
         trim_captured: monitor.trim_captured,
         max_abs_deg: monitor.max_abs,
         max_from_trim_deg: monitor.max_from_trim,

@@ -15,6 +15,7 @@ use std::path::Path;
 
 use sweephold_protocol::{tick_step, Decoder, Frame, FrameError, Header, Phase, Sample, TickStep};
 
+use super::origin::DumpOrigin;
 use super::records::{Channel, Record};
 use super::FrfError;
 
@@ -49,13 +50,27 @@ enum Excitation {
     Any,
 }
 
+/// Like [`load_dump`], with what the record's Header says about where it came from: the
+/// vehicle, protocol version and rate that [`check_one_origin`](super::origin::check_one_origin)
+/// compares before dumps are joined.
+pub fn load_dump_with_origin(path: impl AsRef<Path>) -> Result<(Record, DumpOrigin), FrfError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|error| FrfError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let source = path.display().to_string();
+    let (record, header) = load_dump_bytes_with(&bytes, &source, Excitation::Sweep)?;
+    Ok((record, DumpOrigin::of(&source, &header)))
+}
+
 fn load_dump_with(path: impl AsRef<Path>, excitation: Excitation) -> Result<Record, FrfError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|error| FrfError::Io {
         path: path.to_path_buf(),
         error,
     })?;
-    load_dump_bytes_with(&bytes, &path.display().to_string(), excitation)
+    load_dump_bytes_with(&bytes, &path.display().to_string(), excitation).map(|(r, _)| r)
 }
 
 fn is_excitation(phase: Phase) -> bool {
@@ -94,14 +109,15 @@ pub const SETTLE_S: f64 = 2.0;
 
 /// Load the excitation record from the bytes of a dump; `source` names it in messages.
 pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, FrfError> {
-    load_dump_bytes_with(bytes, source, Excitation::Sweep)
+    load_dump_bytes_with(bytes, source, Excitation::Sweep).map(|(record, _)| record)
 }
 
+/// The record and the Header of its test.
 fn load_dump_bytes_with(
     bytes: &[u8],
     source: &str,
     excitation: Excitation,
-) -> Result<Record, FrfError> {
+) -> Result<(Record, Header), FrfError> {
     let mut decoder = Decoder::new();
     // Samples per test: a new segment starts at every Header.
     let mut segments: Vec<(Option<Header>, Vec<Sample>)> = vec![(None, Vec::new())];
@@ -153,7 +169,8 @@ fn load_dump_bytes_with(
         .iter()
         .map(|(_, samples)| samples.len())
         .sum();
-    record_from_samples_at(&header, all, offset, source, excitation)
+    let record = record_from_samples_at(&header, all, offset, source, excitation)?;
+    Ok((record, header))
 }
 
 /// The excitation record of one test from its Header and its Samples in stream order
@@ -429,7 +446,9 @@ mod tests {
         let early = with_ticks(&bytes, |i, t| if i == 33 { t - 60 } else { t });
         for error in [
             load_dump_bytes(&early, "early.bin").unwrap_err(),
-            load_dump_bytes_with(&early, "early.bin", Excitation::Any).unwrap_err(),
+            load_dump_bytes_with(&early, "early.bin", Excitation::Any)
+                .map(|(r, _)| r)
+                .unwrap_err(),
         ] {
             assert_eq!(
                 error.to_string(),
@@ -534,7 +553,7 @@ mod tests {
         assert!(err.to_string().contains("not a sweep"), "{err}");
         // Verification replays any excitation: the same doublet loads there, whole.
         let bytes = dump_bytes(&doublet);
-        let swept = load_dump_bytes_with(&bytes, "d.dump", Excitation::Any).unwrap();
+        let (swept, _) = load_dump_bytes_with(&bytes, "d.dump", Excitation::Any).unwrap();
         let sweep = load_dump_bytes(&dump_bytes(&DumpSpec::default()), "s.dump").unwrap();
         assert_eq!(swept.len(), sweep.len());
     }

@@ -45,6 +45,7 @@ pub mod csv;
 pub mod dump;
 pub mod miso;
 pub mod options;
+pub mod origin;
 pub mod records;
 pub mod reference;
 pub mod spectra;
@@ -61,9 +62,11 @@ pub use coherence::{debiased_coherence, random_error, valid_range};
 pub use csv::units::{TimeUnit, Unit};
 pub use csv::{load_csv, load_csv_records, parse_csv_records, CsvColumns};
 pub use dump::{
-    load_dump, load_dump_bytes, load_test_dump, record_from_samples, test_record_from_samples,
+    load_dump, load_dump_bytes, load_dump_with_origin, load_test_dump, record_from_samples,
+    test_record_from_samples,
 };
 pub use options::{FrfOptions, RangeSource, ResponseEstimator, ResponseInputs};
+pub use origin::{check_one_origin, DumpOrigin};
 pub use records::{group_by_primary, Channel, Record, RecordGroup};
 pub use spectra::welch_independent_averages;
 
@@ -128,6 +131,16 @@ pub enum FrfError {
     /// Records grouped together disagree (primary axis, rate, channel names).
     #[error("records do not fit together: {0}")]
     InconsistentGroup(String),
+    /// Dumps whose Headers name different vehicles, protocol versions or rates.
+    #[error("{first} and {other} cannot be joined: their Headers name {what}")]
+    MixedDumps {
+        /// The first dump.
+        first: String,
+        /// The dump that differs from it.
+        other: String,
+        /// What differs, e.g. `vehicle bo105 vs trex700l`.
+        what: String,
+    },
     /// Two groups sweep the same axis.
     #[error("two record groups sweep `{0}`: put its records in one group")]
     DuplicateAxis(String),
