@@ -22,7 +22,9 @@ use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
 };
-use sysid::fit::trim::{TrimBalance, TrimPoints};
+use sysid::fit::trim::{
+    implausible_derivation, TrimBalance, TrimPoints, PLAUSIBLE_DERIVED_MAGNITUDE,
+};
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
 };
@@ -314,6 +316,20 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
              frequency response for this structure; no model written",
             result.average_cost,
             args.frf.display()
+        );
+    }
+    if let Some(derived) = result.trim.as_ref().and_then(implausible_derivation) {
+        bail!(
+            "the fit is degenerate: the trim points gave `{}` = {:e}, orders of magnitude \
+             beyond a speed or rate derivative (|value| <= {}); the balance scales the \
+             fitted control derivatives, which {} leaves undetermined for {} (a degenerate \
+             minimum): fit without --trim-points or with a structure the responses \
+             determine; no model written",
+            derived.name,
+            derived.value,
+            PLAUSIBLE_DERIVED_MAGNITUDE,
+            args.frf.display(),
+            result.structure.name
         );
     }
     if let Some(path) = &args.out {
