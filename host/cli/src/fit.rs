@@ -88,7 +88,9 @@ pub struct FitArgs {
     /// `sweephold sim trim-points` writes the simulator's): the structure's `trim_derived`
     /// parameters (the shipped 6-DOF: Lv Mu Nv Zw Nr; the hybrid: Mfu Lfu Nv Zw Nr) are
     /// derived from the steady-state balance at the points and held (status `trim`) until
-    /// they settle; `--trim-balance` says what follows.
+    /// they settle; `--trim-balance` says what follows. Implausible, repeated or collinear
+    /// points are refused, and a fit whose derived parameters exceed 100 in magnitude is
+    /// degenerate: no model is written (the 6-DOF on the campaign's responses).
     #[arg(long, value_name = "FILE")]
     pub trim_points: Option<PathBuf>,
     /// How the trim points enter the fit: `hold` keeps the derived parameters at the
@@ -320,7 +322,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     }
     if let Some(derived) = result.trim.as_ref().and_then(implausible_derivation) {
         bail!(
-            "the fit is degenerate: the trim points gave `{}` = {:e}, orders of magnitude \
+            "the fit is degenerate: the trim points gave `{}` = {:.3e}, orders of magnitude \
              beyond a speed or rate derivative (|value| <= {}); the balance scales the \
              fitted control derivatives, which {} leaves undetermined for {} (a degenerate \
              minimum): fit without --trim-points or with a structure the responses \
