@@ -233,7 +233,7 @@ impl TrimPoints {
         }
         let label_index = column("label");
         let mut points = Vec::new();
-        let mut point_lines = Vec::new();
+        let mut seen: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
         for (line, text) in lines {
             let cells: Vec<&str> = text.split(',').map(str::trim).collect();
             if cells.len() != names.len() {
@@ -266,14 +266,13 @@ impl TrimPoints {
                 states,
                 controls,
             };
-            if let Some((first, _)) =
-                point_lines
-                    .iter()
-                    .zip(&points)
-                    .find(|(_, earlier): &(&usize, &TrimPoint)| {
-                        earlier.states == point.states && earlier.controls == point.controls
-                    })
-            {
+            // Keyed by the numbers' bits (+ 0.0 makes −0 a 0): linear in the points.
+            let key: Vec<u64> = states
+                .iter()
+                .chain(&controls)
+                .map(|v| (v + 0.0).to_bits())
+                .collect();
+            if let Some(first) = seen.insert(key, line) {
                 return Err(TrimError::Csv {
                     line,
                     reason: format!(
@@ -282,7 +281,6 @@ impl TrimPoints {
                     ),
                 });
             }
-            point_lines.push(line);
             points.push(point);
         }
         if points.len() < 2 {
