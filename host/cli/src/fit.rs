@@ -22,7 +22,9 @@ use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
 };
-use sysid::fit::trim::{TrimBalance, TrimPoints};
+use sysid::fit::trim::{
+    implausible_derivation, TrimBalance, TrimPoints, PLAUSIBLE_DERIVED_MAGNITUDE,
+};
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
 };
@@ -86,7 +88,9 @@ pub struct FitArgs {
     /// `sweephold sim trim-points` writes the simulator's): the structure's `trim_derived`
     /// parameters (the shipped 6-DOF: Lv Mu Nv Zw Nr; the hybrid: Mfu Lfu Nv Zw Nr) are
     /// derived from the steady-state balance at the points and held (status `trim`) until
-    /// they settle; `--trim-balance` says what follows.
+    /// they settle; `--trim-balance` says what follows. Implausible, repeated or collinear
+    /// points are refused, and a fit whose derived parameters exceed 100 in magnitude is
+    /// degenerate: no model is written (the 6-DOF on the campaign's responses).
     #[arg(long, value_name = "FILE")]
     pub trim_points: Option<PathBuf>,
     /// How the trim points enter the fit: `hold` keeps the derived parameters at the
@@ -314,6 +318,20 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
              frequency response for this structure; no model written",
             result.average_cost,
             args.frf.display()
+        );
+    }
+    if let Some(derived) = result.trim.as_ref().and_then(implausible_derivation) {
+        bail!(
+            "the fit is degenerate: the trim points gave `{}` = {:.3e}, orders of magnitude \
+             beyond a speed or rate derivative (|value| <= {}); the balance scales the \
+             fitted control derivatives, which {} leaves undetermined for {} (a degenerate \
+             minimum): fit without --trim-points or with a structure the responses \
+             determine; no model written",
+            derived.name,
+            derived.value,
+            PLAUSIBLE_DERIVED_MAGNITUDE,
+            args.frf.display(),
+            result.structure.name
         );
     }
     if let Some(path) = &args.out {

@@ -131,3 +131,183 @@ fn a_bad_trim_point_file_is_refused_in_one_line_and_left_alone() {
         );
     }
 }
+
+#[test]
+fn an_absurd_trim_point_is_refused_before_any_work() {
+    let dir = TempDir::new("absurd");
+    let frf = dir.file("frf.json", b"{}");
+    let text = "label,u,v,w,p,q,r,phi,theta,lat,lon,ped,col\n\
+                hover,0,0,0,0,0,0,0,0,0,0,0,0.35\nfast,1e30,0,0,0,0,0,0,0,0,0,0,0.35\n";
+    let path = dir.file("fast.csv", text.as_bytes());
+    let started = std::time::Instant::now();
+    let out = sweephold(&[
+        "fit",
+        "--frf",
+        frf.to_str().unwrap(),
+        "--model",
+        "bo105-6dof",
+        "--trim-points",
+        path.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("fast.csv: line 3: `u` = 1e30 is not a plausible trim point"),
+        "{stderr}"
+    );
+    assert!(started.elapsed().as_secs_f64() < 10.0);
+}
+
+/// `sweephold fit --frf FRF --model MODEL [extra…]`: status and stderr.
+fn fit(frf: &std::path::Path, model: &str, extra: &[&str]) -> (Option<i32>, String) {
+    let mut args = vec!["fit", "--frf", frf.to_str().unwrap(), "--model", model];
+    args.extend_from_slice(extra);
+    let out = sweephold(&args);
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The quick campaign's responses and the simulator's trim points, in `dir`.
+fn quick_campaign_and_trim_points(dir: &TempDir) -> (PathBuf, PathBuf) {
+    let campaign = dir.0.join("c");
+    let out = sweephold(&[
+        "campaign",
+        "--quick",
+        "--vehicle",
+        "bo105",
+        "--out",
+        campaign.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let points = dir.0.join("tp.csv");
+    let out = sweephold(&[
+        "sim",
+        "trim-points",
+        "--vehicle",
+        "bo105",
+        "--out",
+        points.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (campaign.join("frf.json"), points)
+}
+
+#[test]
+fn degenerate_fits_and_points_that_cannot_inform_are_never_a_success() {
+    let dir = TempDir::new("degenerate");
+    let (frf, points) = quick_campaign_and_trim_points(&dir);
+
+    // The 6-DOF with the simulator's own points: its fitted control derivatives are
+    // undetermined (X_ped, Z_ped of 10⁶–10⁹), the balance gives speed derivatives of 10¹⁴:
+    // refused, no model written.
+    let model = dir.0.join("m6.json");
+    let (code, stderr) = fit(
+        &frf,
+        "bo105-6dof",
+        &[
+            "--trim-points",
+            points.to_str().unwrap(),
+            "--out",
+            model.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("error: the fit is degenerate: the trim points gave `"),
+        "{stderr}"
+    );
+    assert!(!model.exists());
+
+    // Five points on one line through (u, v, w, r): v and r vary only together, so N_v
+    // and N_r cannot be told apart.
+    let mut line = String::from("label,u,v,w,p,q,r,phi,theta,lat,lon,ped,col\n");
+    for t in [-2.0, -1.0, 0.0, 1.0, 2.0] {
+        line.push_str(&format!(
+            "p{t},{},{},{},0,0,{},-0.046,0.039,{},{},{},{}\n",
+            0.5 * t,
+            0.3 * t,
+            -0.2 * t,
+            0.05 * t,
+            -0.007 + 0.004 * t,
+            0.089 - 0.003 * t,
+            0.014 + 0.002 * t,
+            0.354 - 0.001 * t
+        ));
+    }
+    let collinear = dir.file("line.csv", line.as_bytes());
+    let (code, stderr) = fit(
+        &frf,
+        "bo105-9dof-hybrid",
+        &["--trim-points", collinear.to_str().unwrap()],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("the trim points do not vary what `Nv`, `Nr` multiply independently"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("span only 1 direction"), "{stderr}");
+}
+
+#[test]
+fn structure_files_that_would_overflow_run_forever_or_answer_zero_are_refused() {
+    let dir = TempDir::new("structures");
+    let (frf, _) = quick_campaign_and_trim_points(&dir);
+    let six_dof = include_str!("../../sysid/models/bo105-6dof.toml");
+    let nested = format!("{}Yv{}", "(".repeat(20_000), ")".repeat(20_000));
+    let many_states: Vec<String> = (0..1_000).map(|i| format!("\"x{i}\"")).collect();
+    let cases = [
+        (
+            "nested.toml",
+            six_dof.replacen(
+                "Yv = { start",
+                &format!("Yv0 = {{ expr = \"{nested}\" }}\nYv = {{ start"),
+                1,
+            ),
+            "parentheses nested deeper than 64 levels",
+        ),
+        (
+            "constant.toml",
+            six_dof.replacen("Xq = 0.5", "Xq = 0.5\nXq2 = { expr = \"rotor_k*Xq\" }", 1),
+            "`rotor_k` is not a declared constant or parameter",
+        ),
+        (
+            "undefined.toml",
+            six_dof.replacen("\"az\"]", "\"az\", \"beta\"]", 1),
+            "output `beta` is neither a state nor given a row of H0 or H1",
+        ),
+        (
+            "large.toml",
+            six_dof.replacen(
+                "states = [\"u\", \"v\", \"w\", \"p\", \"q\", \"r\", \"phi\", \"theta\"]",
+                &format!("states = [{}]", many_states.join(", ")),
+                1,
+            ),
+            "1000 states: at most 32 are supported",
+        ),
+    ];
+    for (name, text, message) in cases {
+        assert_ne!(text, six_dof, "{name}: the edit applies");
+        let path = dir.file(name, text.as_bytes());
+        let started = std::time::Instant::now();
+        let (code, stderr) = fit(&frf, path.to_str().unwrap(), &[]);
+        assert_eq!(code, Some(1), "{name}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{name}: {stderr}");
+        assert!(
+            stderr.contains(name) && stderr.contains(message),
+            "{name}: {stderr}"
+        );
+        assert!(started.elapsed().as_secs_f64() < 20.0, "{name}");
+    }
+}

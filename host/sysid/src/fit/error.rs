@@ -23,7 +23,7 @@ pub enum StructureProblem {
     #[error("undefined parameter `{0}` (declare it under [parameters])")]
     UndefinedParameter(String),
     /// An expression that is not a linear combination of parameters.
-    #[error("bad expression `{expression}`: {reason}")]
+    #[error("bad expression `{}`: {reason}", shortened(.expression))]
     BadExpression {
         /// The expression text.
         expression: String,
@@ -68,9 +68,45 @@ pub enum StructureProblem {
         /// What is wrong.
         reason: String,
     },
+    /// Constrained parameters that name each other in a chain longer than
+    /// [`crate::fit::expression::MAX_NESTING`] (resolving it recurses once per link).
+    #[error(
+        "constrained parameter `{0}` is defined through a chain of more than {limit} \
+         constrained parameters",
+        limit = crate::fit::expression::MAX_NESTING
+    )]
+    ConstraintChainTooLong(String),
+    /// An output that is not a state and has no row of H0 or H1: its response would be
+    /// identically 0.
+    #[error(
+        "output `{0}` is neither a state nor given a row of H0 or H1: nothing defines its \
+         response"
+    )]
+    UndefinedOutput(String),
+    /// More states, controls, outputs, parameters or pairs than a fit supports (limits
+    /// documented in `host/sysid/models/README.md`); refused before any work.
+    #[error("{count} {what}: at most {limit} are supported")]
+    TooLarge {
+        /// `states`, `controls`, `outputs`, `parameters` or `pairs`.
+        what: &'static str,
+        /// How many the file declares.
+        count: usize,
+        /// The limit.
+        limit: usize,
+    },
     /// The file could not be read.
     #[error("cannot read: {0}")]
     Io(String),
+}
+
+/// An expression as quoted in an error: at most 60 characters, so that a pathological
+/// one still gives a one-line message.
+fn shortened(expression: &str) -> String {
+    const SHOWN: usize = 60;
+    match expression.char_indices().nth(SHOWN) {
+        None => expression.to_string(),
+        Some((end, _)) => format!("{}…", &expression[..end]),
+    }
 }
 
 /// A problem in a structure file, located by file name and 1-based line. The problem is

@@ -7,10 +7,18 @@
 //! ```text
 //! expr   := term (('+' | '-') term)*
 //! term   := factor (('*' | '/') factor)*
-//! factor := number | name | '(' expr ')' | '-' factor | '+' factor
+//! factor := ('-' | '+')* (number | name | '(' expr ')')
 //! ```
+//!
+//! Signs before a factor are read in a loop, and parentheses may nest at most
+//! [`MAX_NESTING`] deep, so no expression — however long — can exhaust the stack.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Deepest nesting of parentheses an expression may have. The parser recurses once per
+/// level; a structure file needs two or three, and 64 keeps the recursion far below any
+/// thread's stack.
+pub const MAX_NESTING: usize = 64;
 
 /// `constant + Σ coefficient·name`, with names not yet resolved to parameters.
 #[derive(Clone, Debug, PartialEq, Default)]
@@ -138,12 +146,17 @@ fn tokenize(text: &str) -> Result<Vec<Token>, String> {
     Ok(tokens)
 }
 
-struct Parser {
+struct Parser<'a> {
     tokens: Vec<Token>,
     position: usize,
+    /// Open parentheses around the current position.
+    depth: usize,
+    /// The structure's parameter names, when known: a product of two names then says
+    /// which of them is declared nowhere (a constant left out of `[constants]`).
+    parameters: Option<&'a BTreeSet<String>>,
 }
 
-impl Parser {
+impl Parser<'_> {
     fn peek(&self) -> Option<&Token> {
         self.tokens.get(self.position)
     }
@@ -181,7 +194,9 @@ impl Parser {
             let rhs = self.factor()?;
             value = if divide {
                 if !rhs.is_constant() {
-                    return Err("division by a parameter is not linear".into());
+                    return Err(self
+                        .undeclared(&rhs)
+                        .unwrap_or_else(|| "division by a parameter is not linear".into()));
                 }
                 if rhs.constant == 0.0 {
                     return Err("division by zero".into());
@@ -192,28 +207,62 @@ impl Parser {
             } else if value.is_constant() {
                 rhs.scaled(value.constant)
             } else {
-                return Err("a product of two parameters is not linear".into());
+                return Err(self.product_of_names(&value, &rhs));
             };
         }
         Ok(value)
     }
 
     fn factor(&mut self) -> Result<LinearForm, String> {
-        match self.next() {
-            Some(Token::Number(value)) => Ok(LinearForm::constant(value)),
-            Some(Token::Name(name)) => Ok(LinearForm::name(&name)),
-            Some(Token::Minus) => Ok(self.factor()?.scaled(-1.0)),
-            Some(Token::Plus) => self.factor(),
-            Some(Token::Open) => {
-                let inner = self.expression()?;
-                match self.next() {
-                    Some(Token::Close) => Ok(inner),
-                    _ => Err("missing `)`".into()),
+        let mut sign = 1.0;
+        loop {
+            match self.next() {
+                Some(Token::Minus) => sign = -sign,
+                Some(Token::Plus) => {}
+                Some(Token::Number(value)) => return Ok(LinearForm::constant(sign * value)),
+                Some(Token::Name(name)) => return Ok(LinearForm::name(&name).scaled(sign)),
+                Some(Token::Open) => {
+                    if self.depth == MAX_NESTING {
+                        return Err(format!(
+                            "parentheses nested deeper than {MAX_NESTING} levels"
+                        ));
+                    }
+                    self.depth += 1;
+                    let inner = self.expression()?;
+                    self.depth -= 1;
+                    return match self.next() {
+                        Some(Token::Close) => Ok(inner.scaled(sign)),
+                        _ => Err("missing `)`".into()),
+                    };
                 }
+                Some(other) => return Err(format!("unexpected `{}`", token_text(&other))),
+                None => return Err("unexpected end of expression".into()),
             }
-            Some(other) => Err(format!("unexpected `{}`", token_text(&other))),
-            None => Err("unexpected end of expression".into()),
         }
+    }
+
+    /// The first name of `form` that is neither a constant (those were replaced by their
+    /// numbers before parsing) nor a declared parameter, as an error; None when every
+    /// name is declared or the parameters are not known.
+    fn undeclared(&self, form: &LinearForm) -> Option<String> {
+        let parameters = self.parameters?;
+        form.terms
+            .keys()
+            .find(|name| !parameters.contains(*name))
+            .map(|name| {
+                format!(
+                    "`{name}` is not a declared constant or parameter (declare it under \
+                     [constants] or [parameters])"
+                )
+            })
+    }
+
+    /// Why `left * right`, both with names, is refused: an undeclared name (most often a
+    /// constant missing from `[constants]`), else a true product of two parameters.
+    fn product_of_names(&self, left: &LinearForm, right: &LinearForm) -> String {
+        self.undeclared(left)
+            .or_else(|| self.undeclared(right))
+            .unwrap_or_else(|| "a product of two parameters is not linear".into())
     }
 }
 
@@ -242,6 +291,26 @@ pub fn parse_linear_with_constants(
     text: &str,
     constants: &BTreeMap<String, f64>,
 ) -> Result<LinearForm, String> {
+    parse(text, constants, None)
+}
+
+/// [`parse_linear_with_constants`] for an expression of a structure whose parameter
+/// names are `parameters`: a product or quotient with a name declared neither there nor
+/// among the constants says so, naming it, instead of calling it a product of two
+/// parameters.
+pub fn parse_linear_declared(
+    text: &str,
+    constants: &BTreeMap<String, f64>,
+    parameters: &BTreeSet<String>,
+) -> Result<LinearForm, String> {
+    parse(text, constants, Some(parameters))
+}
+
+fn parse(
+    text: &str,
+    constants: &BTreeMap<String, f64>,
+    parameters: Option<&BTreeSet<String>>,
+) -> Result<LinearForm, String> {
     let tokens: Vec<Token> = tokenize(text)?
         .into_iter()
         .map(|token| match token {
@@ -258,6 +327,8 @@ pub fn parse_linear_with_constants(
     let mut parser = Parser {
         tokens,
         position: 0,
+        depth: 0,
+        parameters,
     };
     let value = parser.expression()?;
     if let Some(token) = parser.peek() {

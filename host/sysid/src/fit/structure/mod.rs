@@ -19,6 +19,21 @@ mod parse;
 mod schema;
 mod validate;
 
+/// Most states a structure may declare. A fit's work grows with the cube of the states
+/// (one complex n×n solve per frequency and parameter): the shipped structures have 8
+/// and 10, and 32 leaves room for a larger rotor model while keeping that work bounded.
+/// Checked before any work.
+pub const MAX_STATES: usize = 32;
+/// Most controls a structure may declare.
+pub const MAX_CONTROLS: usize = 16;
+/// Most outputs a structure may declare.
+pub const MAX_OUTPUTS: usize = 32;
+/// Most parameters (free, fixed and constrained) a structure may declare: each free one
+/// costs a model evaluation per Jacobian.
+pub const MAX_PARAMETERS: usize = 256;
+/// Most input/output pairs a structure may fit.
+pub const MAX_PAIRS: usize = 128;
+
 /// Whether the optimizer moves a parameter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]

@@ -9,13 +9,13 @@ use super::schema::{
     explain_syntax, line_of, Context, RawActuator, RawParameter, RawRange, RawRows, RawStructure,
     RawValue,
 };
-use super::validate::{check_band, check_every_parameter_is_used, file_constants};
+use super::validate::{check_band, check_every_parameter_is_used, check_sizes, file_constants};
 use super::{
     DerivedParameter, MatrixEntry, MatrixName, ModelStructure, PairRange, PairSpec, Parameter,
     ParameterExpression, ParameterKind,
 };
 use crate::fit::error::{StructureError, StructureProblem};
-use crate::fit::expression::{parse_linear_with_constants, LinearForm};
+use crate::fit::expression::{parse_linear_declared, LinearForm, MAX_NESTING};
 use crate::fit::model::Actuator;
 
 /// Resolves expressions against base and constrained parameters.
@@ -39,6 +39,10 @@ impl Resolver<'_> {
             } else if let Some(inner) = self.derived_forms.get(name) {
                 if visiting.contains(name) {
                     return Err(StructureProblem::CyclicConstraint(name.clone()));
+                }
+                // One recursion per link of the chain: bounded, like an expression's nesting.
+                if visiting.len() > MAX_NESTING {
+                    return Err(StructureProblem::ConstraintChainTooLong(name.clone()));
                 }
                 visiting.push(name.clone());
                 let resolved = self.resolve(inner, visiting)?;
@@ -109,6 +113,7 @@ impl ModelStructure {
         context: &Context<'_>,
         overrides: &BTreeMap<String, f64>,
     ) -> Result<Self, StructureError> {
+        check_sizes(&raw, context)?;
         let states = context.names(&raw.states, "state")?;
         let controls = context.names(&raw.controls, "control")?;
         let outputs = context.names(&raw.outputs, "output")?;
@@ -122,6 +127,8 @@ impl ModelStructure {
         }
 
         // Parameters, in file order.
+        let declared: BTreeSet<String> =
+            raw.parameters.keys().map(|k| k.get_ref().clone()).collect();
         let mut raw_parameters: Vec<_> = raw.parameters.into_iter().collect();
         raw_parameters.sort_by_key(|(key, _)| key.span().start);
         let mut parameters = Vec::new();
@@ -190,8 +197,8 @@ impl ModelStructure {
                         if table.min.is_some() || table.max.is_some() {
                             return Err(bad("a constrained parameter cannot have bounds"));
                         }
-                        let form = parse_linear_with_constants(expression, &constants).map_err(
-                            |reason| {
+                        let form = parse_linear_declared(expression, &constants, &declared)
+                            .map_err(|reason| {
                                 context.error(
                                     value.span(),
                                     StructureProblem::BadExpression {
@@ -199,8 +206,7 @@ impl ModelStructure {
                                         reason,
                                     },
                                 )
-                            },
-                        )?;
+                            })?;
                         derived_forms.insert(name.clone(), form);
                         derived_order.push((name, line, value.span()));
                     } else {
@@ -263,15 +269,16 @@ impl ModelStructure {
                     terms: Vec::new(),
                 }),
                 RawValue::Expression(text) => {
-                    let form = parse_linear_with_constants(text, &constants).map_err(|reason| {
-                        context.error(
-                            value.span(),
-                            StructureProblem::BadExpression {
-                                expression: text.clone(),
-                                reason,
-                            },
-                        )
-                    })?;
+                    let form =
+                        parse_linear_declared(text, &constants, &declared).map_err(|reason| {
+                            context.error(
+                                value.span(),
+                                StructureProblem::BadExpression {
+                                    expression: text.clone(),
+                                    reason,
+                                },
+                            )
+                        })?;
                     referenced.extend(form.terms.keys().cloned());
                     resolver
                         .resolve(&form, &mut Vec::new())
@@ -335,6 +342,17 @@ impl ModelStructure {
                     .map(|state| (index, state))
             })
             .collect();
+
+        // Any other output has nothing that defines it: its response would be 0 at every
+        // frequency, and a pair on it would be fitted to nothing.
+        if let Some(index) = (0..outputs.len())
+            .find(|&index| !rows_with_measurement[index] && !states.contains(&outputs[index]))
+        {
+            return Err(context.error(
+                raw.outputs[index].span(),
+                StructureProblem::UndefinedOutput(outputs[index].clone()),
+            ));
+        }
 
         let mut delays = vec![ParameterExpression::default(); controls.len()];
         for (key, value) in &raw.delays {

@@ -416,3 +416,159 @@ fn actuators_take_numbers_or_constants_and_refuse_anything_else() {
         "{missing}"
     );
 }
+
+/// SMALL with the entry F[x, x] written as `expression`.
+fn small_with_dynamics(expression: &str) -> String {
+    SMALL.replace("[F.x]\nx = \"a\"", &format!("[F.x]\nx = \"{expression}\""))
+}
+
+#[test]
+fn deeply_nested_expressions_are_refused_at_their_line_not_overflowed() {
+    // 20 000 levels of parentheses: refused by the depth limit, in one short line.
+    let nested = format!("{}a{}", "(".repeat(20_000), ")".repeat(20_000));
+    let error = error_of(&small_with_dynamics(&nested));
+    assert_eq!(error.line, Some(15));
+    let message = error.to_string();
+    assert!(
+        message.contains("parentheses nested deeper than 64 levels"),
+        "{message}"
+    );
+    assert!(!message.contains('\n') && message.len() < 200, "{message}");
+    // At the limit it parses.
+    let at_limit = format!("{}a{}", "(".repeat(64), ")".repeat(64));
+    ModelStructure::parse(&small_with_dynamics(&at_limit), "test.toml").unwrap();
+    // A chain of 20 000 signs is read in a loop: no limit needed, the sign is right.
+    let signs = format!("{}a", "- ".repeat(20_001));
+    let structure = ModelStructure::parse(&small_with_dynamics(&signs), "test.toml").unwrap();
+    let model = structure.model(&structure.values()).unwrap();
+    assert_eq!(model.f[(0, 0)], 2.0, "-(−2): an odd number of signs");
+}
+
+#[test]
+fn a_long_chain_of_constrained_parameters_is_refused() {
+    let mut text = SMALL.replace("x = \"a\"", "x = \"a + k200\"");
+    let mut chain = String::from("k0 = { expr = \"a\" }\n");
+    for k in 1..=200 {
+        chain.push_str(&format!("k{k} = {{ expr = \"k{}\" }}\n", k - 1));
+    }
+    text = text.replace("[parameters]\n", &format!("[parameters]\n{chain}"));
+    let error = error_of(&text);
+    assert!(
+        matches!(error.problem, StructureProblem::ConstraintChainTooLong(_)),
+        "{error}"
+    );
+}
+
+#[test]
+fn an_undeclared_constant_in_a_product_is_named() {
+    let error = error_of(&small_with_dynamics("rotor_k*a"));
+    assert_eq!(error.line, Some(15));
+    assert!(
+        error
+            .to_string()
+            .contains("`rotor_k` is not a declared constant or parameter"),
+        "{error}"
+    );
+    let error = error_of(&small_with_dynamics("a / rotor_k"));
+    assert!(
+        error.to_string().contains("`rotor_k` is not a declared"),
+        "{error}"
+    );
+    // Two declared parameters multiplied are still called what they are.
+    let error = error_of(&small_with_dynamics("a*b"));
+    assert!(
+        error
+            .to_string()
+            .contains("a product of two parameters is not linear"),
+        "{error}"
+    );
+}
+
+#[test]
+fn an_output_nothing_defines_is_refused_naming_it() {
+    // `z` is no state and has no H0/H1 row: its response would be 0.
+    let text = SMALL.replace(
+        "outputs = [\"x\", \"y\"]",
+        "outputs = [\"x\", \"y\",\n  \"z\"]",
+    );
+    let error = error_of(&text);
+    assert_eq!(
+        error.problem,
+        StructureProblem::UndefinedOutput("z".to_string())
+    );
+    assert_eq!(error.line, Some(6));
+}
+
+/// A structure with `states` states, each fitted on its own pair: F[i, i] = a_i,
+/// G[i, u] = b_i.
+fn diagonal_structure(states: usize) -> String {
+    let names: Vec<String> = (0..states).map(|i| format!("\"x{i}\"")).collect();
+    let mut text = format!(
+        "name = \"big\"\nstates = [{list}]\ncontrols = [\"u\"]\noutputs = [{list}]\n\n[parameters]\n",
+        list = names.join(", ")
+    );
+    for i in 0..states {
+        text.push_str(&format!("a{i} = -1.0\nb{i} = 1.0\n"));
+    }
+    for i in 0..states {
+        text.push_str(&format!(
+            "[F.x{i}]\nx{i} = \"a{i}\"\n[G.x{i}]\nu = \"b{i}\"\n"
+        ));
+    }
+    for i in 0..states {
+        text.push_str(&format!("[[pairs]]\noutput = \"x{i}\"\ninput = \"u\"\n"));
+    }
+    text
+}
+
+#[test]
+fn structures_beyond_the_size_limits_are_refused_before_any_work() {
+    let started = std::time::Instant::now();
+    let error = error_of(&diagonal_structure(1_000));
+    assert_eq!(
+        error.problem,
+        StructureProblem::TooLarge {
+            what: "states",
+            count: 1_000,
+            limit: MAX_STATES
+        }
+    );
+    assert_eq!(error.line, Some(2));
+    assert!(started.elapsed().as_secs_f64() < 5.0);
+    // At the limit: accepted.
+    ModelStructure::parse(&diagonal_structure(MAX_STATES), "test.toml").unwrap();
+
+    // Parameters: 257 declared, with the states within their limit.
+    let mut text = diagonal_structure(1);
+    let extra: String = (0..MAX_PARAMETERS)
+        .map(|k| format!("p{k} = 0.0\n"))
+        .collect();
+    text = text.replace("[parameters]\n", &format!("[parameters]\n{extra}"));
+    let error = error_of(&text);
+    assert!(
+        matches!(
+            error.problem,
+            StructureProblem::TooLarge { what: "parameters", count, limit: MAX_PARAMETERS }
+                if count == MAX_PARAMETERS + 2
+        ),
+        "{error}"
+    );
+    // The first parameter beyond the limit: p0..p255 on lines 7.., then a0 b0.
+    assert_eq!(error.line, Some(7 + MAX_PARAMETERS));
+
+    // Pairs: 129 of them (duplicates would be refused later; the size comes first).
+    let mut text = diagonal_structure(1);
+    text.push_str(&"[[pairs]]\noutput = \"x0\"\ninput = \"u\"\n".repeat(MAX_PAIRS));
+    let error = error_of(&text);
+    assert!(
+        matches!(
+            error.problem,
+            StructureProblem::TooLarge {
+                what: "pairs",
+                limit: MAX_PAIRS,
+                ..
+            }
+        ),
+        "{error}"
+    );
+}

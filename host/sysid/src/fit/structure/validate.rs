@@ -6,9 +6,39 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use toml::Spanned;
 
 use super::schema::{Context, RawParameter, RawStructure};
-use super::ParameterExpression;
+use super::{
+    ParameterExpression, MAX_CONTROLS, MAX_OUTPUTS, MAX_PAIRS, MAX_PARAMETERS, MAX_STATES,
+};
 use crate::fit::error::{StructureError, StructureProblem};
 use crate::fit::expression::LinearForm;
+
+/// Refuse a structure larger than a fit supports ([`MAX_STATES`] and the others), at the
+/// line of the first name beyond the limit, before anything else is checked or built.
+pub(super) fn check_sizes(raw: &RawStructure, context: &Context<'_>) -> Result<(), StructureError> {
+    let mut parameter_spans: Vec<_> = raw.parameters.keys().map(|key| key.span()).collect();
+    parameter_spans.sort_by_key(|span| span.start);
+    let pair_spans: Vec<_> = raw.pairs.iter().map(|pair| pair.span()).collect();
+    let spans = |list: &[Spanned<String>]| list.iter().map(Spanned::span).collect::<Vec<_>>();
+    for (what, spans, limit) in [
+        ("states", spans(&raw.states), MAX_STATES),
+        ("controls", spans(&raw.controls), MAX_CONTROLS),
+        ("outputs", spans(&raw.outputs), MAX_OUTPUTS),
+        ("parameters", parameter_spans, MAX_PARAMETERS),
+        ("pairs", pair_spans, MAX_PAIRS),
+    ] {
+        if spans.len() > limit {
+            return Err(context.error(
+                spans[limit].clone(),
+                StructureProblem::TooLarge {
+                    what,
+                    count: spans.len(),
+                    limit,
+                },
+            ));
+        }
+    }
+    Ok(())
+}
 
 /// A `[lo, hi]` band in rad/s: two finite numbers with 0 < lo < hi.
 pub(super) fn check_band(band: &[f64]) -> Result<[f64; 2], String> {

@@ -52,6 +52,35 @@ pub const STATE_COLUMNS: [&str; 8] = ["u", "v", "w", "p", "q", "r", "phi", "thet
 /// The stick columns, in their order in [`TrimPoint::controls`] (fractions of travel).
 pub const CONTROL_COLUMNS: [&str; 4] = ["lat", "lon", "ped", "col"];
 
+/// Plausible trim points, checked when a file is read, before any work: the largest
+/// magnitude of each column group, with its unit. Beyond these no helicopter flies
+/// steadily (the fastest reach ~110 m/s; a steady bank or pitch past 90° is no trim; a
+/// pirouette of 3 turns a second is 19 rad/s), and a stick cannot pass full travel.
+pub const PLAUSIBLE_RANGES: [(&str, &[&str], f64, &str); 4] = [
+    ("a speed", &["u", "v", "w"], 150.0, "m/s"),
+    ("a rate", &["p", "q", "r"], 20.0, "rad/s"),
+    (
+        "an angle",
+        &["phi", "theta"],
+        std::f64::consts::FRAC_PI_2,
+        "rad",
+    ),
+    ("a stick", &["lat", "lon", "ped", "col"], 1.0, "of travel"),
+];
+
+/// Largest magnitude a trim-derived parameter may take for a fit to count as a success.
+/// They are speed and rate derivatives (1/s, or rad/s² per m/s): the shipped aircraft's
+/// campaigns derive 0.002–1.4 (`model9.json` `trim`), and 100 is two orders beyond. A fit
+/// whose balance gives more landed in a degenerate minimum (module documentation of
+/// [`implausible_derivation`]).
+pub const PLAUSIBLE_DERIVED_MAGNITUDE: f64 = 100.0;
+
+/// Smallest singular value, relative to the largest, of the balance's matrix with its
+/// columns scaled to unit length, for the derived parameters to count as independently
+/// informed: collinear points give exactly dependent columns (rounding, ~10⁻¹⁶), the
+/// simulator's points ~10⁻¹.
+const INDEPENDENCE_TOLERANCE: f64 = 1e-9;
+
 /// The iteration stops when no derived parameter moved by more than this fraction of its
 /// value between two derivations.
 pub const SETTLED_RELATIVE_CHANGE: f64 = 0.01;
@@ -122,9 +151,35 @@ pub enum TrimError {
         /// The parameter.
         parameter: String,
     },
+    /// The points vary what the derived parameters multiply, but not independently of
+    /// each other (collinear or duplicate points): the balance cannot tell them apart.
+    #[error(
+        "the trim points do not vary what {} multiply independently of each other: their \
+         differences in {varied} span only {directions} direction(s) (collinear or \
+         duplicate points); add points that vary them separately (see docs/formats.md, \
+         trim points)",
+        quoted(.parameters)
+    )]
+    NotIndependent {
+        /// The parameters the points cannot tell apart.
+        parameters: Vec<String>,
+        /// The state columns the points vary, space-separated.
+        varied: String,
+        /// The rank of the points' differences in those columns.
+        directions: usize,
+    },
     /// The model could not be built from the values.
     #[error("{0}")]
     Model(String),
+}
+
+/// `` `a`, `b` `` for an error message.
+fn quoted(names: &[String]) -> String {
+    names
+        .iter()
+        .map(|name| format!("`{name}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 impl TrimPoints {
@@ -178,6 +233,7 @@ impl TrimPoints {
         }
         let label_index = column("label");
         let mut points = Vec::new();
+        let mut seen: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
         for (line, text) in lines {
             let cells: Vec<&str> = text.split(',').map(str::trim).collect();
             if cells.len() != names.len() {
@@ -204,11 +260,28 @@ impl TrimPoints {
             for (value, &index) in controls.iter_mut().zip(&control_index) {
                 *value = number(index)?;
             }
-            points.push(TrimPoint {
+            check_plausible(line, &states, &controls)?;
+            let point = TrimPoint {
                 label: label_index.map_or_else(String::new, |i| cells[i].to_string()),
                 states,
                 controls,
-            });
+            };
+            // Keyed by the numbers' bits (+ 0.0 makes −0 a 0): linear in the points.
+            let key: Vec<u64> = states
+                .iter()
+                .chain(&controls)
+                .map(|v| (v + 0.0).to_bits())
+                .collect();
+            if let Some(first) = seen.insert(key, line) {
+                return Err(TrimError::Csv {
+                    line,
+                    reason: format!(
+                        "the same flight as line {first} (every state and stick equal): a \
+                         duplicate adds no gradient"
+                    ),
+                });
+            }
+            points.push(point);
         }
         if points.len() < 2 {
             return Err(TrimError::TooFewPoints(points.len()));
@@ -236,6 +309,49 @@ impl TrimPoints {
         }
         out
     }
+}
+
+/// Refuse a point outside [`PLAUSIBLE_RANGES`], naming the column, its value and the range.
+fn check_plausible(line: usize, states: &[f64; 8], controls: &[f64; 4]) -> Result<(), TrimError> {
+    let columns = STATE_COLUMNS
+        .iter()
+        .zip(states)
+        .chain(CONTROL_COLUMNS.iter().zip(controls));
+    for (name, &value) in columns {
+        let (what, _, limit, unit) = PLAUSIBLE_RANGES
+            .iter()
+            .find(|(_, names, _, _)| names.contains(name))
+            .expect("every column has a range");
+        if value.abs() > *limit {
+            // 1e30 as 1e30, not 31 digits.
+            let value = if value.abs() >= 1e6 {
+                format!("{value:e}")
+            } else {
+                value.to_string()
+            };
+            return Err(TrimError::Csv {
+                line,
+                reason: format!(
+                    "`{name}` = {value} is not a plausible trim point: {what} lies within \
+                     ±{limit:.4} {unit}"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The first derived parameter whose value is not finite or lies beyond
+/// [`PLAUSIBLE_DERIVED_MAGNITUDE`]: the sign of a degenerate fit. The balance multiplies
+/// the stick gradients of the points by the fitted control derivatives (M_u = −M_lon
+/// ∂δ_lon/∂u, …); when the responses leave those undetermined — the Bo-105 6-DOF
+/// structure lands in a minimum with X_ped, Z_ped of 10⁶–10⁹ — the derived speed
+/// derivatives are as absurd, and holding them drives the refit further away.
+pub fn implausible_derivation(outcome: &TrimOutcome) -> Option<&TrimDerivation> {
+    outcome
+        .parameters
+        .iter()
+        .find(|d| !d.value.is_finite() || d.value.abs() > PLAUSIBLE_DERIVED_MAGNITUDE)
 }
 
 /// One parameter derived from trim points.
@@ -476,6 +592,7 @@ pub fn derive(
             });
         }
     }
+    check_independent(&a, names, points)?;
     let svd = a.svd(true, true);
     let theta = svd
         .solve(&b, 1e-12 * svd.singular_values.max())
@@ -488,6 +605,70 @@ pub fn derive(
             value: *value,
         })
         .collect())
+}
+
+/// Refuse a balance whose derived parameters the points cannot tell apart: the matrix
+/// `a` of [`derive`] (one column per parameter), each column scaled to unit length so
+/// that their sizes do not matter, must have full column rank. The error names the
+/// parameters of the null space and the state columns the points vary, with the rank of
+/// their differences.
+fn check_independent(
+    a: &DMatrix<f64>,
+    names: &[String],
+    points: &TrimPoints,
+) -> Result<(), TrimError> {
+    let mut scaled = a.clone();
+    for mut column in scaled.column_iter_mut() {
+        let norm = column.norm();
+        column /= norm;
+    }
+    let svd = scaled.svd(false, true);
+    let largest = svd.singular_values.max();
+    let v_t = svd.v_t.as_ref().expect("asked for V");
+    let mut tangled = vec![false; names.len()];
+    for (k, &sigma) in svd.singular_values.iter().enumerate() {
+        if sigma <= INDEPENDENCE_TOLERANCE * largest {
+            for (slot, weight) in tangled.iter_mut().zip(v_t.row(k).iter()) {
+                *slot |= weight.abs() > 1e-6;
+            }
+        }
+    }
+    if names.len() <= a.nrows() && !tangled.contains(&true) {
+        return Ok(());
+    }
+    if names.len() > a.nrows() {
+        tangled.iter_mut().for_each(|slot| *slot = true);
+    }
+    // The state columns the points vary, and in how many directions.
+    let count = points.points.len() as f64;
+    let varied: Vec<usize> = (0..STATE_COLUMNS.len())
+        .filter(|&k| {
+            let mean = points.points.iter().map(|p| p.states[k]).sum::<f64>() / count;
+            points.points.iter().any(|p| p.states[k] != mean)
+        })
+        .collect();
+    let differences = DMatrix::from_fn(points.points.len(), varied.len(), |i, j| {
+        points.points[i].states[varied[j]] - points.points[0].states[varied[j]]
+    });
+    let values = differences.singular_values();
+    let directions = values
+        .iter()
+        .filter(|&&sigma| sigma > 1e-9 * values.max())
+        .count();
+    Err(TrimError::NotIndependent {
+        parameters: names
+            .iter()
+            .zip(&tangled)
+            .filter(|(_, &tangled)| tangled)
+            .map(|(name, _)| name.clone())
+            .collect(),
+        varied: varied
+            .iter()
+            .map(|&k| STATE_COLUMNS[k])
+            .collect::<Vec<_>>()
+            .join(" "),
+        directions,
+    })
 }
 
 #[cfg(test)]

@@ -252,3 +252,106 @@ fn quasi_static_derivative_residualizes_the_flapping() {
     assert!((got - want).abs() <= 1e-9 * want.abs(), "{got} vs {want}");
     assert_eq!(quasi_static_derivative(&model, "q", "nonesuch"), None);
 }
+
+const HEADER: &str = "label,u,v,w,p,q,r,phi,theta,lat,lon,ped,col\n";
+
+#[test]
+fn implausible_magnitudes_are_refused_when_read() {
+    let hover = "hover,0,0,0,0,0,0,0,0,0,0,0,0.35\n";
+    let cases = [
+        (
+            "fast,1e30,0,0,0,0,0,0,0,0,0,0,0.35\n",
+            "`u` = 1e30 is not a plausible trim point: a speed lies within ±150.0000 m/s",
+        ),
+        ("spin,0,0,0,0,0,-25,0,0,0,0,0,0.35\n", "`r` = -25"),
+        (
+            "inverted,0,0,0,0,0,0,3.1,0,0,0,0,0.35\n",
+            "`phi` = 3.1 is not a plausible trim point: an angle lies within ±1.5708 rad",
+        ),
+        ("stick,0,0,0,0,0,0,0,0,0,1.5,0,0.35\n", "`lon` = 1.5"),
+    ];
+    for (point, message) in cases {
+        let text = format!("{HEADER}{hover}{point}");
+        let error = TrimPoints::parse_csv(&text).unwrap_err().to_string();
+        assert!(error.starts_with("line 3: "), "{error}");
+        assert!(error.contains(message), "{error}");
+    }
+    // At the edges of the ranges: accepted.
+    let edges = format!("{HEADER}{hover}edge,150,-150,0,20,0,-20,1.5707,-1.5707,1,-1,1,-1\n");
+    assert!(TrimPoints::parse_csv(&edges).is_ok());
+}
+
+#[test]
+fn duplicate_points_are_refused_naming_both_lines() {
+    let text = format!(
+        "{HEADER}hover,0,0,0,0,0,0,0,0,0,0,0,0.35\nforward,1,0,0,0,0,0,0,0,0,0.01,0,0.35\n\
+         again,0,0,0,0,0,0,0,0,0,0,0,0.35\n"
+    );
+    assert_eq!(
+        TrimPoints::parse_csv(&text).unwrap_err().to_string(),
+        "line 4: the same flight as line 2 (every state and stick equal): a duplicate adds no gradient"
+    );
+}
+
+#[test]
+fn collinear_points_are_refused_naming_what_they_fail_to_vary() {
+    // Five points on one line through (u, v, w, r): every column of the balance is
+    // non-zero, but v and r (what Nv and Nr multiply in the yaw row) vary only together.
+    let structure = hybrid_structure();
+    let truth = hybrid_truth_values(&structure);
+    let line: Vec<[f64; 4]> = [-2.0, -1.0, 0.0, 1.0, 2.0]
+        .iter()
+        .map(|&t| [0.5 * t, 0.3 * t, -0.2 * t, 0.05 * t])
+        .collect();
+    let points = linear_trim_points(&structure, &truth, &line);
+    let error = derive(
+        &structure,
+        &truth,
+        &points,
+        &names(&["Lv", "Mu", "Nv", "Zw", "Nr"]),
+    )
+    .unwrap_err();
+    let TrimError::NotIndependent {
+        parameters,
+        varied,
+        directions,
+    } = &error
+    else {
+        panic!("{error}");
+    };
+    assert!(parameters.contains(&"Nv".to_string()), "{error}");
+    assert!(parameters.contains(&"Nr".to_string()), "{error}");
+    assert!(varied.contains("u v w") && varied.contains('r'), "{error}");
+    assert_eq!(*directions, 1, "{error}");
+    // The same number of points spread over the four directions: accepted.
+    let spread = linear_trim_points(&structure, &truth, &STEPS[..5]);
+    assert!(derive(&structure, &truth, &spread, &names(&["Lv", "Mu", "Nv"])).is_ok());
+}
+
+#[test]
+fn derived_parameters_orders_of_magnitude_off_mark_the_fit_degenerate() {
+    let outcome = |values: &[f64]| TrimOutcome {
+        points: 9,
+        rounds: 2,
+        settled: true,
+        parameters: values
+            .iter()
+            .zip(["Lv", "Mu", "Nv"])
+            .map(|(&value, name)| TrimDerivation {
+                name: name.into(),
+                value,
+            })
+            .collect(),
+    };
+    // The shipped aircraft's campaigns: ≤ 1.4.
+    assert!(implausible_derivation(&outcome(&[-0.3, 0.05, 1.4])).is_none());
+    // The Bo-105 6-DOF with the simulator's trim points: L_v = 1.6·10⁴, M_u = 8.2·10¹⁵.
+    let off = outcome(&[1.6e4, 8.2e15, 3.3e3]);
+    assert_eq!(implausible_derivation(&off).unwrap().name, "Lv");
+    assert_eq!(
+        implausible_derivation(&outcome(&[0.1, f64::NAN, 0.0]))
+            .unwrap()
+            .name,
+        "Mu"
+    );
+}
