@@ -12,12 +12,12 @@
 
 #![cfg(unix)]
 
-use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
-use nix::sys::signal::{kill, Signal};
-use nix::unistd::Pid;
+use nix::sys::signal::Signal;
+
+mod support;
+use support::signals::{interrupted_by, run_ok, snapshot};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(
@@ -36,79 +36,6 @@ fn fly_args(fc: &str, seed: &str) -> Vec<String> {
     ]
     .map(String::from)
     .to_vec()
-}
-
-fn run_ok(dir: &Path, args: &[String]) {
-    let output = Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
-
-/// Run `args` paused at `point`, send `signals` there a tenth of a second apart; the exit
-/// code and stderr.
-fn interrupted_at(
-    dir: &Path,
-    args: &[String],
-    point: &str,
-    signals: &[Signal],
-) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .current_dir(dir)
-        .args(args)
-        .env("SWEEPHOLD_TEST_PAUSE_AT", point)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut seen = String::new();
-    loop {
-        let mut line = String::new();
-        let n = stderr.read_line(&mut line).unwrap();
-        if n == 0 {
-            let _ = child.kill();
-            panic!("{args:?} never paused at {point}: {seen}");
-        }
-        seen += &line;
-        if line.trim() == format!("paused at {}", point.trim_end_matches('!')) {
-            break;
-        }
-    }
-    let pid = Pid::from_raw(i32::try_from(child.id()).unwrap());
-    for (i, signal) in signals.iter().enumerate() {
-        if i > 0 {
-            std::thread::sleep(std::time::Duration::from_millis(100));
-        }
-        kill(pid, *signal).unwrap();
-    }
-    stderr.read_to_string(&mut seen).unwrap();
-    let status = child.wait().unwrap();
-    (status.code(), seen)
-}
-
-/// The bytes of every file below `dir`, by path.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(folder) = stack.pop() {
-        for entry in std::fs::read_dir(&folder).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                files.push((path.clone(), std::fs::read(&path).unwrap()));
-            }
-        }
-    }
-    files.sort();
-    files
 }
 
 /// Every path below `dir` (recursively) other than the earlier result `o` and the kept
@@ -168,7 +95,7 @@ fn table(fc: &str) {
     for signal in [Signal::SIGINT, Signal::SIGTERM] {
         for point in POINTS {
             let case = format!("{fc}: {signal} at {point}");
-            let (code, stderr) = interrupted_at(&dir, &second, point, &[signal]);
+            let (code, stderr) = interrupted_by(&dir, &second, point, &[signal]);
             assert_eq!(code, Some(1), "{case}: {stderr}");
             let last = stderr.lines().last().unwrap_or_default();
             assert!(
@@ -186,7 +113,7 @@ fn table(fc: &str) {
         for point in POINTS {
             let case = format!("{fc}: {signal} twice at {point}");
             let held = format!("{point}!");
-            let (code, stderr) = interrupted_at(&dir, &second, &held, &[signal, signal]);
+            let (code, stderr) = interrupted_by(&dir, &second, &held, &[signal, signal]);
             assert_eq!(code, Some(130), "{case}: {stderr}");
             assert!(snapshot(&dir.join("o")) == before, "{case}: o changed");
             assert_eq!(leftovers(&dir), Vec::<PathBuf>::new(), "{case}");

@@ -5,12 +5,12 @@
 
 #![cfg(unix)]
 
-use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
-use nix::sys::signal::{kill, Signal};
-use nix::unistd::Pid;
+use nix::sys::signal::Signal;
+
+mod support;
+use support::signals::{interrupted_by, run_ok, snapshot};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sweephold-signals-{name}-{}", std::process::id()));
@@ -19,79 +19,9 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-fn run_ok(dir: &Path, args: &[&str]) {
-    let output = Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
-
 /// Run `args` paused at `point`, send `signal` there; the exit code and stderr.
 fn interrupted_at(dir: &Path, args: &[&str], point: &str, signal: Signal) -> (Option<i32>, String) {
-    interrupted_at_by(dir, args, point, &[signal])
-}
-
-/// Run `args` paused at `point` (`POINT!`: held there through the first signal), send
-/// `signals` there a tenth of a second apart; the exit code and stderr.
-fn interrupted_at_by(
-    dir: &Path,
-    args: &[&str],
-    point: &str,
-    signals: &[Signal],
-) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .current_dir(dir)
-        .args(args)
-        .env("SWEEPHOLD_TEST_PAUSE_AT", point)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut seen = String::new();
-    loop {
-        let mut line = String::new();
-        let n = stderr.read_line(&mut line).unwrap();
-        assert!(n > 0, "{args:?} never paused at {point}: {seen}");
-        seen += &line;
-        if line.trim() == format!("paused at {}", point.trim_end_matches('!')) {
-            break;
-        }
-    }
-    let pid = Pid::from_raw(i32::try_from(child.id()).unwrap());
-    for (i, signal) in signals.iter().enumerate() {
-        if i > 0 {
-            std::thread::sleep(std::time::Duration::from_millis(100));
-        }
-        kill(pid, *signal).unwrap();
-    }
-    stderr.read_to_string(&mut seen).unwrap();
-    let status = child.wait().unwrap();
-    (status.code(), seen)
-}
-
-/// The bytes of every file below `dir`, by path.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(folder) = stack.pop() {
-        for entry in std::fs::read_dir(&folder).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                files.push((path.clone(), std::fs::read(&path).unwrap()));
-            }
-        }
-    }
-    files.sort();
-    files
+    interrupted_by(dir, args, point, &[signal])
 }
 
 /// Every path below `dir` (recursively) whose name says it is a leftover.
@@ -170,7 +100,7 @@ fn a_second_signal_ends_a_campaign_at_once_leaving_nothing_behind() {
         ("frf!", [Signal::SIGINT, Signal::SIGINT]),
         ("write!", [Signal::SIGTERM, Signal::SIGTERM]),
     ] {
-        let (code, stderr) = interrupted_at_by(&dir, &second, point, &signals);
+        let (code, stderr) = interrupted_by(&dir, &second, point, &signals);
         assert_eq!(code, Some(130), "{point}: {stderr}");
         assert!(snapshot(&dir.join("c")) == before, "{point}: c changed");
         assert_eq!(leftovers(&dir), Vec::<PathBuf>::new(), "{point}");

@@ -1,0 +1,3 @@
+//! What more than one CLI test binary needs.
+
+pub mod signals;
