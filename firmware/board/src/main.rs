@@ -1,13 +1,20 @@
-//! `sweephold-fc`: the flight-controller image for a SpeedyBee F405 V4 (STM32F405)
-//! flying a TREX 700L (`cargo fw`).
+//! `sweephold-fc`: the flight-controller image for an STM32F405 flight controller flying a
+//! TREX 700L (`cargo fw`; by default for a SpeedyBee F405 V4, `--features
+//! board-matek-f405-te` for a Matek F405-TE).
 //!
-//! Boots on the board and, unchanged, in `qemu-system-arm -M netduinoplus2`. The board
-//! support is this crate, on the `stm32f4` peripheral access crate: clocks, the tick
-//! timer, the servo and ESC outputs, the USART frame link and the loop that ties them to
-//! [`sweephold_firmware::FlightController`]. Which pin does what is `pins.rs`. The flight
-//! logic is the `sweephold_firmware` library. On the host this is an empty program (so
-//! that `cargo build --workspace` works) whose unit tests cover the pin map, the divider
-//! arithmetic and the byte ring.
+//! Boots on the board and, unchanged, in `qemu-system-arm -M netduinoplus2`. Three rooms:
+//!
+//! - `image/`: the image logic, the same on every board (boot, the control loop of both
+//!   run modes, the frame link, the defmt logger, the build-time flight configuration)
+//!   around [`sweephold_firmware::FlightController`] and the board application;
+//! - `chip/`: the STM32F405 drivers on the `stm32f4` peripheral access crate, which take
+//!   the peripherals once (`chip::devices`) and their pins from a board map;
+//! - `boards/`: one folder per board (its pin map, crystal and `memory.x`) and the choice
+//!   of the board the image is built for.
+//!
+//! `ring` is the byte ring the drivers and the logger share. On the host this is an
+//! empty program (so that `cargo build --workspace` works) whose unit tests cover the
+//! board maps, the divider arithmetic and the byte ring.
 //!
 //! A panic or a hard fault puts the outputs in their safe state (servos at their
 //! failsafe pulses, the ESC at the throttle cut) and resets the MCU; the boot path
@@ -21,53 +28,23 @@
 #![cfg_attr(target_os = "none", no_std, no_main)]
 #![deny(unsafe_op_in_unsafe_fn)]
 
-#[cfg(target_os = "none")]
-mod clocks;
-#[cfg(target_os = "none")]
-mod delay;
 #[cfg(any(target_os = "none", test))]
-mod dividers;
-#[cfg(target_os = "none")]
-mod gpio;
-#[cfg(target_os = "none")]
-mod image_config;
-#[cfg(target_os = "none")]
-mod imu_device;
-#[cfg(target_os = "none")]
-mod imu_spi;
-#[cfg(target_os = "none")]
-mod link;
-#[cfg(target_os = "none")]
-mod log;
-#[cfg(target_os = "none")]
-mod logport;
-#[cfg(target_os = "none")]
-mod nvic;
+mod boards;
 #[cfg(any(target_os = "none", test))]
-mod pins;
+mod chip;
+#[cfg(target_os = "none")]
+mod image;
 #[cfg(any(target_os = "none", test))]
 mod ring;
-#[cfg(target_os = "none")]
-mod runner;
-#[cfg(target_os = "none")]
-mod sbus_uart;
-#[cfg(target_os = "none")]
-mod semihosting;
-#[cfg(target_os = "none")]
-mod servo;
-#[cfg(target_os = "none")]
-mod ticker;
-#[cfg(target_os = "none")]
-mod usart;
-#[cfg(target_os = "none")]
-mod watchdog;
 
 #[cfg(target_os = "none")]
-mod image {
+mod vectors {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use stm32f4::stm32f405::interrupt;
 
-    use crate::{log, logport, runner, sbus_uart, servo, ticker, usart};
+    use crate::boards::BOARD;
+    use crate::chip::{logport, sbus_uart, servo, ticker, usart};
+    use crate::image::{log, runner};
 
     // Log lines carry the loop tick they were written in (the `tick` of the Sample).
     defmt::timestamp!("{=u32}", log::tick());
@@ -114,7 +91,7 @@ mod image {
     /// the interrupted code held.
     fn safe_state() {
         cortex_m::interrupt::disable();
-        servo::force_failsafe();
+        servo::force_failsafe_anywhere(&BOARD);
         usart::silence();
         sbus_uart::silence();
         logport::silence();

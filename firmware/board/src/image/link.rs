@@ -4,8 +4,8 @@ use sweephold_firmware::FrameSink;
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{encode, Decoder, Frame, FrameError, MAX_FRAME_LEN};
 
-use crate::logport;
-use crate::usart::{UsartRx, UsartTx};
+use crate::chip::logport;
+use crate::chip::usart::{UsartRx, UsartTx};
 
 /// Bytes taken from the receive ring per decoder pass.
 const RX_CHUNK: usize = 64;

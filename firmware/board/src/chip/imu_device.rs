@@ -1,23 +1,26 @@
-//! The IMU device the board stack reads: the ICM-42688-P on SPI1 ([`crate::imu_spi`]), or,
+//! The IMU device the board stack reads: the ICM-42688-P on SPI1 ([`crate::chip::imu_spi`]), or,
 //! in the bench image (feature `bench-imu`), the flight logic's register-level emulator
 //! of the same chip standing still, so that QEMU, which has nothing on SPI1, can
 //! calibrate, arm and fly the board application. The bench image is for tests only: the
 //! attitude it reports is a still board's, whatever the aircraft does.
 
-use crate::clocks::Clocks;
-use crate::dividers::DividerError;
+use stm32f4::stm32f405 as pac;
+
+use crate::chip::boot::Boot;
+use crate::chip::dividers::DividerError;
+use crate::chip::pins::ImuPins;
 
 #[cfg(not(feature = "bench-imu"))]
-mod chip {
-    use super::{Clocks, DividerError};
-    use crate::imu_spi::{self, ImuSpi};
+mod device {
+    use super::{pac, Boot, DividerError, ImuPins};
+    use crate::chip::imu_spi::{self, ImuSpi};
 
     /// The chip on SPI1.
     pub type ImuDevice = ImuSpi;
 
     /// Configure SPI1.
-    pub fn init(clocks: &Clocks) -> Result<ImuDevice, DividerError> {
-        let (spi, hz) = imu_spi::init(clocks)?;
+    pub fn init(spi1: pac::SPI1, pins: ImuPins, boot: &Boot) -> Result<ImuDevice, DividerError> {
+        let (spi, hz) = imu_spi::init(spi1, pins, boot)?;
         defmt::info!("IMU: ICM-42688-P on SPI1 at {=u32} Hz", hz);
         Ok(spi)
     }
@@ -27,9 +30,9 @@ mod chip {
 }
 
 #[cfg(feature = "bench-imu")]
-mod chip {
-    use super::{Clocks, DividerError};
-    use crate::imu_spi;
+mod device {
+    use super::{pac, Boot, DividerError, ImuPins};
+    use crate::chip::imu_spi;
     use sweephold_firmware::imu::emulator::{Icm42688Emulator, Imperfections};
     use sweephold_firmware::imu::GRAVITY_M_S2;
 
@@ -38,8 +41,8 @@ mod chip {
 
     /// An emulated chip at rest, level, with a bench board's bias and noise. SPI1 is
     /// set up as on the board image (chip select released), then left alone.
-    pub fn init(clocks: &Clocks) -> Result<ImuDevice, DividerError> {
-        imu_spi::init(clocks)?;
+    pub fn init(spi1: pac::SPI1, pins: ImuPins, boot: &Boot) -> Result<ImuDevice, DividerError> {
+        imu_spi::init(spi1, pins, boot)?;
         let mut device = Icm42688Emulator::new(Imperfections::BENCH);
         device.set_truth([0.0; 3], [0.0, 0.0, -GRAVITY_M_S2]);
         defmt::warn!("IMU: BENCH IMAGE, emulated ICM-42688-P at rest (never fly this image)");
@@ -56,4 +59,4 @@ mod chip {
     }
 }
 
-pub use chip::{before_poll, init, ImuDevice};
+pub use device::{before_poll, init, ImuDevice};

@@ -11,7 +11,7 @@
 //! (or under QEMU, where nothing is on the bus) reports it missing on its first tick and
 //! refuses to arm. The board's clock for the receiver's timeouts is the tick count.
 //!
-//! Each processed IMU sample feeds the independent watchdog ([`crate::watchdog`]),
+//! Each processed IMU sample feeds the independent watchdog ([`crate::chip::watchdog`]),
 //! which the first one starts: a loop that stops processing fresh samples resets the
 //! board into Disarmed with the throttle cut (while the IMU failsafe flies, its control
 //! ticks feed it instead).
@@ -53,21 +53,23 @@ use sweephold_protocol::{
     LinkConfig, SensorIn,
 };
 
-use crate::clocks::{self, ClockSource, Clocks};
-use crate::delay::BusyDelay;
-use crate::dividers;
-use crate::image_config::{image_config, link_config, stack_config};
-use crate::imu_device::{self, ImuDevice};
-use crate::link::{self, FrameScratch, Inbound, Telemetry};
-use crate::log;
-use crate::logport;
-use crate::nvic::{self, Irq};
-use crate::sbus_uart::{self, SbusRx};
-use crate::semihosting;
-use crate::servo::{self, ServoChannel, Servos, ESC_CUT_US};
-use crate::ticker::Ticker;
-use crate::usart::{self, UsartTx};
-use crate::watchdog::Watchdog;
+use crate::boards::BOARD;
+use crate::chip::clocks::ClockSource;
+use crate::chip::delay::BusyDelay;
+use crate::chip::devices::{self, Devices};
+use crate::chip::dividers;
+use crate::chip::imu_device::{self, ImuDevice};
+use crate::chip::logport;
+use crate::chip::nvic::{self, Irq};
+use crate::chip::sbus_uart::{self, SbusRx};
+use crate::chip::servo::{self, ServoChannel, Servos, ESC_CUT_US};
+use crate::chip::ticker::Ticker;
+use crate::chip::usart::{self, UsartTx};
+use crate::chip::watchdog::Watchdog;
+use crate::image::config::{image_config, link_config, stack_config};
+use crate::image::link::{self, FrameScratch, Inbound, Telemetry};
+use crate::image::log;
+use crate::image::semihosting;
 
 /// Host silence after which the loop steps on its own again [s].
 pub const LINK_TIMEOUT_S: u32 = 1;
@@ -406,42 +408,24 @@ impl Runner {
 
 /// Bring the board up and run the loop forever.
 pub fn run() -> ! {
-    let clocks: Clocks = clocks::init();
-    defmt::info!("clocks {}", clocks);
-
-    // Servos first: their failsafe pulses and the throttle cut are on the pins before
-    // anything else runs.
-    let (servos, esc) = match servo::init(&clocks) {
-        Ok(outputs) => outputs,
-        Err(error) => defmt::panic!("servo timer: {}", error),
-    };
-    let (tx, rx) = match usart::init(&clocks) {
-        Ok(halves) => halves,
-        Err(error) => defmt::panic!("USART1: {}", error),
-    };
-    defmt::info!(
-        "USART1 {=u32} Bd, BRR {=u32:#x}, rate error {=u32} ppm",
-        usart::BAUD,
-        tx.brr(),
-        dividers::baud_error_ppm(clocks.pclk2_hz, usart::BAUD, tx.brr())
-    );
-    if let Err(error) = logport::init(&clocks) {
-        defmt::panic!("USART3 (log): {}", error);
-    }
-    let sbus = match sbus_uart::init(&clocks) {
-        Ok(sbus) => sbus,
-        Err(error) => defmt::panic!("USART2 (SBUS): {}", error),
-    };
-    let spi = match imu_device::init(&clocks) {
-        Ok(spi) => spi,
-        Err(error) => defmt::panic!("SPI1 (IMU): {}", error),
-    };
+    let Devices {
+        mut boot,
+        servos,
+        esc,
+        tx,
+        rx,
+        sbus,
+        imu,
+        watchdog,
+        tim5,
+    } = devices::bring_up(&BOARD);
+    let clocks = boot.clocks;
 
     let fc = match FlightController::new(image_config()) {
         Ok(fc) => fc,
         Err(error) => defmt::panic!("flight configuration refused: {=str}", error.message()),
     };
-    let mut stack = match Stack::new(spi, BusyDelay::new(clocks.hclk_hz), stack_config()) {
+    let mut stack = match Stack::new(imu, BusyDelay::new(clocks.hclk_hz), stack_config()) {
         Ok(stack) => stack,
         Err(error) => defmt::panic!("board configuration refused: {=str}", error.message()),
     };
@@ -482,11 +466,11 @@ pub fn run() -> ! {
         stats: LoopStats::default(),
         host_ignored_reported: false,
         scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
-        watchdog: Watchdog::new(),
+        watchdog,
     };
     runner.announce();
 
-    let ticker = match Ticker::start(&clocks, TIMER_HZ) {
+    let ticker = match Ticker::start(tim5, &mut boot, TIMER_HZ) {
         Ok(ticker) => ticker,
         Err(error) => defmt::panic!("tick timer: {}", error),
     };

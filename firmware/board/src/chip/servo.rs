@@ -1,10 +1,15 @@
 //! Servo and ESC outputs: PWM compare channels behind `embedded_hal::pwm::SetDutyCycle`.
 //!
-//! Which pad, timer and channel drives what is the board's pin map ([`crate::pins`]):
-//! swash servos 1–3 on TIM4 CH1/CH2 and TIM3 CH3, the tail servo on TIM8 CH3, the ESC on
-//! TIM2 CH3. Each timer counts microseconds (prescaler from its actual kernel clock) at
-//! the frame rate of its group ([`crate::pins::OutputTimer::frame_hz`]), so a channel's
-//! duty value is the pulse width in µs and `max_duty_cycle()` is the frame period in µs.
+//! Which pad, timer and channel drives what is the board's map ([`BoardMap`]: the four
+//! servos, the ESC, and each output timer's frame rate). Each timer counts microseconds
+//! (prescaler from its actual kernel clock) at the frame rate of its group, so a
+//! channel's duty value is the pulse width in µs and `max_duty_cycle()` is the frame
+//! period in µs.
+//!
+//! The output timers (TIM1..TIM4, TIM8) are owned by one [`OutputTimers`], moved to a
+//! `'static` place at boot and shared by the channels (each writes only its own compare
+//! register, a single store). The panic and fault path is the one place that steals them
+//! ([`force_failsafe_anywhere`]).
 //!
 //! From boot the servos hold their failsafe pulses and the ESC the throttle cut
 //! ([`ESC_CUT_US`]): the pins carry them before any other driver starts.
@@ -16,12 +21,13 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 
 use stm32f4::stm32f405 as pac;
 
-use crate::clocks::{ClockGate, Clocks};
-use crate::dividers::{self, DividerError};
-use crate::gpio::{self, Pull};
-use crate::pins::{self, Output, OutputTimer};
+use crate::chip::boot::Boot;
+use crate::chip::clocks::{ClockGate, Clocks};
+use crate::chip::dividers::{self, DividerError};
+use crate::chip::gpio::Pull;
+use crate::chip::pins::{BoardMap, Output, OutputTimer};
 
-pub use crate::pins::{MAX_PULSE_US, MIN_PULSE_US};
+pub use crate::chip::pins::{MAX_PULSE_US, MIN_PULSE_US};
 
 /// The ESC's pulse while the motor must not run [µs]: the throttle cut of the board
 /// application's standard ESC range (`ThrottleSettings::standard().esc_min_us`).
@@ -49,33 +55,58 @@ pub fn set_failsafe(pulse_us: [u16; 4]) {
     }
 }
 
-/// Run `$body` with `$tim` bound to the register block of `$timer` (the PAC gives the
-/// 32-bit, the 16-bit general-purpose and the advanced timers their own types; the
-/// field API the image uses is the same).
+/// The timers that may drive outputs, owned.
+pub struct OutputTimers {
+    tim1: pac::TIM1,
+    tim2: pac::TIM2,
+    tim3: pac::TIM3,
+    tim4: pac::TIM4,
+    tim8: pac::TIM8,
+}
+
+impl OutputTimers {
+    /// The five timers, handed over by the PAC.
+    pub fn new(
+        tim1: pac::TIM1,
+        tim2: pac::TIM2,
+        tim3: pac::TIM3,
+        tim4: pac::TIM4,
+        tim8: pac::TIM8,
+    ) -> Self {
+        OutputTimers {
+            tim1,
+            tim2,
+            tim3,
+            tim4,
+            tim8,
+        }
+    }
+}
+
+/// Run `$body` with `$tim` bound to the register block of `$timer` in `$timers` (the PAC
+/// gives the 32-bit, the 16-bit general-purpose and the advanced timers their own types;
+/// the field API the image uses is the same).
 macro_rules! with_timer {
-    ($timer:expr, |$tim:ident| $body:expr) => {
+    ($timers:expr, $timer:expr, |$tim:ident| $body:expr) => {
         match $timer {
+            OutputTimer::Tim1 => {
+                let $tim = &$timers.tim1;
+                $body
+            }
             OutputTimer::Tim2 => {
-                // SAFETY: TIM2's register block is always mapped. This module is its only
-                // user; its read-modify-writes run in thread mode at boot, before any
-                // interrupt exists that could touch it, and afterwards only whole
-                // compare registers are written (single volatile stores).
-                let $tim = unsafe { &*pac::TIM2::ptr() };
+                let $tim = &$timers.tim2;
                 $body
             }
             OutputTimer::Tim3 => {
-                // SAFETY: as for TIM2.
-                let $tim = unsafe { &*pac::TIM3::ptr() };
+                let $tim = &$timers.tim3;
                 $body
             }
             OutputTimer::Tim4 => {
-                // SAFETY: as for TIM2.
-                let $tim = unsafe { &*pac::TIM4::ptr() };
+                let $tim = &$timers.tim4;
                 $body
             }
             OutputTimer::Tim8 => {
-                // SAFETY: as for TIM2.
-                let $tim = unsafe { &*pac::TIM8::ptr() };
+                let $tim = &$timers.tim8;
                 $body
             }
         }
@@ -85,6 +116,7 @@ macro_rules! with_timer {
 /// The kernel clock and the clock gate of an output timer.
 fn clock_of(timer: OutputTimer, clocks: &Clocks) -> (ClockGate, u32) {
     match timer {
+        OutputTimer::Tim1 => (ClockGate::Tim1, clocks.apb2_timer_hz),
         OutputTimer::Tim2 => (ClockGate::Tim2, clocks.apb1_timer_hz),
         OutputTimer::Tim3 => (ClockGate::Tim3, clocks.apb1_timer_hz),
         OutputTimer::Tim4 => (ClockGate::Tim4, clocks.apb1_timer_hz),
@@ -95,15 +127,16 @@ fn clock_of(timer: OutputTimer, clocks: &Clocks) -> (ClockGate, u32) {
 /// Write `pulse_us` into the compare register of `output` (a single store).
 // One body serves the 32-bit TIM2 (u32 fields) and the 16-bit timers (u16 fields).
 #[allow(clippy::useless_conversion)]
-fn write_compare(output: &Output, pulse_us: u16) {
+fn write_compare(timers: &OutputTimers, output: &Output, pulse_us: u16) {
     let index = usize::from(output.channel.clamp(1, 4) - 1);
-    with_timer!(output.timer, |tim| tim
+    with_timer!(timers, output.timer, |tim| tim
         .ccr(index)
         .write(|w| w.ccr().set(pulse_us.into())));
 }
 
 /// One servo output (a timer compare channel).
 pub struct ServoChannel {
+    timers: &'static OutputTimers,
     output: Output,
     period_us: u16,
 }
@@ -118,7 +151,7 @@ impl SetDutyCycle for ServoChannel {
     }
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
-        write_compare(&self.output, duty.min(self.period_us));
+        write_compare(self.timers, &self.output, duty.min(self.period_us));
         Ok(())
     }
 }
@@ -139,29 +172,33 @@ impl<P: SetDutyCycle> Servos<P> {
     }
 }
 
-/// Start every output timer at its group's frame rate with the failsafe pulses (servos)
-/// and the throttle cut (ESC) loaded before the outputs are enabled. Returns the four
-/// servos and the ESC's channel (its duty value is the throttle pulse in µs).
+/// Start every output timer of `map` at its group's frame rate with the failsafe pulses
+/// (servos) and the throttle cut (ESC) loaded before the outputs are enabled. Returns
+/// the four servos and the ESC's channel (its duty value is the throttle pulse in µs).
 // One body serves the 32-bit TIM2 (u32 fields) and the 16-bit timers (u16 fields).
 #[allow(clippy::useless_conversion)]
-pub fn init(clocks: &Clocks) -> Result<(Servos<ServoChannel>, ServoChannel), DividerError> {
-    for timer in OutputTimer::ALL {
-        let (gate, timer_hz) = clock_of(timer, clocks);
-        let (prescaler, reload) = dividers::servo_dividers(timer_hz, timer.frame_hz())?;
-        gate.enable();
-        with_timer!(timer, |tim| {
+pub fn init(
+    timers: &'static OutputTimers,
+    map: &BoardMap,
+    boot: &Boot,
+) -> Result<(Servos<ServoChannel>, ServoChannel), DividerError> {
+    for rate in map.output_timers {
+        let (gate, timer_hz) = clock_of(rate.timer, &boot.clocks);
+        let (prescaler, reload) = dividers::servo_dividers(timer_hz, rate.frame_hz)?;
+        boot.enable_clock(gate);
+        with_timer!(timers, rate.timer, |tim| {
             tim.cr1().reset();
             tim.psc().write(|w| w.psc().set(prescaler));
             tim.arr().write(|w| w.arr().set(reload.into()));
         });
     }
-    force_failsafe();
-    let outputs = pins::SERVOS.iter().chain([&pins::ESC]);
-    for output in outputs.clone() {
+    force_failsafe(timers, map);
+    let outputs = map.outputs();
+    for output in &outputs {
         // PWM mode 1 with the compare preload on; channels 1, 2 in CCMR1, 3, 4 in CCMR2.
         let index = output.channel.clamp(1, 4) - 1;
         let within = index % 2;
-        with_timer!(output.timer, |tim| {
+        with_timer!(timers, output.timer, |tim| {
             if index < 2 {
                 tim.ccmr1_output().modify(|_, w| {
                     w.ocm(within).pwm_mode1();
@@ -177,40 +214,60 @@ pub fn init(clocks: &Clocks) -> Result<(Servos<ServoChannel>, ServoChannel), Div
         });
     }
     // Load prescaler, reload and compare preloads, then start the counters; the advanced
-    // timer's outputs also need their main output enable.
-    for timer in OutputTimer::ALL {
-        with_timer!(timer, |tim| {
+    // timers' outputs also need their main output enable.
+    for rate in map.output_timers {
+        with_timer!(timers, rate.timer, |tim| {
             tim.egr().write(|w| w.ug().set_bit());
             tim.cr1().write(|w| w.arpe().set_bit().cen().set_bit());
         });
     }
-    // SAFETY: as in `with_timer!`: TIM8 is this module's, written at boot only.
-    let tim8 = unsafe { &*pac::TIM8::ptr() };
-    tim8.bdtr().modify(|_, w| w.moe().set_bit());
-    for output in outputs {
-        gpio::alternate_function(output.pin, Pull::None);
+    for rate in map.output_timers {
+        match rate.timer {
+            OutputTimer::Tim1 => {
+                timers.tim1.bdtr().modify(|_, w| w.moe().set_bit());
+            }
+            OutputTimer::Tim8 => {
+                timers.tim8.bdtr().modify(|_, w| w.moe().set_bit());
+            }
+            OutputTimer::Tim2 | OutputTimer::Tim3 | OutputTimer::Tim4 => {}
+        }
+    }
+    for output in &outputs {
+        boot.alternate_function(output.pin, Pull::None);
     }
     let channel = |output: Output| {
-        let frame_us = dividers::SERVO_COUNTER_HZ / output.timer.frame_hz();
+        let frame_us = dividers::SERVO_COUNTER_HZ / map.frame_hz(output.timer);
         ServoChannel {
+            timers,
             output,
             period_us: u16::try_from(frame_us).unwrap_or(u16::MAX),
         }
     };
     Ok((
         Servos {
-            channels: pins::SERVOS.map(channel),
+            channels: map.servos.map(channel),
         },
-        channel(pins::ESC),
+        channel(map.esc),
     ))
 }
 
-/// Write the failsafe pulses and the throttle cut straight into the compare registers.
-/// Needs no driver state, so the panic and fault handlers can call it whatever the
-/// program was doing.
-pub fn force_failsafe() {
-    for (output, pulse) in pins::SERVOS.iter().zip(&FAILSAFE_PULSE_US) {
-        write_compare(output, pulse.load(Ordering::Relaxed));
+/// Write the failsafe pulses and the throttle cut into the compare registers of `map`'s
+/// outputs.
+fn force_failsafe(timers: &OutputTimers, map: &BoardMap) {
+    for (output, pulse) in map.servos.iter().zip(&FAILSAFE_PULSE_US) {
+        write_compare(timers, output, pulse.load(Ordering::Relaxed));
     }
-    write_compare(&pins::ESC, ESC_CUT_US);
+    write_compare(timers, &map.esc, ESC_CUT_US);
+}
+
+/// [`force_failsafe`] from the panic and fault handlers, whatever the program was doing:
+/// needs no driver state and takes the timers regardless of their owner.
+pub fn force_failsafe_anywhere(map: &BoardMap) {
+    // SAFETY: called only on the way to a reset (panic, fault, unexpected interrupt) with
+    // interrupts disabled: the owner of the timers never runs again, so these stolen
+    // instances cannot race with it. Each write is a whole compare register (a single
+    // store), valid whatever state the timer is in.
+    let p = unsafe { pac::Peripherals::steal() };
+    let timers = OutputTimers::new(p.TIM1, p.TIM2, p.TIM3, p.TIM4, p.TIM8);
+    force_failsafe(&timers, map);
 }

@@ -1,5 +1,5 @@
 //! The onboard log: every frame the image sends to the host also goes, as the same COBS
-//! bytes, to an OpenLog-style serial logger on USART3 TX (pad T3, PC10), whose file
+//! bytes, to an OpenLog-style serial logger on USART3 TX (the board map's `log_tx`), whose file
 //! `sweephold decode` then reads as it reads a dump.
 //!
 //! The log never blocks the loop: a frame is copied into a 4 KiB ring (a short critical
@@ -20,11 +20,13 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::interrupt::{self, CriticalSection, Mutex};
 use stm32f4::stm32f405 as pac;
 
-use crate::clocks::{ClockGate, Clocks};
-use crate::dividers::{self, DividerError};
-use crate::gpio::{self, Pull};
-use crate::nvic::{self, Irq};
-use crate::pins;
+use crate::chip::boot::Boot;
+use crate::chip::clocks::ClockGate;
+use crate::chip::dividers::{self, DividerError};
+use crate::chip::gpio::Pull;
+use crate::chip::nvic::{self, Irq};
+use crate::chip::pins::Pin;
+use crate::chip::shared::IrqShared;
 use crate::ring::ByteRing;
 
 /// Line rate of the logger [Bd].
@@ -37,19 +39,16 @@ static RING: Mutex<RefCell<ByteRing<CAPACITY>>> = Mutex::new(RefCell::new(ByteRi
 /// Frames dropped so far to make room (or too long for the ring).
 static DROPPED: AtomicU32 = AtomicU32::new(0);
 
-/// USART3's registers.
-fn usart3() -> &'static pac::usart1::RegisterBlock {
-    // SAFETY: USART3's register block is always mapped. This module is its only user;
-    // its one read-modify-write (CR1's TXEIE in `pump`) runs inside a critical section.
-    unsafe { &*pac::USART3::ptr() }
-}
+/// USART3, once set up: reached inside a critical section only (its one
+/// read-modify-write, CR1's TXEIE in `pump`, never interleaves).
+static USART3: IrqShared<pac::USART3> = IrqShared::new();
 
-/// Configure the pin, the baud rate (from PCLK1: USART3 is on APB1) and the interrupt.
-pub fn init(clocks: &Clocks) -> Result<(), DividerError> {
-    let brr = dividers::usart_brr(clocks.pclk1_hz, BAUD)?;
-    ClockGate::Usart3.enable();
-    gpio::alternate_function(pins::LOG_TX, Pull::None);
-    let usart3 = usart3();
+/// Configure the `tx` pin, the baud rate (from PCLK1: USART3 is on APB1) and the
+/// interrupt.
+pub fn init(usart3: pac::USART3, tx: Pin, boot: &mut Boot) -> Result<(), DividerError> {
+    let brr = dividers::usart_brr(boot.clocks.pclk1_hz, BAUD)?;
+    boot.enable_clock(ClockGate::Usart3);
+    boot.alternate_function(tx, Pull::None);
     usart3.cr1().reset();
     usart3.brr().write(|w| {
         w.div_mantissa().set((brr >> 4) as u16);
@@ -58,7 +57,8 @@ pub fn init(clocks: &Clocks) -> Result<(), DividerError> {
     usart3.cr2().reset();
     usart3.cr3().reset();
     usart3.cr1().write(|w| w.ue().set_bit().te().set_bit());
-    nvic::enable(Irq::Usart3);
+    interrupt::free(|cs| USART3.put(cs, usart3));
+    boot.enable_interrupt(Irq::Usart3);
     Ok(())
 }
 
@@ -85,7 +85,9 @@ pub fn dropped() -> u32 {
 /// Feed the data register while it has room; the TXE interrupt stays on exactly while
 /// bytes are waiting.
 fn pump(cs: &CriticalSection) {
-    let usart3 = usart3();
+    let Some(usart3) = USART3.get(cs) else {
+        return;
+    };
     let mut ring = RING.borrow(cs).borrow_mut();
     while usart3.sr().read().txe().bit_is_set() {
         match ring.pop() {

@@ -1,8 +1,8 @@
 //! SPI1 and the IMU's chip select as one `embedded_hal::spi::SpiDevice`: the bus the
 //! ICM-42688-P driver of the flight logic talks through.
 //!
-//! Pins PA5 SCK, PA6 MISO, PA7 MOSI (AF5) and PA4 chip select (GPIO, active low), from
-//! the pin map. SPI mode 3 (CPOL 1, CPHA 1), 8-bit frames, MSB first, master with
+//! Pins: the board map's [`ImuPins`] (SCK, MISO, MOSI in AF5; the chip select a GPIO,
+//! active low). SPI mode 3 (CPOL 1, CPHA 1), 8-bit frames, MSB first, master with
 //! software slave management, at the fastest clock not above [`MAX_CLOCK_HZ`].
 //!
 //! Each transaction asserts the chip select, runs its operations byte by byte
@@ -19,11 +19,12 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{self, ErrorKind, ErrorType, Operation, SpiDevice};
 use stm32f4::stm32f405 as pac;
 
-use crate::clocks::{ClockGate, Clocks};
-use crate::delay::BusyDelay;
-use crate::dividers::{self, DividerError};
-use crate::gpio::{self, Pull};
-use crate::pins;
+use crate::chip::boot::Boot;
+use crate::chip::clocks::ClockGate;
+use crate::chip::delay::BusyDelay;
+use crate::chip::dividers::{self, DividerError};
+use crate::chip::gpio::{Gpio, Pull};
+use crate::chip::pins::{ImuPins, Pin};
 
 /// Highest SPI clock the ICM-42688-P takes [Hz] (datasheet: 24 MHz).
 pub const MAX_CLOCK_HZ: u32 = 24_000_000;
@@ -31,13 +32,6 @@ pub const MAX_CLOCK_HZ: u32 = 24_000_000;
 /// Status-register polls before a flag counts as never coming: a byte at the slowest
 /// configured clock (8 MHz on the HSI tree) takes 1 µs, a poll a few cycles.
 const FLAG_POLLS: u32 = 10_000;
-
-/// SPI1's registers.
-fn spi1() -> &'static pac::spi1::RegisterBlock {
-    // SAFETY: SPI1's register block is always mapped. This module is its only user, from
-    // thread mode only (the loop reads the IMU there), so no access interleaves.
-    unsafe { &*pac::SPI1::ptr() }
-}
 
 /// A transfer that did not complete.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
@@ -57,21 +51,25 @@ impl spi::Error for SpiError {
     }
 }
 
-/// SPI1 with the IMU's chip select.
+/// SPI1 with the IMU's chip select. Owns SPI1 (thread mode only: the loop reads the IMU
+/// there).
 pub struct ImuSpi {
+    spi1: pac::SPI1,
+    gpio: &'static Gpio,
+    chip_select: Pin,
     delay: BusyDelay,
 }
 
-/// Configure SPI1 and its pins; the chip select is released (high) before anything
-/// else. Returns the device and the SPI clock it runs at \[Hz\].
-pub fn init(clocks: &Clocks) -> Result<(ImuSpi, u32), DividerError> {
+/// Configure SPI1 and the board's IMU pins; the chip select is released (high) before
+/// anything else. Returns the device and the SPI clock it runs at \[Hz\].
+pub fn init(spi1: pac::SPI1, pins: ImuPins, boot: &Boot) -> Result<(ImuSpi, u32), DividerError> {
+    let clocks = boot.clocks;
     let bits = dividers::spi_baud_bits(clocks.pclk2_hz, MAX_CLOCK_HZ)?;
-    gpio::output(pins::IMU_CS, true);
-    ClockGate::Spi1.enable();
-    for pin in [pins::IMU_SCK, pins::IMU_MISO, pins::IMU_MOSI] {
-        gpio::alternate_function(pin, Pull::None);
+    boot.output(pins.cs, true);
+    boot.enable_clock(ClockGate::Spi1);
+    for pin in [pins.sck, pins.miso, pins.mosi] {
+        boot.alternate_function(pin, Pull::None);
     }
-    let spi1 = spi1();
     spi1.cr1().reset();
     spi1.cr2().reset();
     spi1.cr1().write(|w| {
@@ -87,43 +85,48 @@ pub fn init(clocks: &Clocks) -> Result<(ImuSpi, u32), DividerError> {
     });
     Ok((
         ImuSpi {
+            spi1,
+            gpio: boot.gpio,
+            chip_select: pins.cs,
             delay: BusyDelay::new(clocks.hclk_hz),
         },
         clocks.pclk2_hz >> (bits + 1),
     ))
 }
 
-/// Poll until `ready` holds, at most [`FLAG_POLLS`] times.
-fn wait_for(ready: impl Fn(&pac::spi1::sr::R) -> bool) -> Result<(), SpiError> {
-    let spi1 = spi1();
-    for _ in 0..FLAG_POLLS {
-        let status = spi1.sr().read();
-        if status.ovr().bit_is_set() {
-            // Cleared by reading DR then SR (RM0090 §28.4.8).
-            let _ = spi1.dr().read();
-            let _ = spi1.sr().read();
-            return Err(SpiError::Overrun);
+impl ImuSpi {
+    /// Poll until `ready` holds, at most [`FLAG_POLLS`] times.
+    fn wait_for(&self, ready: impl Fn(&pac::spi1::sr::R) -> bool) -> Result<(), SpiError> {
+        let spi1 = &self.spi1;
+        for _ in 0..FLAG_POLLS {
+            let status = spi1.sr().read();
+            if status.ovr().bit_is_set() {
+                // Cleared by reading DR then SR (RM0090 §28.4.8).
+                let _ = spi1.dr().read();
+                let _ = spi1.sr().read();
+                return Err(SpiError::Overrun);
+            }
+            if ready(&status) {
+                return Ok(());
+            }
         }
-        if ready(&status) {
-            return Ok(());
-        }
+        Err(SpiError::Timeout)
     }
-    Err(SpiError::Timeout)
-}
 
-/// Clock one byte out and one in.
-fn exchange(byte: u8) -> Result<u8, SpiError> {
-    let spi1 = spi1();
-    wait_for(|status| status.txe().bit_is_set())?;
-    spi1.dr().write(|w| w.dr().set(u16::from(byte)));
-    wait_for(|status| status.rxne().bit_is_set())?;
-    Ok((spi1.dr().read().dr().bits() & 0xFF) as u8)
-}
+    /// Clock one byte out and one in.
+    fn exchange(&self, byte: u8) -> Result<u8, SpiError> {
+        let spi1 = &self.spi1;
+        self.wait_for(|status| status.txe().bit_is_set())?;
+        spi1.dr().write(|w| w.dr().set(u16::from(byte)));
+        self.wait_for(|status| status.rxne().bit_is_set())?;
+        Ok((spi1.dr().read().dr().bits() & 0xFF) as u8)
+    }
 
-/// Wait until the last byte has left the shift register (BSY clear), so the chip
-/// select is not released in the middle of it.
-fn wait_idle() -> Result<(), SpiError> {
-    wait_for(|status| status.bsy().bit_is_clear())
+    /// Wait until the last byte has left the shift register (BSY clear), so the chip
+    /// select is not released in the middle of it.
+    fn wait_idle(&self) -> Result<(), SpiError> {
+        self.wait_for(|status| status.bsy().bit_is_clear())
+    }
 }
 
 impl ErrorType for ImuSpi {
@@ -132,20 +135,22 @@ impl ErrorType for ImuSpi {
 
 impl SpiDevice for ImuSpi {
     fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), SpiError> {
-        gpio::set(pins::IMU_CS, false);
+        self.gpio.set(self.chip_select, false);
+        let spi = &*self;
+        let mut delay = spi.delay;
         let result = operations
             .iter_mut()
             .try_for_each(|operation| match operation {
                 Operation::Read(buffer) => buffer.iter_mut().try_for_each(|byte| {
-                    *byte = exchange(0)?;
+                    *byte = spi.exchange(0)?;
                     Ok(())
                 }),
-                Operation::Write(bytes) => {
-                    bytes.iter().try_for_each(|&byte| exchange(byte).map(drop))
-                }
+                Operation::Write(bytes) => bytes
+                    .iter()
+                    .try_for_each(|&byte| spi.exchange(byte).map(drop)),
                 Operation::Transfer(read, write) => {
                     for i in 0..read.len().max(write.len()) {
-                        let received = exchange(write.get(i).copied().unwrap_or(0))?;
+                        let received = spi.exchange(write.get(i).copied().unwrap_or(0))?;
                         if let Some(slot) = read.get_mut(i) {
                             *slot = received;
                         }
@@ -153,16 +158,16 @@ impl SpiDevice for ImuSpi {
                     Ok(())
                 }
                 Operation::TransferInPlace(buffer) => buffer.iter_mut().try_for_each(|byte| {
-                    *byte = exchange(*byte)?;
+                    *byte = spi.exchange(*byte)?;
                     Ok(())
                 }),
                 Operation::DelayNs(ns) => {
-                    self.delay.delay_ns(*ns);
+                    delay.delay_ns(*ns);
                     Ok(())
                 }
             });
-        let idle = wait_idle();
-        gpio::set(pins::IMU_CS, true);
+        let idle = self.wait_idle();
+        self.gpio.set(self.chip_select, true);
         result.and(idle)
     }
 }

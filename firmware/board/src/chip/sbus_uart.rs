@@ -1,10 +1,10 @@
 //! USART2 RX: the SBUS receiver's bytes, into a ring the control tick empties.
 //!
-//! Pin PA3 (AF7), behind the board's inverter on the SBUS pad. SBUS is 100 000 Bd, 8 data
+//! Pin: the board map's `sbus_rx` (PA3, AF7), behind the board's inverter. SBUS is 100 000 Bd, 8 data
 //! bits, even parity, 2 stop bits: the USART runs with 9-bit words (M = 1) of which the
 //! ninth is the parity (PCE = 1, PS = 0), and STOP = 0b10.
 //!
-//! The receive interrupt (priority [`crate::nvic::PRIORITY_RECEIVER`]) moves each byte into
+//! The receive interrupt (priority [`crate::chip::nvic::PRIORITY_RECEIVER`]) moves each byte into
 //! a [`RX_CAPACITY`]-byte ring; a byte with a parity, framing or noise error is dropped
 //! and counted, since SBUS carries no checksum of its own and a frame with a damaged byte
 //! must not be decoded (the decoder resynchronises on the next frame). The control tick
@@ -20,11 +20,13 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::interrupt::{self, Mutex};
 use stm32f4::stm32f405 as pac;
 
-use crate::clocks::{ClockGate, Clocks};
-use crate::dividers::{self, DividerError};
-use crate::gpio::{self, Pull};
-use crate::nvic::{self, Irq};
-use crate::pins;
+use crate::chip::boot::Boot;
+use crate::chip::clocks::ClockGate;
+use crate::chip::dividers::{self, DividerError};
+use crate::chip::gpio::Pull;
+use crate::chip::nvic::{self, Irq};
+use crate::chip::pins::Pin;
+use crate::chip::shared::IrqShared;
 use crate::ring::ByteRing;
 
 /// SBUS line rate [Bd].
@@ -40,21 +42,15 @@ static LINE_ERRORS: AtomicU32 = AtomicU32::new(0);
 /// Bytes lost: hardware overruns and a full ring.
 static LOST: AtomicU32 = AtomicU32::new(0);
 
-/// USART2's registers.
-fn usart2() -> &'static pac::usart1::RegisterBlock {
-    // SAFETY: USART2's register block is always mapped. This module is its only user:
-    // the set-up runs in thread mode before the interrupt is unmasked, after which only
-    // the interrupt handler reads it.
-    unsafe { &*pac::USART2::ptr() }
-}
+/// USART2, once set up: after the set-up only the interrupt handler reads it.
+static USART2: IrqShared<pac::USART2> = IrqShared::new();
 
-/// Configure the pin, 100 000 Bd 8E2 (from PCLK1: USART2 is on APB1) and the receive
-/// interrupt.
-pub fn init(clocks: &Clocks) -> Result<SbusRx, DividerError> {
-    let brr = dividers::usart_brr(clocks.pclk1_hz, BAUD)?;
-    ClockGate::Usart2.enable();
-    gpio::alternate_function(pins::SBUS_RX, Pull::None);
-    let usart2 = usart2();
+/// Configure the `rx` pin, 100 000 Bd 8E2 (from PCLK1: USART2 is on APB1) and the
+/// receive interrupt.
+pub fn init(usart2: pac::USART2, rx: Pin, boot: &mut Boot) -> Result<SbusRx, DividerError> {
+    let brr = dividers::usart_brr(boot.clocks.pclk1_hz, BAUD)?;
+    boot.enable_clock(ClockGate::Usart2);
+    boot.alternate_function(rx, Pull::None);
     usart2.cr1().reset();
     usart2.brr().write(|w| {
         w.div_mantissa().set((brr >> 4) as u16);
@@ -70,29 +66,34 @@ pub fn init(clocks: &Clocks) -> Result<SbusRx, DividerError> {
         w.rxneie().set_bit();
         w.ue().set_bit()
     });
-    nvic::enable(Irq::Usart2);
+    interrupt::free(|cs| USART2.put(cs, usart2));
+    boot.enable_interrupt(Irq::Usart2);
     Ok(SbusRx { _owned: () })
 }
 
 /// USART2 interrupt: move the received byte into the ring, or count why not.
 pub fn on_interrupt() {
-    // Reading SR then DR clears RXNE and the error flags (ORE, NE, FE, PE).
-    let usart2 = usart2();
-    let status = usart2.sr().read();
-    if status.rxne().bit_is_clear() && status.ore().bit_is_clear() {
-        return;
-    }
-    let byte = (usart2.dr().read().dr().bits() & 0xFF) as u8;
-    if status.ore().bit_is_set() {
-        LOST.fetch_add(1, Ordering::Relaxed);
-    }
-    if status.pe().bit_is_set() || status.fe().bit_is_set() || status.nf().bit_is_set() {
-        LINE_ERRORS.fetch_add(1, Ordering::Relaxed);
-        return;
-    }
-    if !interrupt::free(|cs| RX.borrow(cs).borrow_mut().push(byte)) {
-        LOST.fetch_add(1, Ordering::Relaxed);
-    }
+    interrupt::free(|cs| {
+        let Some(usart2) = USART2.get(cs) else {
+            return;
+        };
+        // Reading SR then DR clears RXNE and the error flags (ORE, NE, FE, PE).
+        let status = usart2.sr().read();
+        if status.rxne().bit_is_clear() && status.ore().bit_is_clear() {
+            return;
+        }
+        let byte = (usart2.dr().read().dr().bits() & 0xFF) as u8;
+        if status.ore().bit_is_set() {
+            LOST.fetch_add(1, Ordering::Relaxed);
+        }
+        if status.pe().bit_is_set() || status.fe().bit_is_set() || status.nf().bit_is_set() {
+            LINE_ERRORS.fetch_add(1, Ordering::Relaxed);
+            return;
+        }
+        if !RX.borrow(cs).borrow_mut().push(byte) {
+            LOST.fetch_add(1, Ordering::Relaxed);
+        }
+    });
 }
 
 /// The receiver's byte stream.

@@ -1,7 +1,7 @@
 //! The fixed-rate tick: TIM5 update interrupt at the loop rate.
 //!
 //! TIM5 is 32-bit, so it runs with prescaler 0 and an auto-reload computed from its
-//! actual kernel clock ([`crate::clocks::Clocks::apb1_timer_hz`]). The interrupt handler
+//! actual kernel clock ([`crate::chip::clocks::Clocks::apb1_timer_hz`]). The interrupt handler
 //! only counts; the flight logic runs in thread mode and takes the count with
 //! [`take_due`], so an overrun (a tick that took longer than the period) shows up as a
 //! count above one instead of nested or lost interrupts.
@@ -10,21 +10,17 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use stm32f4::stm32f405 as pac;
 
-use crate::clocks::{ClockGate, Clocks};
-use crate::dividers::{self, DividerError};
-use crate::nvic::{self, Irq};
+use crate::chip::boot::Boot;
+use crate::chip::clocks::ClockGate;
+use crate::chip::dividers::{self, DividerError};
+use crate::chip::nvic::Irq;
+use crate::chip::shared::IrqShared;
 
 /// Ticks signalled by the timer and not yet taken by the loop.
 static DUE: AtomicU32 = AtomicU32::new(0);
 
-/// TIM5's registers.
-fn tim5() -> &'static pac::tim5::RegisterBlock {
-    // SAFETY: TIM5's register block is always mapped. This module is its only user: the
-    // set-up writes run in thread mode before its interrupt is unmasked, after which
-    // only the interrupt handler touches it (whole-register writes, no read-modify-write
-    // shared with other code).
-    unsafe { &*pac::TIM5::ptr() }
-}
+/// TIM5, once started: after the set-up only the interrupt handler touches it.
+static TIM5: IrqShared<pac::TIM5> = IrqShared::new();
 
 /// The running tick timer.
 pub struct Ticker {
@@ -34,10 +30,10 @@ pub struct Ticker {
 
 impl Ticker {
     /// Start TIM5 at `rate_hz` from its kernel clock and enable its interrupt.
-    pub fn start(clocks: &Clocks, rate_hz: u32) -> Result<Ticker, DividerError> {
-        let reload = dividers::tick_reload(clocks.apb1_timer_hz, rate_hz)?;
-        ClockGate::Tim5.enable();
-        let tim5 = tim5();
+    pub fn start(tim5: pac::TIM5, boot: &mut Boot, rate_hz: u32) -> Result<Ticker, DividerError> {
+        let timer_hz = boot.clocks.apb1_timer_hz;
+        let reload = dividers::tick_reload(timer_hz, rate_hz)?;
+        boot.enable_clock(ClockGate::Tim5);
         // Out of reset PSC = 0 (also in the shadow register) and ARR preload is off, so
         // no update event (EGR.UG) is needed: the ARR write takes effect at once.
         // Written in this order for QEMU's TIM2..TIM5 model, which arms its alarm on the ARR
@@ -50,9 +46,10 @@ impl Ticker {
         // URS: only counter overflow raises the update interrupt.
         tim5.cr1().write(|w| w.urs().set_bit().cen().set_bit());
         tim5.arr().write(|w| w.arr().set(reload));
-        nvic::enable(Irq::Tim5);
+        cortex_m::interrupt::free(|cs| TIM5.put(cs, tim5));
+        boot.enable_interrupt(Irq::Tim5);
         Ok(Ticker {
-            achieved_millihz: dividers::achieved_rate_millihz(clocks.apb1_timer_hz, reload),
+            achieved_millihz: dividers::achieved_rate_millihz(timer_hz, reload),
         })
     }
 
@@ -69,10 +66,14 @@ impl Ticker {
 
 /// TIM5 interrupt: acknowledge the update and count it.
 pub fn on_interrupt() {
-    let tim5 = tim5();
-    if tim5.sr().read().uif().bit_is_set() {
-        // rc_w0: the PAC writes 1 to the other flags (no effect) and 0 to UIF.
-        tim5.sr().write(|w| w.uif().clear());
-        DUE.fetch_add(1, Ordering::AcqRel);
-    }
+    cortex_m::interrupt::free(|cs| {
+        let Some(tim5) = TIM5.get(cs) else {
+            return;
+        };
+        if tim5.sr().read().uif().bit_is_set() {
+            // rc_w0: the PAC writes 1 to the other flags (no effect) and 0 to UIF.
+            tim5.sr().write(|w| w.uif().clear());
+            DUE.fetch_add(1, Ordering::AcqRel);
+        }
+    });
 }

@@ -6,7 +6,8 @@
 //! started on and the reason is recorded in [`Clocks::source`]. Every divider in the image
 //! (tick timer, servo PWM, baud rate) is computed from the [`Clocks`] returned here.
 //!
-//! Board clock tree with the crystal (RM0090 §6.2, Fig. 21), HSE = [`HSE_HZ`]:
+//! Clock tree with the board's crystal (RM0090 §6.2, Fig. 21), HSE = the board map's
+//! [`Crystal`] (8 MHz on every board of the list; PLLM = HSE / 2 MHz):
 //!
 //! ```text
 //! f_VCO_in = HSE / PLLM = 2 MHz          (1–2 MHz; 2 MHz gives the lowest PLL jitter)
@@ -23,25 +24,7 @@
 
 use stm32f4::stm32f405 as pac;
 
-/// The reset and clock control's registers.
-fn rcc() -> &'static pac::rcc::RegisterBlock {
-    // SAFETY: the RCC register block is always mapped. This module is its only user;
-    // the clock-enable read-modify-writes run in thread mode at boot, before any
-    // interrupt that could touch the RCC is enabled (none does).
-    unsafe { &*pac::RCC::ptr() }
-}
-
-/// The flash interface's registers (wait states).
-fn flash() -> &'static pac::flash::RegisterBlock {
-    // SAFETY: always mapped; only the clock set-up below writes the access control
-    // register, once, at boot.
-    unsafe { &*pac::FLASH::ptr() }
-}
-
-/// Frequency of the board's crystal [Hz]. 8 MHz is what STM32F405 flight-controller
-/// boards and the STM32F4 Discovery carry; change it (it must be a multiple of 2 MHz)
-/// for another crystal.
-pub const HSE_HZ: u32 = 8_000_000;
+use crate::chip::pins::Crystal;
 
 /// The internal RC oscillator every STM32F4 starts on [Hz].
 pub const HSI_HZ: u32 = 16_000_000;
@@ -58,8 +41,8 @@ const READY_POLLS: u32 = 100_000;
 /// 1 GHz whatever the (absent) RCC says. Used only when the RCC reads back all zeros.
 pub const EMULATED_TIMER_HZ: u32 = 1_000_000_000;
 
-// RCC_PLLCFGR fields (RM0090 §7.3.2): VCO input 2 MHz, VCO 336 MHz, SYSCLK /2, 48 MHz /7.
-const PLLM: u8 = (HSE_HZ / 2_000_000) as u8;
+// RCC_PLLCFGR fields (RM0090 §7.3.2): VCO 336 MHz, SYSCLK /2, 48 MHz /7 (PLLM, the
+// VCO input divider, is the crystal's: `Crystal::pll_m`).
 const PLLN: u16 = 168;
 const PLLQ: u8 = 7;
 
@@ -135,9 +118,21 @@ fn wait_for(mut ready: impl FnMut() -> bool) -> bool {
     (0..READY_POLLS).any(|_| ready())
 }
 
-/// Bring up the clock tree (see the module documentation) and report what it is.
-pub fn init() -> Clocks {
-    let rcc = rcc();
+/// The RCC after the clock set-up: what switches the peripherals' clocks on.
+pub struct ClockGates {
+    rcc: pac::RCC,
+}
+
+/// Bring up the clock tree (see the module documentation) with the board's `crystal` and
+/// report what it is. Takes the RCC and the flash interface (wait states) for good; the
+/// RCC comes back as the [`ClockGates`] the drivers' set-up uses.
+pub fn init(rcc: pac::RCC, flash: pac::FLASH, crystal: Crystal) -> (Clocks, ClockGates) {
+    let clocks = configure(&rcc, &flash, crystal);
+    (clocks, ClockGates { rcc })
+}
+
+fn configure(rcc: &pac::RCC, flash: &pac::FLASH, crystal: Crystal) -> Clocks {
+    let pllm = crystal.pll_m();
     if rcc.cr().read().hsirdy().bit_is_clear() {
         // Out of reset a real STM32F4 runs on HSI with HSION and HSIRDY set.
         return Clocks {
@@ -155,10 +150,11 @@ pub fn init() -> Clocks {
     // The PLL may only be configured while it is off (it is, out of reset). Reserved
     // bits keep their reset values.
     rcc.pllcfgr().modify(|_, w| {
-        // SAFETY: PLLM = 4 (2..=63), PLLN = 168 (50..=432), PLLQ = 7 (2..=15): values
-        // RM0090 §7.3.2 allows, giving the frequencies of the module documentation.
+        // SAFETY: PLLM = HSE / 2 MHz, 2..=13 for the crystals `Crystal::hz` accepts
+        // (2..=63 allowed), PLLN = 168 (50..=432), PLLQ = 7 (2..=15): values RM0090
+        // §7.3.2 allows, giving the frequencies of the module documentation.
         unsafe {
-            w.pllm().bits(PLLM);
+            w.pllm().bits(pllm);
             w.plln().bits(PLLN);
             w.pllq().bits(PLLQ);
         }
@@ -174,7 +170,6 @@ pub fn init() -> Clocks {
 
     // Wait states before the clock goes up (5 at 168 MHz and 2.7–3.6 V, RM0090 Table
     // 10); read back so the new latency is in effect.
-    let flash = flash();
     flash.acr().write(|w| {
         w.latency().ws5();
         w.prften().set_bit();
@@ -207,6 +202,8 @@ pub fn init() -> Clocks {
 /// A peripheral's clock-enable bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ClockGate {
+    /// TIM1 (APB2ENR.TIM1EN).
+    Tim1,
     /// GPIO port A (AHB1ENR.GPIOAEN).
     GpioA,
     /// GPIO port B (AHB1ENR.GPIOBEN).
@@ -233,12 +230,13 @@ pub enum ClockGate {
     Spi1,
 }
 
-impl ClockGate {
-    /// Turn the clock on, then read the register back: RM0090 §7.3 asks for two bus
+impl ClockGates {
+    /// Turn `gate`'s clock on, then read the register back: RM0090 §7.3 asks for two bus
     /// cycles between the enable and the first access to the peripheral.
-    pub fn enable(self) {
-        let rcc = rcc();
-        match self {
+    pub fn enable(&self, gate: ClockGate) {
+        let rcc = &self.rcc;
+        match gate {
+            ClockGate::Tim1 => rcc.apb2enr().modify(|_, w| w.tim1en().set_bit()),
             ClockGate::GpioA => rcc.ahb1enr().modify(|_, w| w.gpioaen().set_bit()),
             ClockGate::GpioB => rcc.ahb1enr().modify(|_, w| w.gpioben().set_bit()),
             ClockGate::GpioC => rcc.ahb1enr().modify(|_, w| w.gpiocen().set_bit()),

@@ -29,27 +29,25 @@ use stm32f4::stm32f405 as pac;
 /// IWDG reload value (12 bits): 1000 counts of LSI / 64.
 const RELOAD: u16 = 1000;
 
-/// The IWDG's registers.
-fn iwdg() -> &'static pac::iwdg::RegisterBlock {
-    // SAFETY: the IWDG register block is always mapped; this module is its only user,
-    // from thread mode only.
-    unsafe { &*pac::IWDG::ptr() }
-}
-
-/// The watchdog: not started until the first fresh sample.
+/// The watchdog: not started until the first fresh sample. Owns the IWDG (thread mode
+/// only).
 pub struct Watchdog {
+    iwdg: pac::IWDG,
     started: bool,
 }
 
 impl Watchdog {
     /// A watchdog that has not started.
-    pub const fn new() -> Self {
-        Watchdog { started: false }
+    pub fn new(iwdg: pac::IWDG) -> Self {
+        Watchdog {
+            iwdg,
+            started: false,
+        }
     }
 
     /// A fresh sample was processed: start the watchdog (the first time) or feed it.
     pub fn fed_by_fresh_sample(&mut self) {
-        let iwdg = iwdg();
+        let iwdg = &self.iwdg;
         if !self.started {
             self.started = true;
             // Start first (the LSI comes up with it), then unlock and set the prescaler
@@ -67,7 +65,7 @@ impl Watchdog {
     /// start it: only a fresh sample does).
     pub fn fed_by_failsafe_tick(&mut self) {
         if self.started {
-            iwdg().kr().write(|w| w.key().feed());
+            self.iwdg.kr().write(|w| w.key().feed());
         }
     }
 }

@@ -54,21 +54,34 @@ impl Irq {
     }
 }
 
-/// Set `irq`'s priority, then unmask it in the NVIC.
-pub fn enable(irq: Irq) {
-    // SAFETY: the image uses no priority-based critical sections (its critical sections
-    // mask every interrupt), so a priority change cannot break one; the NVIC's
-    // priority registers are written by this function only, from thread mode at boot.
-    unsafe {
-        let mut core = cortex_m::Peripherals::steal();
-        core.NVIC.set_priority(irq.interrupt(), irq.priority());
-        // SAFETY: as above: unmasking cannot break a mask-based critical section, and
-        // the handler of each unmasked interrupt exists (named vectors in main.rs).
-        NVIC::unmask(irq.interrupt());
+/// The NVIC, taken once with the core's peripherals: what unmasks the image's
+/// interrupts at boot.
+pub struct Nvic(NVIC);
+
+impl Nvic {
+    /// The core's NVIC, handed over by `cortex_m::Peripherals::take`.
+    pub fn new(nvic: NVIC) -> Self {
+        Nvic(nvic)
+    }
+
+    /// Set `irq`'s priority, then unmask it in the NVIC.
+    pub fn enable(&mut self, irq: Irq) {
+        // SAFETY: the image uses no priority-based critical sections (its critical
+        // sections mask every interrupt), so a priority change cannot break one; the
+        // NVIC's priority registers are written through this owned NVIC only, from
+        // thread mode at boot.
+        unsafe {
+            self.0.set_priority(irq.interrupt(), irq.priority());
+            // SAFETY: as above: unmasking cannot break a mask-based critical section,
+            // and the handler of each unmasked interrupt exists (named vectors in
+            // main.rs).
+            NVIC::unmask(irq.interrupt());
+        }
     }
 }
 
-/// Mask `irq` in the NVIC.
+/// Mask `irq` in the NVIC. Any context may: masking is one write of a write-1-to-clear
+/// register (and `cortex_m` makes it safe).
 pub fn disable(irq: Irq) {
     NVIC::mask(irq.interrupt());
 }

@@ -24,8 +24,8 @@ use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 use cortex_m::interrupt::{self, Mutex};
 use rtt_target::{rtt_init, ChannelMode, UpChannel};
 
+use crate::image::semihosting;
 use crate::ring::ByteRing;
-use crate::semihosting;
 
 /// Where frames go besides RTT.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -5,7 +5,7 @@
 //! call: SYS_READ on a host FIFO gets the SensorIn, SYS_WRITE sends the tick's frames.
 //!
 //! Selected at run time, never on a board: the image must be in QEMU (the RCC reads back
-//! as zeros, [`ClockSource::NoRcc`](crate::clocks::ClockSource::NoRcc), which no STM32F4
+//! as zeros, [`ClockSource::NoRcc`](crate::chip::clocks::ClockSource::NoRcc), which no STM32F4
 //! does) *and* the host must have put the [`MAILBOX`] words into RAM before boot
 //! (`-device loader,addr=0x20010000,data=0x53485354,data-len=4` and the complement at
 //! 0x20010004). Without `-semihosting` a `BKPT` would be a HardFault, hence the

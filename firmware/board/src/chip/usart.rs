@@ -1,6 +1,6 @@
 //! USART1: the telemetry and in-the-loop link, interrupt-driven, with byte rings.
 //!
-//! Pins PA9 (TX) / PA10 (RX), alternate function 7; 8N1 at [`BAUD`], no flow control.
+//! Pins: the board map's `link_tx` / `link_rx` (alternate function 7); 8N1 at [`BAUD`], no flow control.
 //! The transmitter side is an [`embedded_io::Write`] ([`UsartTx`]) plus an
 //! all-or-nothing [`UsartTx::queue_frame`] for whole frames; the receiver side is an
 //! [`embedded_io::Read`] + [`embedded_io::ReadReady`] ([`UsartRx`]).
@@ -17,24 +17,23 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use sweephold_protocol::{encode, Frame, MAX_FRAME_LEN};
 
-use crate::ring::ByteRing;
 use cortex_m::interrupt::{self, CriticalSection, Mutex};
-
-use crate::clocks::{ClockGate, Clocks};
-use crate::dividers::{self, DividerError};
-use crate::gpio::{self, Pull};
-use crate::logport;
-use crate::nvic::{self, Irq};
-use crate::pins;
 use stm32f4::stm32f405 as pac;
 
-/// USART1's registers.
-fn usart1() -> &'static pac::usart1::RegisterBlock {
-    // SAFETY: USART1's register block is always mapped. This module is its only user;
-    // the one read-modify-write (CR1's TXEIE in `pump`) runs inside a critical section,
-    // so the interrupt handler cannot interleave with it.
-    unsafe { &*pac::USART1::ptr() }
-}
+use crate::chip::boot::Boot;
+use crate::chip::clocks::ClockGate;
+use crate::chip::dividers::{self, DividerError};
+use crate::chip::gpio::Pull;
+use crate::chip::logport;
+use crate::chip::nvic::{self, Irq};
+use crate::chip::pins::Pin;
+use crate::chip::shared::IrqShared;
+use crate::ring::ByteRing;
+
+/// USART1, once set up: reached inside a critical section by thread mode (queuing,
+/// `flush`) and by the interrupt handler, so the one read-modify-write (CR1's TXEIE in
+/// `pump`) never interleaves.
+static USART1: IrqShared<pac::USART1> = IrqShared::new();
 
 /// Line rate [Bd]. A 200 Hz loop in the loop with a host sends a Sample (~130 bytes on
 /// the wire) and an ActuatorOut (~35) per tick: 33 kB/s, 72 % of the 46 kB/s that
@@ -55,13 +54,17 @@ static RX: Mutex<RefCell<ByteRing<RX_CAPACITY>>> = Mutex::new(RefCell::new(ByteR
 /// Received bytes lost: hardware overruns plus bytes that found the ring full.
 static RX_LOST: AtomicU32 = AtomicU32::new(0);
 
-/// Configure pins, baud rate and interrupts; returns the two halves of the link.
-pub fn init(clocks: &Clocks) -> Result<(UsartTx, UsartRx), DividerError> {
-    let brr = dividers::usart_brr(clocks.pclk2_hz, BAUD)?;
-    ClockGate::Usart1.enable();
-    let usart1 = usart1();
-    gpio::alternate_function(pins::LINK_TX, Pull::None);
-    gpio::alternate_function(pins::LINK_RX, Pull::Up);
+/// Configure USART1 on the board's `tx` / `rx` pins (baud rate, interrupts); returns the
+/// two halves of the link.
+pub fn init(
+    usart1: pac::USART1,
+    (tx, rx): (Pin, Pin),
+    boot: &mut Boot,
+) -> Result<(UsartTx, UsartRx), DividerError> {
+    let brr = dividers::usart_brr(boot.clocks.pclk2_hz, BAUD)?;
+    boot.enable_clock(ClockGate::Usart1);
+    boot.alternate_function(tx, Pull::None);
+    boot.alternate_function(rx, Pull::Up);
     usart1.cr1().reset();
     // BRR is 16 bits wide (`usart_brr` checks the range): mantissa and fraction.
     usart1.brr().write(|w| {
@@ -80,7 +83,8 @@ pub fn init(clocks: &Clocks) -> Result<(UsartTx, UsartRx), DividerError> {
             .rxneie()
             .set_bit()
     });
-    nvic::enable(Irq::Usart1);
+    interrupt::free(|cs| USART1.put(cs, usart1));
+    boot.enable_interrupt(Irq::Usart1);
     Ok((
         UsartTx {
             dropped_frames: 0,
@@ -96,7 +100,9 @@ fn pump(cs: &CriticalSection) {
     if CAPTURED.load(Ordering::Relaxed) {
         return;
     }
-    let usart1 = usart1();
+    let Some(usart1) = USART1.get(cs) else {
+        return;
+    };
     let mut ring = TX.borrow(cs).borrow_mut();
     while usart1.sr().read().txe().bit_is_set() {
         match ring.pop() {
@@ -111,7 +117,7 @@ fn pump(cs: &CriticalSection) {
 }
 
 /// Set when the frames leave through semihosting instead of the pin (QEMU only, see
-/// [`crate::semihosting`]): the transmit ring then keeps what is queued until
+/// `crate::image::semihosting`): the transmit ring then keeps what is queued until
 /// [`take_captured`] empties it.
 static CAPTURED: AtomicBool = AtomicBool::new(false);
 
@@ -127,20 +133,23 @@ pub fn take_captured(buf: &mut [u8]) -> usize {
 
 /// USART1 interrupt: move a received byte into the ring, feed the transmitter.
 pub fn on_interrupt() {
-    // Reading SR then DR clears RXNE and the error flags (ORE, NE, FE).
-    let usart1 = usart1();
-    let status = usart1.sr().read();
-    if status.rxne().bit_is_set() || status.ore().bit_is_set() {
-        let byte = (usart1.dr().read().dr().bits() & 0xFF) as u8;
-        if status.ore().bit_is_set() {
-            RX_LOST.fetch_add(1, Ordering::Relaxed);
+    interrupt::free(|cs| {
+        let Some(usart1) = USART1.get(cs) else {
+            return;
+        };
+        // Reading SR then DR clears RXNE and the error flags (ORE, NE, FE).
+        let status = usart1.sr().read();
+        if status.rxne().bit_is_set() || status.ore().bit_is_set() {
+            let byte = (usart1.dr().read().dr().bits() & 0xFF) as u8;
+            if status.ore().bit_is_set() {
+                RX_LOST.fetch_add(1, Ordering::Relaxed);
+            }
+            if !RX.borrow(cs).borrow_mut().push(byte) {
+                RX_LOST.fetch_add(1, Ordering::Relaxed);
+            }
         }
-        let pushed = interrupt::free(|cs| RX.borrow(cs).borrow_mut().push(byte));
-        if !pushed {
-            RX_LOST.fetch_add(1, Ordering::Relaxed);
-        }
-    }
-    interrupt::free(pump);
+        pump(cs);
+    });
 }
 
 /// Received bytes lost so far (overruns and ring overflows).
@@ -229,11 +238,14 @@ impl embedded_io::Write for UsartTx {
     /// Wait until the ring is empty and the last stop bit has left the pin.
     fn flush(&mut self) -> Result<(), Infallible> {
         loop {
-            let empty = interrupt::free(|cs| {
+            let done = interrupt::free(|cs| {
                 pump(cs);
                 TX.borrow(cs).borrow().is_empty()
+                    && USART1
+                        .get(cs)
+                        .is_some_and(|usart1| usart1.sr().read().tc().bit_is_set())
             });
-            if empty && usart1().sr().read().tc().bit_is_set() {
+            if done {
                 return Ok(());
             }
         }

@@ -1,0 +1,28 @@
+//! The board list: one folder per flight controller, each with its pin map and crystal
+//! (`mod.rs`, a [`BoardMap`]) and its memory layout (`memory.x`, which `build.rs` hands
+//! to the linker), and the choice of the board the image is built for.
+//!
+//! A board is selected by the cargo feature `board-<folder with dashes>`; without one,
+//! the image is for the default board, the SpeedyBee F405 V4. Two board features at once
+//! stop the build.
+//!
+//! Adding a board: a folder here with `mod.rs` and `memory.x`, its line in this list and
+//! in `ALL`, and its feature in `Cargo.toml`. Nothing else changes as long as the board
+//! is an STM32F405 with the host link on USART1, SBUS on USART2, the log on USART3 and
+//! an ICM-42688-P on SPI1 (see [`BoardMap`]).
+//!
+//! **What it may import.** The chip layer's map types (`crate::chip::pins`) only.
+
+pub use crate::chip::pins::BoardMap;
+
+pub mod speedybee_f405_v4;
+
+/// The board the image is built for (the default).
+pub const BOARD: BoardMap = speedybee_f405_v4::BOARD;
+
+/// Every board of the list (for the tests of their maps).
+#[cfg(test)]
+pub const ALL: [BoardMap; 1] = [speedybee_f405_v4::BOARD];
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,15 @@
+//! The image logic, the same on every board: the boot and the control loop
+//! ([`runner`]: what the flight controller does each tick in either run mode), the frame
+//! link to the host ([`link`]), the QEMU-only semihosting transport ([`semihosting`]),
+//! the defmt logger ([`log`]) and the flight configuration the image is built with
+//! ([`config`]).
+//!
+//! **What it may import.** The flight logic (`sweephold-firmware`), the wire protocol,
+//! the chip layer (`crate::chip`: drivers, taken and set up by `chip::devices`) and the
+//! selected board's map (`crate::boards::BOARD`); never the PAC directly.
+
+pub mod config;
+pub mod link;
+pub mod log;
+pub mod runner;
+pub mod semihosting;
