@@ -1,6 +1,6 @@
 //! `sweephold fly --fc serial:PATH`: a pseudo-terminal stands in for the board's serial
 //! port. A thread on the master side plays the board with the firmware library, as the
-//! board image does (`firmware/board/src/runner.rs`): a Configure builds the vehicle's
+//! board image does (`firmware/board/src/image/runner.rs`): a Configure builds the vehicle's
 //! preset with the received rate and test and is answered by Header + ConfigureResult;
 //! each SensorIn steps the flight logic, whose Events and Sample go out, then the
 //! ActuatorOut answering its `seq`. The host opens the slave side as the board's tty.
