@@ -136,6 +136,7 @@ impl ErrorType for ImuSpi {
 impl SpiDevice for ImuSpi {
     fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), SpiError> {
         self.gpio.set(self.chip_select, false);
+        // The operations borrow the bus through `spi`; the delay is a copy (a clock rate).
         let spi = &*self;
         let mut delay = spi.delay;
         let result = operations

@@ -207,7 +207,7 @@ impl Runner {
             self.host_ignored_reported = false;
         }
         if out.mode == AppMode::ImuFailsafe {
-            // The IMU is gone and the failsafe flies without it: see `crate::watchdog`.
+            // The IMU is gone and the failsafe flies without it: see `crate::chip::watchdog`.
             self.watchdog.fed_by_failsafe_tick();
         }
         if let Some(reason) = out.abort {
