@@ -1,5 +1,11 @@
-//! Put the selected board's `memory.x` (`src/boards/<board>/memory.x`) where the linker
-//! (cortex-m-rt's `link.x`) finds it.
+//! Hand the linker (cortex-m-rt's `link.x`) the workspace's `memory.x`, and check the
+//! board choice.
+//!
+//! `memory.x` is the chip's memory layout: every board of the image is an STM32F405RG, so
+//! the layout is one file at the workspace root, not one per board folder (the linker
+//! also looks in the working directory, the workspace root, first: a copy per board
+//! would be shadowed by a root file anyway). A board on another chip would be another
+//! image.
 //!
 //! The board is the one whose folder matches an enabled `board-<folder with dashes>`
 //! feature (cargo sets `CARGO_FEATURE_BOARD_<FOLDER IN CAPITALS>`), else the default
@@ -7,33 +13,26 @@
 //! here.
 use std::{env, fs, path::PathBuf};
 
-/// The board without a `board-*` feature.
-const DEFAULT_BOARD: &str = "speedybee_f405_v4";
-
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    let boards = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"))
-        .join("src")
-        .join("boards");
-    let mut folders: Vec<String> = fs::read_dir(&boards)
+    let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
+    let boards = manifest.join("src").join("boards");
+    let folders: Vec<String> = fs::read_dir(&boards)
         .expect("src/boards is readable")
         .filter_map(|entry| entry.ok())
         .filter(|entry| entry.path().is_dir())
         .filter_map(|entry| entry.file_name().into_string().ok())
         .collect();
-    folders.sort();
     let selected: Vec<&String> = folders
         .iter()
         .filter(|folder| {
             env::var_os(format!("CARGO_FEATURE_BOARD_{}", folder.to_uppercase())).is_some()
         })
         .collect();
-    let board = match selected.as_slice() {
-        [] => DEFAULT_BOARD,
-        [one] => one.as_str(),
-        many => panic!("more than one board feature: {many:?}"),
-    };
-    let memory = boards.join(board).join("memory.x");
+    if selected.len() > 1 {
+        panic!("more than one board feature: {selected:?}");
+    }
+    let memory = manifest.join("../../memory.x");
     fs::copy(&memory, out.join("memory.x"))
         .unwrap_or_else(|e| panic!("copy {} into OUT_DIR: {e}", memory.display()));
     println!("cargo:rustc-link-search={}", out.display());

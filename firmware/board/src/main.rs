@@ -9,7 +9,7 @@
 //!   around [`sweephold_firmware::FlightController`] and the board application;
 //! - `chip/`: the STM32F405 drivers on the `stm32f4` peripheral access crate, which take
 //!   the peripherals once (`chip::devices`) and their pins from a board map;
-//! - `boards/`: one folder per board (its pin map, crystal and `memory.x`) and the choice
+//! - `boards/`: one folder per board (its pin map and crystal) and the choice
 //!   of the board the image is built for.
 //!
 //! `ring` is the byte ring the drivers and the logger share. On the host this is an

@@ -1,12 +1,12 @@
 //! The board list: one folder per flight controller, each with its pin map and crystal
-//! (`mod.rs`, a [`BoardMap`]) and its memory layout (`memory.x`, which `build.rs` hands
-//! to the linker), and the choice of the board the image is built for.
+//! (`mod.rs`, a [`BoardMap`]), and the choice of the board the image is built for. The
+//! memory layout is the chip's, shared by every board: the workspace's `memory.x`.
 //!
 //! A board is selected by the cargo feature `board-<folder with dashes>`
 //! (`cargo fw --features board-matek-f405-te`); without one, the image is for the
 //! default board, the SpeedyBee F405 V4. Two board features at once stop the build.
 //!
-//! Adding a board: a folder here with `mod.rs` and `memory.x`, its line in this list and
+//! Adding a board: a folder here with `mod.rs`, its line in this list and
 //! in `ALL`, and its feature in `Cargo.toml`. Nothing else changes as long as the board
 //! is an STM32F405 with the host link on USART1, SBUS on USART2, the log on USART3 and
 //! an ICM-42688-P on SPI1 (see [`BoardMap`]).

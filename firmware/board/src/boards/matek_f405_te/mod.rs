@@ -1,8 +1,8 @@
 //! Matek F405-TE (STM32F405RGT6, ICM-42688-P on SPI1, 8 MHz HSE) flying a TREX 700L:
 //! the second board of the image (`cargo fw --features board-matek-f405-te`). Every pin,
-//! alternate function and timer channel the image uses on it is named here; `memory.x`
-//! next to this file is its memory layout. Where the map comes from and what is still to
-//! be checked on a real board: `README.md` in this folder.
+//! alternate function and timer channel the image uses on it is named here (its memory
+//! layout is the chip's: the workspace's `memory.x`). Where the map comes from and what
+//! is still to be checked on a real board: `README.md` in this folder.
 //!
 //! | function                 | peripheral     | pin(s)            | pad on the board |
 //! |--------------------------|----------------|-------------------|------------------|

@@ -1,7 +1,7 @@
 //! SpeedyBee F405 V4 (STM32F405RGT6, ICM-42688-P on SPI1, 8 MHz
 //! HSE) flying a TREX 700L: the default board of the image. Every pin, alternate function
-//! and timer channel the image uses on it is named here and nowhere else; `memory.x` next
-//! to this file is its memory layout.
+//! and timer channel the image uses on it is named here and nowhere else (its memory
+//! layout is the chip's: the workspace's `memory.x`).
 //!
 //! Taken from the board's published Betaflight target (`configs/SPEEDYBEEF405V4`):
 //!
