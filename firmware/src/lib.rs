@@ -3,7 +3,7 @@
 //! The host-testable, `no_std`, allocation-free flight logic of the sweephold flight
 //! controller: Tischler's exponential frequency sweep (and doublet / 3-2-1-1 inputs)
 //! flown under the *conditional attitude hold* of Jung, Shim & Kim, with off-axis noise,
-//! abort safety, CCPM-120 mixing and postcard telemetry.
+//! abort safety, swashplate mixing (120°, 135°, 140° CCPM, H1) and postcard telemetry.
 //!
 //! The entry point is [`FlightController`]: build it from a [`Config`] (presets
 //! [`Config::bo105_default`] and [`Config::trex700l_default`]), then call
@@ -40,7 +40,8 @@
 //! adaptive sweep amplitude), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`slew`] (the commands' slew
-//! limit), [`mixer`] (CCPM-120),
+//! limit), [`mixer`] (swash and tail mixing), [`swash`] (the swash types, phase angle
+//! and cyclic ring),
 //! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); for the
 //! board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot calibration
 //! and, on the host, a register-level emulator of the chip), [`receiver`] (SBUS decoding,
@@ -86,6 +87,7 @@ pub mod receiver;
 pub mod safety;
 pub mod sink;
 pub mod slew;
+pub mod swash;
 pub mod sweep;
 pub mod trim;
 pub mod turns;
