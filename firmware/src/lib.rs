@@ -29,7 +29,8 @@
 //!
 //! **What it may import.** Of the workspace, only the wire protocol
 //! (`sweephold-protocol`); otherwise `no_std` crates that allocate nothing (heapless,
-//! libm, micromath, embedded-hal, embedded-io, rand_pcg, defmt). It never imports the
+//! libm, micromath, embedded-hal, embedded-io, rand_pcg, defmt, and for the parameter
+//! store sequential-storage, embedded-storage and embassy-futures). It never imports the
 //! host crates: they drive it (in-process, in QEMU or over a serial port).
 //!
 //! Modules, one concept each: [`sweep`] (the sweep, its closed-form phase and its
@@ -50,7 +51,8 @@
 //! stabilised pilot mode, failsafes and the throttle around the sequencer); and
 //! [`board_stack`] (all of these wired together: the IMU polled at 1 kHz through the
 //! monitor, calibration, filters and estimator, the receiver bytes through the SBUS
-//! decoder and channel map, and the application's control tick).
+//! decoder and channel map, and the application's control tick); [`params`] (the
+//! board's parameter table, its typed view and its flash store).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -82,6 +84,7 @@ pub mod hold;
 pub mod imu;
 pub mod mixer;
 pub mod noise;
+pub mod params;
 pub mod pulse;
 pub mod receiver;
 pub mod safety;
