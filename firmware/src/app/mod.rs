@@ -10,6 +10,8 @@
 //!   transition rule;
 //! * [`pilot_mode`]: the stabilised pilot mode's rate loops and heading hold;
 //! * [`arming`]: pre-arm and test-entry checks, switch edges;
+//! * [`param_link`]: the host's parameter requests (list, get, set, save, reset),
+//!   obeyed only while disarmed;
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
 //! * [`throttle`]: the ESC channel and its soft start;
 //! * [`inputs`]: the input types;
@@ -55,6 +57,7 @@ pub mod failsafe;
 pub mod inputs;
 pub mod modes;
 pub mod outputs;
+pub mod param_link;
 pub mod pilot_mode;
 pub mod reporting;
 pub mod throttle;
@@ -246,6 +249,8 @@ pub struct BoardApp {
     imu_trim: [f32; 3],
     /// What the board events last reported.
     reporter: Reporter,
+    /// A valid parameter set is in use ([`BoardApp::set_params_valid`]).
+    params_valid: bool,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -292,6 +297,7 @@ impl BoardApp {
             stick_reference: StickMean::default(),
             imu_trim: [0.0; 3],
             reporter: Reporter::default(),
+            params_valid: true,
             fc,
             config,
         })
@@ -324,6 +330,14 @@ impl BoardApp {
     /// disarmed, never a takeover in flight.
     pub fn host_link_allowed(&self) -> bool {
         self.mode == Mode::Disarmed
+    }
+
+    /// Whether a valid parameter set is in use: false (the parameter store held no valid
+    /// set, the defaults fly) refuses every arm request with
+    /// [`CheckFailure::ParamsInvalid`] until a valid set is saved and this is set again.
+    /// True from [`BoardApp::new`] (an application built without a store).
+    pub fn set_params_valid(&mut self, valid: bool) {
+        self.params_valid = valid;
     }
 
     /// The command applied by the last tick.
@@ -363,6 +377,10 @@ impl BoardApp {
             imu: imu.health,
             attitude_valid: imu.attitude.is_some(),
             rc: rc.as_ref(),
+            level: imu
+                .attitude
+                .is_some_and(|[phi, theta, _]| arming::is_level(phi, theta)),
+            params_valid: self.params_valid,
         };
         let failsafe = &self.config.failsafe;
         let conditions = modes::Conditions {

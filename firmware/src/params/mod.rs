@@ -19,6 +19,8 @@
 //! Every value is an `f32`, as ArduPilot's parameters travel over MAVLink: whole
 //! numbers up to 2²⁴ are exact, which covers every integer parameter here.
 
+#[cfg(test)]
+pub(crate) mod mock_flash;
 pub mod store;
 pub mod table;
 #[cfg(test)]
