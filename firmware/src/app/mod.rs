@@ -10,8 +10,6 @@
 //!   transition rule;
 //! * [`pilot_mode`]: the stabilised pilot mode's rate loops and heading hold;
 //! * [`arming`]: pre-arm and test-entry checks, switch edges;
-//! * [`param_link`]: the host's parameter requests (list, get, set, save, reset),
-//!   obeyed only while disarmed;
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
 //! * [`throttle`]: the ESC channel and its soft start;
 //! * [`inputs`]: the input types;
@@ -57,7 +55,6 @@ pub mod failsafe;
 pub mod inputs;
 pub mod modes;
 pub mod outputs;
-pub mod param_link;
 pub mod pilot_mode;
 pub mod reporting;
 pub mod throttle;
@@ -333,9 +330,10 @@ impl BoardApp {
     }
 
     /// Whether a valid parameter set is in use: false (the parameter store held no valid
-    /// set, the defaults fly) refuses every arm request with
-    /// [`CheckFailure::ParamsInvalid`] until a valid set is saved and this is set again.
-    /// True from [`BoardApp::new`] (an application built without a store).
+    /// set, the defaults fly; [`crate::params::link::ParamLink::params_valid`]) refuses
+    /// every arm request with [`CheckFailure::ParamsInvalid`] until a valid set is saved
+    /// and this is set again. True from [`BoardApp::new`] (an application built without
+    /// a store).
     pub fn set_params_valid(&mut self, valid: bool) {
         self.params_valid = valid;
     }

@@ -15,10 +15,12 @@
 //!   limits around their centre, distinct receiver channels, the test valid, …); the
 //!   defaults give the preset exactly.
 //! * [`store`] — the set in flash, versioned, CRC-checked and wear-levelled.
+//! * [`link`] — the host's parameter requests (protocol 1.5), obeyed only disarmed.
 //!
 //! Every value is an `f32`, as ArduPilot's parameters travel over MAVLink: whole
 //! numbers up to 2²⁴ are exact, which covers every integer parameter here.
 
+pub mod link;
 #[cfg(test)]
 pub(crate) mod mock_flash;
 pub mod store;

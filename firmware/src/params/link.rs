@@ -2,12 +2,13 @@
 //! save and reset the board's [`ParamTable`], answered with [`ParamReply`]s. Obeyed
 //! only while the board application is disarmed; armed, every request is refused with
 //! [`ParamRefusal::Armed`] and changes nothing, as the host link's other frames are
-//! (`BoardApp::host_link_allowed`).
+//! ([`BoardApp::host_link_allowed`](crate::app::BoardApp::host_link_allowed) is the
+//! `disarmed` argument of [`ParamLink::handle`]).
 //!
 //! At boot [`ParamLink::boot`] loads the store; [`ParamLink::store_event`] is the
 //! [`Event::ParamStore`] that reports what it found and [`ParamLink::params_valid`]
 //! the flag the application's pre-arm check takes
-//! ([`BoardApp::set_params_valid`](super::BoardApp::set_params_valid)): the defaults
+//! ([`BoardApp::set_params_valid`](crate::app::BoardApp::set_params_valid)): the defaults
 //! fly only on the ground until a valid set is saved. A `Set` changes the table in RAM;
 //! the application flies the set it was built from until the board rebuilds it (the
 //! board integration decides when: at the next boot, or on the ground after a save).
@@ -181,5 +182,5 @@ fn lookup(name: &ParamName) -> Option<ParamId> {
 const _: () = assert!(MAX_NAME_LEN == sweephold_protocol::PARAM_NAME_LEN);
 
 #[cfg(test)]
-#[path = "param_link_tests.rs"]
+#[path = "link_tests.rs"]
 mod tests;
