@@ -234,3 +234,56 @@ fn an_inconsistent_set_gives_no_configuration() {
     table.set_by_name("TAIL_RPM", 20_000.0).unwrap();
     assert!(table.params(VehicleId::Trex700l).is_ok());
 }
+
+/// The README's parameter table row of `id`: name, unit, range, kind, TREX 700L and
+/// Bo-105 defaults, meaning.
+fn readme_row(id: ParamId) -> String {
+    let def = id.def();
+    let kind = match def.kind {
+        ParamKind::Real => String::from("real"),
+        ParamKind::Integer => String::from("integer"),
+        ParamKind::OneOf(choices) => choices
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+    };
+    let trex = ParamTable::defaults(VehicleId::Trex700l).get(id);
+    let bo105 = ParamTable::defaults(VehicleId::Bo105).get(id);
+    format!(
+        "| `{}` | {} | {} … {} | {} | {} | {} | {} |",
+        def.name,
+        if def.unit.is_empty() { "—" } else { def.unit },
+        def.min,
+        def.max,
+        kind,
+        trex,
+        bo105,
+        def.doc
+    )
+}
+
+#[test]
+fn the_readme_lists_every_parameter_as_defined() {
+    let readme = include_str!("../../README.md");
+    let missing: Vec<String> = ParamId::ALL
+        .iter()
+        .map(|id| readme_row(*id))
+        .filter(|row| !readme.lines().any(|line| line == row))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "firmware/README.md lacks or differs in these rows:\n{}",
+        missing.join("\n")
+    );
+}
+
+/// Prints the README table (`cargo test -p sweephold-firmware --lib print_readme_table
+/// -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn print_readme_table() {
+    for id in ParamId::ALL {
+        println!("{}", readme_row(id));
+    }
+}
