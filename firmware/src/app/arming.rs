@@ -100,9 +100,11 @@ pub struct CheckInput<'a> {
 /// [`MAX_ARM_TILT_DEG`] of level: the tilt of body z from the vertical is
 /// `acos(cos φ · cos θ)`.
 pub fn is_level(phi: f32, theta: f32) -> bool {
-    let cos_limit = libm::cosf(MAX_ARM_TILT_DEG.to_radians());
-    libm::cosf(phi) * libm::cosf(theta) >= cos_limit
+    libm::cosf(phi) * libm::cosf(theta) >= COS_MAX_ARM_TILT
 }
+
+/// cos 25° (f32), the bound of [`is_level`], kept as a constant for the control tick.
+const COS_MAX_ARM_TILT: f32 = 0.906_307_8;
 
 /// The pre-arm checks; `arm_max` is the throttle threshold.
 pub fn pre_arm(input: &CheckInput<'_>, arm_max: f32) -> Result<(), CheckFailure> {

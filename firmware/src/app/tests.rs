@@ -1307,6 +1307,9 @@ fn arming_is_refused_for_each_failed_check() {
         params_valid: true,
     };
     assert_eq!(pre_arm(&imu_ok, 0.05), Err(CheckFailure::ReceiverInvalid));
+    // The bound is cos 25°.
+    assert!(is_level(25f32.to_radians() - 1e-4, 0.0));
+    assert!(!is_level(25f32.to_radians() + 1e-4, 0.0));
     // Tilted 24° about both axes at once is 33.4° from level; 24° about one is not.
     assert!(is_level(24f32.to_radians(), 0.0));
     assert!(is_level(0.0, -24f32.to_radians()));
