@@ -3,7 +3,7 @@
 //! The host-testable, `no_std`, allocation-free flight logic of the sweephold flight
 //! controller: Tischler's exponential frequency sweep (and doublet / 3-2-1-1 inputs)
 //! flown under the *conditional attitude hold* of Jung, Shim & Kim, with off-axis noise,
-//! abort safety, CCPM-120 mixing and postcard telemetry.
+//! abort safety, swashplate mixing (120°, 135°, 140° CCPM, H1) and postcard telemetry.
 //!
 //! The entry point is [`FlightController`]: build it from a [`Config`] (presets
 //! [`Config::bo105_default`] and [`Config::trex700l_default`]), then call
@@ -29,7 +29,8 @@
 //!
 //! **What it may import.** Of the workspace, only the wire protocol
 //! (`sweephold-protocol`); otherwise `no_std` crates that allocate nothing (heapless,
-//! libm, micromath, embedded-hal, embedded-io, rand_pcg, defmt). It never imports the
+//! libm, micromath, embedded-hal, embedded-io, rand_pcg, defmt, and for the parameter
+//! store sequential-storage, embedded-storage and embassy-futures). It never imports the
 //! host crates: they drive it (in-process, in QEMU or over a serial port).
 //!
 //! Modules, one concept each: [`sweep`] (the sweep, its closed-form phase and its
@@ -40,7 +41,8 @@
 //! adaptive sweep amplitude), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`slew`] (the commands' slew
-//! limit), [`mixer`] (CCPM-120),
+//! limit), [`mixer`] (swash and tail mixing), [`swash`] (the swash types, phase angle
+//! and cyclic ring),
 //! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); for the
 //! board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot calibration
 //! and, on the host, a register-level emulator of the chip), [`receiver`] (SBUS decoding,
@@ -49,7 +51,8 @@
 //! stabilised pilot mode, failsafes and the throttle around the sequencer); and
 //! [`board_stack`] (all of these wired together: the IMU polled at 1 kHz through the
 //! monitor, calibration, filters and estimator, the receiver bytes through the SBUS
-//! decoder and channel map, and the application's control tick).
+//! decoder and channel map, and the application's control tick); [`params`] (the
+//! board's parameter table, its typed view and its flash store).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -81,11 +84,13 @@ pub mod hold;
 pub mod imu;
 pub mod mixer;
 pub mod noise;
+pub mod params;
 pub mod pulse;
 pub mod receiver;
 pub mod safety;
 pub mod sink;
 pub mod slew;
+pub mod swash;
 pub mod sweep;
 pub mod trim;
 pub mod turns;

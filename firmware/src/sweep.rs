@@ -639,7 +639,7 @@ mod tests {
                 break;
             }
             worst_phase = worst_phase.max(angle_between(phases.phase_radians(n), theta));
-            if n % 997 == 0 {
+            if n.is_multiple_of(997) {
                 let mut fresh = signal.ticker(rate);
                 worst_phase = worst_phase.max(angle_between(fresh.phase_radians(n), theta));
             }

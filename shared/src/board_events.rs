@@ -117,6 +117,12 @@ pub enum RefusedCheck {
     SoftStartRunning,
     /// The sequencer is not idle.
     SequencerBusy,
+    /// The parameter store held no valid set: the defaults are in use until a set is
+    /// saved. Since 1.5.
+    ParamsInvalid,
+    /// The board stands more than 25° from level (or the IMU mounting is wrong).
+    /// Since 1.5.
+    NotLevel,
 }
 
 impl RefusedCheck {
@@ -131,6 +137,8 @@ impl RefusedCheck {
             RefusedCheck::TestSwitchOn => "test_switch_on",
             RefusedCheck::SoftStartRunning => "soft_start_running",
             RefusedCheck::SequencerBusy => "sequencer_busy",
+            RefusedCheck::ParamsInvalid => "params_invalid",
+            RefusedCheck::NotLevel => "not_level",
         }
     }
 }

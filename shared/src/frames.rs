@@ -13,6 +13,9 @@ use postcard::experimental::max_size::MaxSize;
 use serde::{Deserialize, Serialize};
 
 pub use crate::board_events::{FlightMode, HostFrame, ImuHealth, RefusedCheck, Request};
+pub use crate::param_frames::{
+    ParamName, ParamOp, ParamRefusal, ParamReply, ParamRequest, ParamStoreStatus, PARAM_NAME_LEN,
+};
 
 /// Version of the wire protocol. A host refuses a dump whose `major` differs from its
 /// own; `minor` bumps only add frame variants at the end of [`Frame`] or enum variants at
@@ -31,8 +34,10 @@ pub struct ProtocolVersion {
 /// application's abort reasons [`AbortReason::RcLost`], [`AbortReason::ImuFault`] and
 /// [`AbortReason::Disarmed`]; 1.3 [`InputKind::AdaptiveSweep`]; 1.4 the board
 /// application's events ([`Event::ModeChange`], [`Event::ImuHealthChange`],
-/// [`Event::Refused`], [`Event::HostLinkIgnored`]).
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 4 };
+/// [`Event::Refused`], [`Event::HostLinkIgnored`]); 1.5 the parameter frames
+/// ([`Frame::ParamRequest`], [`Frame::ParamReply`]), [`Event::ParamStore`] and the
+/// refusals [`RefusedCheck::ParamsInvalid`] and [`RefusedCheck::NotLevel`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 5 };
 
 impl ProtocolVersion {
     /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
@@ -527,6 +532,14 @@ pub enum Event {
         /// Which frame.
         frame: HostFrame,
     },
+    /// What the parameter store held at boot (defaults in use unless `Loaded`).
+    /// Since 1.5.
+    ParamStore {
+        /// Tick of the report.
+        tick: u32,
+        /// What was found.
+        status: ParamStoreStatus,
+    },
 }
 
 /// Host → flight controller, each tick, when running in the loop: the simulated sensors
@@ -608,4 +621,8 @@ pub enum Frame {
     Configure(LinkConfig),
     /// The answer to a [`Frame::Configure`] (flight controller → host). Since 1.1.
     ConfigureResult(ConfigureResult),
+    /// A parameter request (host → flight controller). Since 1.5.
+    ParamRequest(ParamRequest),
+    /// The answer to a [`Frame::ParamRequest`] (flight controller → host). Since 1.5.
+    ParamReply(ParamReply),
 }

@@ -32,6 +32,7 @@ pub mod cobs;
 pub mod codec;
 pub mod decoder;
 pub mod frames;
+pub mod param_frames;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
 

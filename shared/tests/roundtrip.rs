@@ -78,7 +78,7 @@ fn adaptive_sweep_is_appended_and_announced_only_when_used() {
     assert_eq!(encoded(InputKind::Sweep), [0]);
     assert_eq!(encoded(InputKind::ThreeTwoOneOne), [2]);
     assert_eq!(encoded(InputKind::AdaptiveSweep), [3]);
-    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 4 });
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 5 });
     let mut test = sweephold_protocol::synthetic::header().test;
     for kind in [
         InputKind::Sweep,

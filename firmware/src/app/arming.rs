@@ -10,14 +10,18 @@
 //! the signal returns, must go off and on again before it requests anything.
 //!
 //! Pre-arm checks, in the order they are reported (the first failure is named):
-//! IMU healthy (status Ok, fresh, finite), attitude estimate valid, receiver frame
-//! valid, throttle stick at or below `ThrottleSettings::arm_max`, test switch off.
+//! IMU healthy (status Ok, fresh, finite), attitude estimate valid, the estimate within
+//! [`MAX_ARM_TILT_DEG`] of level (a board standing tilted, or an IMU mounting that is
+//! wrong by 90° or 180° about a horizontal axis), a valid parameter set in use,
+//! receiver frame valid, throttle stick at or below `ThrottleSettings::arm_max`, test
+//! switch off.
 //! Test-entry checks (armed, in the pilot mode): IMU healthy, attitude valid, receiver
 //! valid, the soft start finished (a sweep on a rotor still spooling up would measure a
 //! changing aircraft), the sequencer idle.
 
 use super::failsafe::ImuProblem;
 use super::inputs::RcInput;
+pub use crate::imu::rotation::MAX_ARM_TILT_DEG;
 
 /// A check that failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,6 +41,10 @@ pub enum CheckFailure {
     SoftStartRunning,
     /// The sequencer is not idle (a test's end is still being wound up).
     SequencerBusy,
+    /// The parameter store held no valid set (the defaults are in use).
+    ParamsInvalid,
+    /// The attitude estimate is more than [`MAX_ARM_TILT_DEG`] from level.
+    NotLevel,
 }
 
 /// A request that was refused, and why.
@@ -82,11 +90,31 @@ pub struct CheckInput<'a> {
     pub attitude_valid: bool,
     /// This tick's receiver frame, if valid.
     pub rc: Option<&'a RcInput>,
+    /// The attitude estimate is within [`MAX_ARM_TILT_DEG`] of level ([`is_level`]).
+    pub level: bool,
+    /// A valid parameter set is in use (not the defaults after a bad store).
+    pub params_valid: bool,
 }
+
+/// Whether roll `phi` and pitch `theta` \[rad\] put the body within
+/// [`MAX_ARM_TILT_DEG`] of level: the tilt of body z from the vertical is
+/// `acos(cos φ · cos θ)`.
+pub fn is_level(phi: f32, theta: f32) -> bool {
+    libm::cosf(phi) * libm::cosf(theta) >= COS_MAX_ARM_TILT
+}
+
+/// cos 25° (f32), the bound of [`is_level`], kept as a constant for the control tick.
+const COS_MAX_ARM_TILT: f32 = 0.906_307_8;
 
 /// The pre-arm checks; `arm_max` is the throttle threshold.
 pub fn pre_arm(input: &CheckInput<'_>, arm_max: f32) -> Result<(), CheckFailure> {
     healthy(input)?;
+    if !input.level {
+        return Err(CheckFailure::NotLevel);
+    }
+    if !input.params_valid {
+        return Err(CheckFailure::ParamsInvalid);
+    }
     let rc = input.rc.ok_or(CheckFailure::ReceiverInvalid)?;
     // NaN counts as high.
     if rc.throttle.is_nan() || rc.throttle > arm_max {

@@ -246,6 +246,8 @@ pub struct BoardApp {
     imu_trim: [f32; 3],
     /// What the board events last reported.
     reporter: Reporter,
+    /// A valid parameter set is in use ([`BoardApp::set_params_valid`]).
+    params_valid: bool,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -292,6 +294,7 @@ impl BoardApp {
             stick_reference: StickMean::default(),
             imu_trim: [0.0; 3],
             reporter: Reporter::default(),
+            params_valid: true,
             fc,
             config,
         })
@@ -324,6 +327,15 @@ impl BoardApp {
     /// disarmed, never a takeover in flight.
     pub fn host_link_allowed(&self) -> bool {
         self.mode == Mode::Disarmed
+    }
+
+    /// Whether a valid parameter set is in use: false (the parameter store held no valid
+    /// set, the defaults fly; [`crate::params::link::ParamLink::params_valid`]) refuses
+    /// every arm request with [`CheckFailure::ParamsInvalid`] until a valid set is saved
+    /// and this is set again. True from [`BoardApp::new`] (an application built without
+    /// a store).
+    pub fn set_params_valid(&mut self, valid: bool) {
+        self.params_valid = valid;
     }
 
     /// The command applied by the last tick.
@@ -363,6 +375,10 @@ impl BoardApp {
             imu: imu.health,
             attitude_valid: imu.attitude.is_some(),
             rc: rc.as_ref(),
+            level: imu
+                .attitude
+                .is_some_and(|[phi, theta, _]| arming::is_level(phi, theta)),
+            params_valid: self.params_valid,
         };
         let failsafe = &self.config.failsafe;
         let conditions = modes::Conditions {

@@ -53,6 +53,8 @@ pub const fn refused_check(check: CheckFailure) -> RefusedCheck {
         CheckFailure::TestSwitchOn => RefusedCheck::TestSwitchOn,
         CheckFailure::SoftStartRunning => RefusedCheck::SoftStartRunning,
         CheckFailure::SequencerBusy => RefusedCheck::SequencerBusy,
+        CheckFailure::ParamsInvalid => RefusedCheck::ParamsInvalid,
+        CheckFailure::NotLevel => RefusedCheck::NotLevel,
     }
 }
 

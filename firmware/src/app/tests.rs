@@ -4,7 +4,7 @@
 //! the rate loops on a rigid-body rate model. Every tick's telemetry is decoded with the
 //! protocol's decoder and its Sample checked against the tick's output.
 
-use super::arming::{pre_arm, test_entry, CheckInput, SwitchEdge};
+use super::arming::{is_level, pre_arm, test_entry, CheckInput, SwitchEdge};
 use super::failsafe::{FailsafeSettings, RcLossHold};
 use super::modes::{next, Conditions, Transition};
 use super::pilot_mode::{Drive, LoopFactors, RateAxisGains, RateLoop};
@@ -1256,6 +1256,26 @@ fn arming_is_refused_for_each_failed_check() {
         (|rig| rig.imu.psi = f32::NAN, CheckFailure::AttitudeInvalid),
         (|rig| rig.rc.throttle = 0.06, CheckFailure::ThrottleHigh),
         (|rig| rig.rc.test_switch = true, CheckFailure::TestSwitchOn),
+        // 26° of roll, or of pitch, or 19° of each (acos(cos²19°) = 26.9°).
+        (
+            |rig| rig.imu.phi = 26f32.to_radians(),
+            CheckFailure::NotLevel,
+        ),
+        (
+            |rig| rig.imu.theta = -26f32.to_radians(),
+            CheckFailure::NotLevel,
+        ),
+        (
+            |rig| {
+                rig.imu.phi = 19f32.to_radians();
+                rig.imu.theta = 19f32.to_radians();
+            },
+            CheckFailure::NotLevel,
+        ),
+        (
+            |rig| rig.app.set_params_valid(false),
+            CheckFailure::ParamsInvalid,
+        ),
     ];
     for (fail, failure) in checks {
         let mut rig = Rig::in_mode(Mode::Disarmed);
@@ -1270,6 +1290,7 @@ fn arming_is_refused_for_each_failed_check() {
         rig.imu = ImuInput::AT_REST;
         rig.rc.throttle = 0.0;
         rig.rc.test_switch = false;
+        rig.app.set_params_valid(true);
         let out = rig.ticks(20);
         assert_eq!(out.mode, Mode::Disarmed, "{failure:?}");
         rig.rc.arm = false;
@@ -1282,8 +1303,17 @@ fn arming_is_refused_for_each_failed_check() {
         imu: Ok(()),
         attitude_valid: true,
         rc: None,
+        level: true,
+        params_valid: true,
     };
     assert_eq!(pre_arm(&imu_ok, 0.05), Err(CheckFailure::ReceiverInvalid));
+    // The bound is cos 25°.
+    assert!(is_level(25f32.to_radians() - 1e-4, 0.0));
+    assert!(!is_level(25f32.to_radians() + 1e-4, 0.0));
+    // Tilted 24° about both axes at once is 33.4° from level; 24° about one is not.
+    assert!(is_level(24f32.to_radians(), 0.0));
+    assert!(is_level(0.0, -24f32.to_radians()));
+    assert!(!is_level(24f32.to_radians(), 24f32.to_radians()));
     assert_eq!(
         test_entry(&imu_ok, true, true),
         Err(CheckFailure::ReceiverInvalid)

@@ -76,7 +76,7 @@ impl Bench {
                 self.bytes.extend_from_slice(&frame.encode());
             }
         }
-        if self.now_us % 5000 == 0 {
+        if self.now_us.is_multiple_of(5000) {
             let bytes = std::mem::take(&mut self.bytes);
             let out = self
                 .stack
@@ -220,7 +220,7 @@ fn the_estimate_follows_a_roll_through_rotor_vibration() {
     let mut largest_rate = 0.0f32;
     for _ in 0..1000 {
         bench.step_ms();
-        if bench.stack.samples() % 5 == 0 {
+        if bench.stack.samples().is_multiple_of(5) {
             largest_rate = bench
                 .stack
                 .imu_values()

@@ -6,6 +6,8 @@
 //!   units and body axes per data-ready.
 //! * [`ImuMonitor`] — fed with every poll, reports the first [`ImuFault`]
 //!   (missing, stuck, saturated, not ready).
+//! * [`rotation`] — the mounting as one of the 24 axis-aligned rotations, and the
+//!   pre-arm check that the board stands within 25° of level.
 //! * [`calibration`] — gyro bias and level offsets from a still window at boot, one
 //!   sample at a time.
 //! * `emulator` (with `std` or in tests) — the chip as an `SpiDevice`, fed with the
@@ -29,6 +31,9 @@ pub mod calibration;
 pub mod emulator;
 mod icm42688;
 pub mod registers;
+pub mod rotation;
+#[cfg(test)]
+mod rotation_tests;
 #[cfg(test)]
 mod tests;
 
@@ -40,6 +45,7 @@ pub use icm42688::{
     GYRO_RAD_S_PER_LSB, GYRO_STARTUP_MS, INIT_REGISTERS, SOFT_RESET_MS, TEMP_LSB_PER_C,
     TEMP_OFFSET_C,
 };
+pub use rotation::{check_level, ImuRotation, LevelError};
 
 use embedded_hal::spi::ErrorKind;
 

@@ -165,11 +165,14 @@ fn handle_frame<W: Write>(
                 summary.header = Some(header);
             }
         }
-        // In-the-loop traffic is not telemetry; a dump of a serial link may hold it.
+        // In-the-loop and parameter traffic is not telemetry; a dump of a serial link may
+        // hold it.
         Frame::SensorIn(_)
         | Frame::ActuatorOut(_)
         | Frame::Configure(_)
-        | Frame::ConfigureResult(_) => {}
+        | Frame::ConfigureResult(_)
+        | Frame::ParamRequest(_)
+        | Frame::ParamReply(_) => {}
     }
     Ok(())
 }
@@ -233,6 +236,9 @@ pub fn event_json(event: &Event) -> serde_json::Value {
         Event::HostLinkIgnored { tick, frame } => {
             json!({"type": "event", "event": "host_link_ignored", "tick": tick, "frame": frame.name()})
         }
+        Event::ParamStore { tick, status } => {
+            json!({"type": "event", "event": "param_store", "tick": tick, "status": status.name()})
+        }
     }
 }
 
@@ -270,6 +276,9 @@ pub fn event_text(event: &Event) -> String {
         },
         Event::HostLinkIgnored { tick, frame } => {
             format!("tick {tick}: host {} ignored while armed", frame.name())
+        }
+        Event::ParamStore { tick, status } => {
+            format!("tick {tick}: parameter store {}", status.name())
         }
     }
 }

@@ -226,6 +226,77 @@ pub fn event() -> impl Strategy<Value = Event> {
             }
         ),
         (any::<u32>(), reason()).prop_map(|(tick, reason)| Event::Abort { tick, reason }),
+        (any::<u32>(), param_store_status())
+            .prop_map(|(tick, status)| Event::ParamStore { tick, status }),
+    ]
+}
+
+pub fn param_store_status() -> impl Strategy<Value = ParamStoreStatus> {
+    prop_oneof![
+        Just(ParamStoreStatus::Loaded),
+        Just(ParamStoreStatus::Empty),
+        Just(ParamStoreStatus::Corrupt),
+        Just(ParamStoreStatus::OtherVersion),
+        Just(ParamStoreStatus::Invalid),
+        Just(ParamStoreStatus::FlashError),
+    ]
+}
+
+/// Any 16 name bytes, valid names or not (a decoder must carry whatever arrives).
+pub fn param_name() -> impl Strategy<Value = ParamName> {
+    prop_oneof![
+        "[A-Z0-9_]{1,16}".prop_map(|name| ParamName::new(&name).unwrap()),
+        Just(ParamName::EMPTY),
+    ]
+}
+
+pub fn param_op() -> impl Strategy<Value = ParamOp> {
+    prop_oneof![
+        Just(ParamOp::List),
+        Just(ParamOp::Get),
+        Just(ParamOp::Set),
+        Just(ParamOp::Save),
+        Just(ParamOp::Reset),
+    ]
+}
+
+pub fn param_refusal() -> impl Strategy<Value = ParamRefusal> {
+    prop_oneof![
+        Just(ParamRefusal::Armed),
+        Just(ParamRefusal::UnknownName),
+        Just(ParamRefusal::NotFinite),
+        Just(ParamRefusal::OutOfRange),
+        Just(ParamRefusal::NotAnInteger),
+        Just(ParamRefusal::NotAChoice),
+        Just(ParamRefusal::Inconsistent),
+        Just(ParamRefusal::StoreFailed),
+        Just(ParamRefusal::NoStore),
+    ]
+}
+
+pub fn param_request() -> impl Strategy<Value = ParamRequest> {
+    prop_oneof![
+        Just(ParamRequest::List),
+        param_name().prop_map(|name| ParamRequest::Get { name }),
+        (param_name(), real()).prop_map(|(name, value)| ParamRequest::Set { name, value }),
+        Just(ParamRequest::Save),
+        Just(ParamRequest::Reset),
+    ]
+}
+
+pub fn param_reply() -> impl Strategy<Value = ParamReply> {
+    prop_oneof![
+        (any::<u16>(), any::<u16>(), param_name(), real()).prop_map(
+            |(index, count, name, value)| ParamReply::Value {
+                index,
+                count,
+                name,
+                value
+            }
+        ),
+        param_op().prop_map(|op| ParamReply::Done { op }),
+        (param_op(), param_name(), param_refusal())
+            .prop_map(|(op, name, reason)| ParamReply::Refused { op, name, reason }),
     ]
 }
 
@@ -262,6 +333,8 @@ pub fn frame() -> impl Strategy<Value = Frame> {
         actuator_out().prop_map(Frame::ActuatorOut),
         link_config().prop_map(Frame::Configure),
         configure_result().prop_map(Frame::ConfigureResult),
+        param_request().prop_map(Frame::ParamRequest),
+        param_reply().prop_map(Frame::ParamReply),
     ]
 }
 

@@ -1,0 +1,173 @@
+//! The board's parameters: one typed table of everything an aircraft owner sets up
+//! (swash type and servos, receiver map, IMU mounting, head speed, hold gains and
+//! thresholds, abort limits, the test), its defaults from the aircraft preset, and the
+//! typed view the control code reads.
+//!
+//! * [`table`] — the definitions: name (≤ 16 characters, ArduPilot / Rotorflight
+//!   style), unit, range, kind. `firmware/README.md` lists them all with their defaults.
+//! * [`ParamTable`] — the values. Set by name or id with the range and kind checked
+//!   (unknown names, NaN, infinities, out-of-range values, fractions where a whole
+//!   number is needed and values outside a list are refused; the table is unchanged
+//!   then). No allocation, no panic path.
+//! * [`Params`] ([`typed`]) — the values as the configuration structs the control code
+//!   already reads ([`StackConfig`](crate::board_stack::StackConfig) and the board's
+//!   frame rates and mounting), built only when the whole set is consistent (servo
+//!   limits around their centre, distinct receiver channels, the test valid, …); the
+//!   defaults give the preset exactly.
+//! * [`store`] — the set in flash, versioned, CRC-checked and wear-levelled.
+//! * [`link`] — the host's parameter requests (protocol 1.5), obeyed only disarmed.
+//!
+//! Every value is an `f32`, as ArduPilot's parameters travel over MAVLink: whole
+//! numbers up to 2²⁴ are exact, which covers every integer parameter here.
+
+pub mod link;
+#[cfg(test)]
+pub(crate) mod mock_flash;
+pub mod store;
+pub mod table;
+#[cfg(test)]
+mod tests;
+pub mod typed;
+
+pub use table::{ParamDef, ParamId, ParamKind, COUNT, DEFS, MAX_NAME_LEN, TABLE_VERSION};
+pub use typed::{Params, ParamsError};
+
+use sweephold_protocol::VehicleId;
+
+/// Why a value was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SetError {
+    /// No parameter has that name.
+    UnknownName,
+    /// NaN or infinite.
+    NotFinite,
+    /// Below the minimum or above the maximum.
+    OutOfRange,
+    /// A whole number is needed.
+    NotAnInteger,
+    /// Not one of the accepted values.
+    NotAChoice,
+}
+
+impl SetError {
+    /// Human-readable explanation.
+    pub const fn message(self) -> &'static str {
+        match self {
+            SetError::UnknownName => "unknown parameter name",
+            SetError::NotFinite => "value is NaN or infinite",
+            SetError::OutOfRange => "value outside the parameter's range",
+            SetError::NotAnInteger => "value must be a whole number",
+            SetError::NotAChoice => "value is not one of the parameter's choices",
+        }
+    }
+}
+
+impl ParamId {
+    /// The parameter called `name` (exact, upper case).
+    pub fn from_name(name: &str) -> Option<ParamId> {
+        ParamId::ALL
+            .iter()
+            .zip(DEFS.iter())
+            .find(|(_, def)| def.name == name)
+            .map(|(id, _)| *id)
+    }
+
+    /// Its position in the table.
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The parameter at `index`.
+    pub fn from_index(index: usize) -> Option<ParamId> {
+        ParamId::ALL.get(index).copied()
+    }
+
+    /// Its definition.
+    pub fn def(self) -> &'static ParamDef {
+        // `index` < COUNT by construction; the fallback only avoids a panic path.
+        DEFS.get(self.index()).unwrap_or(&DEFS[0])
+    }
+}
+
+impl ParamDef {
+    /// Whether `value` is acceptable for this parameter.
+    pub fn check(&self, value: f32) -> Result<(), SetError> {
+        if !value.is_finite() {
+            return Err(SetError::NotFinite);
+        }
+        if value < self.min || value > self.max {
+            return Err(SetError::OutOfRange);
+        }
+        match self.kind {
+            ParamKind::Real => Ok(()),
+            ParamKind::Integer if libm::truncf(value) == value => Ok(()),
+            ParamKind::Integer => Err(SetError::NotAnInteger),
+            ParamKind::OneOf(choices) if choices.contains(&value) => Ok(()),
+            ParamKind::OneOf(_) => Err(SetError::NotAChoice),
+        }
+    }
+}
+
+/// The values of every parameter, in table order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamTable {
+    values: [f32; COUNT],
+}
+
+impl ParamTable {
+    /// The defaults: the preset of `vehicle` ([`crate::board_stack::StackConfig`] with
+    /// [`crate::app::AppConfig::preset`], test axis lat, the board's frame rates and
+    /// mounting).
+    pub fn defaults(vehicle: VehicleId) -> Self {
+        ParamTable {
+            values: typed::values_of(&Params::preset(vehicle)),
+        }
+    }
+
+    /// A table holding `values` if every one is acceptable, else the first refused
+    /// parameter and why.
+    pub fn from_values(values: [f32; COUNT]) -> Result<Self, (ParamId, SetError)> {
+        for (id, value) in ParamId::ALL.iter().zip(values) {
+            id.def().check(value).map_err(|error| (*id, error))?;
+        }
+        Ok(ParamTable { values })
+    }
+
+    /// Every value, in table order.
+    pub const fn values(&self) -> &[f32; COUNT] {
+        &self.values
+    }
+
+    /// The value of `id`.
+    pub fn get(&self, id: ParamId) -> f32 {
+        self.values.get(id.index()).copied().unwrap_or(0.0)
+    }
+
+    /// The value of the parameter called `name`.
+    pub fn get_by_name(&self, name: &str) -> Result<f32, SetError> {
+        ParamId::from_name(name)
+            .map(|id| self.get(id))
+            .ok_or(SetError::UnknownName)
+    }
+
+    /// Set `id` to `value` after checking it; on a refusal nothing changes.
+    pub fn set(&mut self, id: ParamId, value: f32) -> Result<(), SetError> {
+        id.def().check(value)?;
+        if let Some(slot) = self.values.get_mut(id.index()) {
+            *slot = value;
+        }
+        Ok(())
+    }
+
+    /// Set the parameter called `name`; on a refusal nothing changes.
+    pub fn set_by_name(&mut self, name: &str, value: f32) -> Result<(), SetError> {
+        let id = ParamId::from_name(name).ok_or(SetError::UnknownName)?;
+        self.set(id, value)
+    }
+
+    /// The typed view, if the whole set is consistent.
+    pub fn params(&self, vehicle: VehicleId) -> Result<Params, ParamsError> {
+        Params::from_values(&self.values, vehicle)
+    }
+}

@@ -1,0 +1,163 @@
+//! The parameter definitions: name, unit, range, kind, one line of meaning. The order is
+//! the order of the stored record and of a list over the link; a parameter is only ever
+//! appended (a change of order or meaning bumps [`TABLE_VERSION`]).
+
+/// What values a parameter takes besides its range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamKind {
+    /// Any finite value in the range.
+    Real,
+    /// A whole number in the range.
+    Integer,
+    /// One of these values (each within the range).
+    OneOf(&'static [f32]),
+}
+
+/// One parameter's definition.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamDef {
+    /// Its name, at most [`MAX_NAME_LEN`] characters, upper case.
+    pub name: &'static str,
+    /// Its unit ("" for a number without one).
+    pub unit: &'static str,
+    /// Smallest accepted value.
+    pub min: f32,
+    /// Largest accepted value.
+    pub max: f32,
+    /// Real, integer or one of a list.
+    pub kind: ParamKind,
+    /// What it sets.
+    pub doc: &'static str,
+}
+
+/// Longest parameter name (ArduPilot's limit, which Rotorflight's names also keep).
+pub const MAX_NAME_LEN: usize = 16;
+
+/// The version of the table's layout, stored with every record: a record of another
+/// version is not loaded (its values could mean other things).
+pub const TABLE_VERSION: u16 = 1;
+
+/// Swash type codes: H1, 120°, 135°, 140°.
+const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
+/// Servo direction: normal or reversed.
+const DIRECTIONS: &[f32] = &[-1.0, 1.0];
+/// ArduPilot's numbers of the 24 axis-aligned rotations and the two aliases.
+const ROTATIONS: &[f32] = &[
+    0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 18.0, 20.0, 22.0, 24.0, 25.0, 26.0, 27.0,
+    28.0, 29.0, 30.0, 31.0, 32.0, 33.0, 34.0, 35.0, 36.0, 37.0,
+];
+/// Pulse widths a servo or receiver setting may take \[µs\]: 760 µs-centre tail servos
+/// included.
+const PULSE_MIN: f32 = 500.0;
+const PULSE_MAX: f32 = 2500.0;
+
+macro_rules! params {
+    ($( $id:ident = $name:literal, $unit:literal, $min:expr, $max:expr, $kind:expr, $doc:literal; )*) => {
+        /// Every parameter, in table order.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+        #[allow(non_camel_case_types)]
+        #[repr(u8)]
+        pub enum ParamId {
+            $( #[doc = $doc] $id, )*
+        }
+
+        /// Number of parameters.
+        pub const COUNT: usize = [$( stringify!($id) ),*].len();
+
+        /// The definitions, in table order.
+        pub const DEFS: [ParamDef; COUNT] = [
+            $( ParamDef { name: $name, unit: $unit, min: $min, max: $max, kind: $kind, doc: $doc }, )*
+        ];
+
+        impl ParamId {
+            /// Every parameter, in table order.
+            pub const ALL: [ParamId; COUNT] = [$( ParamId::$id ),*];
+        }
+    };
+}
+
+use ParamKind::{Integer, OneOf, Real};
+
+params! {
+    SwashType = "SWASH_TYPE", "", 0.0, 140.0, OneOf(SWASH_TYPES), "Swash type: 0 H1 (mechanical), 120, 135 or 140 (CCPM plate angle).";
+    SwashPhase = "SWASH_PHASE", "deg", -180.0, 180.0, Real, "Phase angle subtracted from every servo azimuth (clockwise positive).";
+    SwashLead = "SWASH_LEAD", "", 1.0, 3.0, Integer, "Swash output on the fore-aft axis (front); the others follow clockwise.";
+    Servo1Dir = "SERVO1_DIR", "", -1.0, 1.0, OneOf(DIRECTIONS), "Swash output 1 direction: 1 normal, -1 reversed.";
+    Servo1Mid = "SERVO1_MID", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 1 pulse at zero height (centre).";
+    Servo1Min = "SERVO1_MIN", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 1 lowest pulse.";
+    Servo1Max = "SERVO1_MAX", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 1 highest pulse.";
+    Servo1Throw = "SERVO1_THROW", "us", 0.0, 1000.0, Real, "Swash output 1 pulse per unit height.";
+    Servo2Dir = "SERVO2_DIR", "", -1.0, 1.0, OneOf(DIRECTIONS), "Swash output 2 direction: 1 normal, -1 reversed.";
+    Servo2Mid = "SERVO2_MID", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 2 pulse at zero height (centre).";
+    Servo2Min = "SERVO2_MIN", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 2 lowest pulse.";
+    Servo2Max = "SERVO2_MAX", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 2 highest pulse.";
+    Servo2Throw = "SERVO2_THROW", "us", 0.0, 1000.0, Real, "Swash output 2 pulse per unit height.";
+    Servo3Dir = "SERVO3_DIR", "", -1.0, 1.0, OneOf(DIRECTIONS), "Swash output 3 direction: 1 normal, -1 reversed.";
+    Servo3Mid = "SERVO3_MID", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 3 pulse at zero height (centre).";
+    Servo3Min = "SERVO3_MIN", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 3 lowest pulse.";
+    Servo3Max = "SERVO3_MAX", "us", PULSE_MIN, PULSE_MAX, Integer, "Swash output 3 highest pulse.";
+    Servo3Throw = "SERVO3_THROW", "us", 0.0, 1000.0, Real, "Swash output 3 pulse per unit height.";
+    TailDir = "TAIL_DIR", "", -1.0, 1.0, OneOf(DIRECTIONS), "Tail servo direction: 1 normal, -1 reversed.";
+    TailMid = "TAIL_MID", "us", PULSE_MIN, PULSE_MAX, Integer, "Tail servo centre pulse (760 for narrow-band servos).";
+    TailMin = "TAIL_MIN", "us", PULSE_MIN, PULSE_MAX, Integer, "Tail servo lowest pulse.";
+    TailMax = "TAIL_MAX", "us", PULSE_MIN, PULSE_MAX, Integer, "Tail servo highest pulse.";
+    TailThrow = "TAIL_THROW", "us", 0.0, 1000.0, Real, "Tail servo pulse per unit pedal height.";
+    ServoRate = "SERVO_RATE", "Hz", 50.0, 333.0, Integer, "Swash servo frame rate (read by the board's output timers).";
+    TailRate = "TAIL_RATE", "Hz", 50.0, 333.0, Integer, "Tail servo frame rate (read by the board's output timers).";
+    CollMin = "COLL_MIN", "", -1.0, 1.0, Real, "Swash height at full negative collective command.";
+    CollMax = "COLL_MAX", "", -1.0, 1.0, Real, "Swash height at full positive collective command.";
+    CycScale = "CYC_SCALE", "", 0.0, 1.0, Real, "Swash height per unit cyclic command.";
+    PedScale = "PED_SCALE", "", 0.0, 1.0, Real, "Tail height per unit pedal command.";
+    CycRing = "CYC_RING", "", 0.1, 1.5, Real, "Cyclic ring: longest (lat, lon) command vector; 1.5 never limits.";
+    RcLat = "RC_LAT", "", 1.0, 16.0, Integer, "Receiver channel of the lateral cyclic (aileron).";
+    RcLon = "RC_LON", "", 1.0, 16.0, Integer, "Receiver channel of the longitudinal cyclic (elevator).";
+    RcThr = "RC_THR", "", 1.0, 16.0, Integer, "Receiver channel of the throttle.";
+    RcPed = "RC_PED", "", 1.0, 16.0, Integer, "Receiver channel of the pedal (rudder).";
+    RcArm = "RC_ARM", "", 1.0, 16.0, Integer, "Receiver channel of the arm switch.";
+    RcCol = "RC_COL", "", 1.0, 16.0, Integer, "Receiver channel of the collective.";
+    RcTest = "RC_TEST", "", 1.0, 16.0, Integer, "Receiver channel of the test switch.";
+    RcMode = "RC_MODE", "", 1.0, 16.0, Integer, "Receiver channel of the mode switch.";
+    RcRev = "RC_REV", "", 0.0, 255.0, Integer, "Reversed functions, bit i of lat, lon, thr, ped, arm, col, test, mode.";
+    RcMin = "RC_MIN", "", 0.0, 2047.0, Integer, "Raw SBUS value at full negative travel.";
+    RcMid = "RC_MID", "", 0.0, 2047.0, Integer, "Raw SBUS value at centre.";
+    RcMax = "RC_MAX", "", 0.0, 2047.0, Integer, "Raw SBUS value at full positive travel.";
+    RcTimeout = "RC_TIMEOUT", "ms", 20.0, 1000.0, Integer, "Receiver link lost after this long without an intact frame.";
+    ImuRot = "IMU_ROT", "", 0.0, 37.0, OneOf(ROTATIONS), "IMU mounting, ArduPilot's ROTATION_* number (axis-aligned only).";
+    HeadRpm = "HEAD_RPM", "rpm", 600.0, 4000.0, Real, "Main rotor speed: places the 1/rev and 2/rev notches.";
+    TailRpm = "TAIL_RPM", "rpm", 1200.0, 20000.0, Real, "Tail rotor speed: places the tail notch.";
+    HoldLatP = "HOLD_LAT_P", "1/rad", 0.0, 20.0, Real, "Attitude hold, roll: stick per rad of attitude error.";
+    HoldLatI = "HOLD_LAT_I", "1/rad/s", 0.0, 20.0, Real, "Attitude hold, roll: stick per rad·s of integrated error.";
+    HoldLatD = "HOLD_LAT_D", "s/rad", 0.0, 5.0, Real, "Attitude hold, roll: stick per rad/s of roll rate.";
+    HoldLatLim = "HOLD_LAT_LIM", "", 0.01, 1.0, Real, "Attitude hold, roll: output limit, fraction of stick.";
+    HoldLonP = "HOLD_LON_P", "1/rad", 0.0, 20.0, Real, "Attitude hold, pitch: stick per rad of attitude error.";
+    HoldLonI = "HOLD_LON_I", "1/rad/s", 0.0, 20.0, Real, "Attitude hold, pitch: stick per rad·s of integrated error.";
+    HoldLonD = "HOLD_LON_D", "s/rad", 0.0, 5.0, Real, "Attitude hold, pitch: stick per rad/s of pitch rate.";
+    HoldLonLim = "HOLD_LON_LIM", "", 0.01, 1.0, Real, "Attitude hold, pitch: output limit, fraction of stick.";
+    HoldPedP = "HOLD_PED_P", "1/rad", 0.0, 20.0, Real, "Heading hold: stick per rad of heading error.";
+    HoldPedI = "HOLD_PED_I", "1/rad/s", 0.0, 20.0, Real, "Heading hold: stick per rad·s of integrated error.";
+    HoldPedD = "HOLD_PED_D", "s/rad", 0.0, 5.0, Real, "Heading hold: stick per rad/s of yaw rate.";
+    HoldPedLim = "HOLD_PED_LIM", "", 0.01, 1.0, Real, "Heading hold: output limit, fraction of stick.";
+    HoldEngage = "HOLD_ENGAGE", "deg", 0.5, 90.0, Real, "Conditional hold engages beyond this attitude error.";
+    HoldRelease = "HOLD_RELEASE", "deg", 0.5, 90.0, Real, "Conditional hold releases within this attitude error.";
+    AbortAtt = "ABORT_ATT", "deg", 1.0, 90.0, Real, "Test abort: roll or pitch beyond this.";
+    AbortRateRoll = "ABORT_RATE_R", "deg/s", 1.0, 1000.0, Real, "Test abort: roll rate beyond this.";
+    AbortRatePitch = "ABORT_RATE_P", "deg/s", 1.0, 1000.0, Real, "Test abort: pitch rate beyond this.";
+    AbortRateYaw = "ABORT_RATE_Y", "deg/s", 1.0, 1000.0, Real, "Test abort: yaw rate beyond this.";
+    AbortStick = "ABORT_STICK", "", 0.01, 1.0, Real, "Test abort: pilot stick moved this far from its trim.";
+    TestAxis = "TEST_AXIS", "", 0.0, 3.0, Integer, "Axis under test: 0 lat, 1 lon, 2 ped, 3 col.";
+    TestInput = "TEST_INPUT", "", 0.0, 3.0, Integer, "Input: 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    TestMode = "TEST_MODE", "", 0.0, 2.0, Integer, "Mode: 0 conditional attitude hold, 1 standard, 2 off-axis noise.";
+    SweepRecord = "SWP_TREC", "s", 1.0, 3600.0, Real, "Sweep record length.";
+    SweepAmp = "SWP_AMP", "", 0.001, 0.5, Real, "Sweep amplitude, fraction of stick travel.";
+    SweepOmegaMin = "SWP_WMIN", "rad/s", 0.01, 100.0, Real, "Sweep start frequency.";
+    SweepOmegaMax = "SWP_WMAX", "rad/s", 0.01, 400.0, Real, "Sweep end frequency.";
+    SweepFade = "SWP_FADE", "s", 0.0, 60.0, Real, "Raised-cosine fade-in and fade-out length.";
+    SweepHold = "SWP_HOLD", "", 0.0, 255.0, Integer, "Cycles at the start frequency before the sweep.";
+    PulseAmp = "PULSE_AMP", "", 0.001, 0.5, Real, "Doublet / 3-2-1-1 amplitude, fraction of stick travel.";
+    PulseWidth = "PULSE_WIDTH", "s", 0.01, 60.0, Real, "Doublet / 3-2-1-1 unit pulse width.";
+    NoiseRms = "NOISE_RMS", "", 0.0, 0.5, Real, "Off-axis noise RMS, fraction of stick travel.";
+    NoiseCutoff = "NOISE_CUTOFF", "rad/s", 0.01, 3200.0, Real, "Off-axis noise low-pass cut-off.";
+    TestSeed = "TEST_SEED", "", 0.0, 16_777_215.0, Integer, "Noise seed (up to 2^24 - 1, exact in the f32 value).";
+    TestFreeze = "TEST_FREEZE", "", 0.0, 1.0, Integer, "1: freeze the excitation while the hold is engaged in band.";
+}

@@ -1,0 +1,481 @@
+//! The typed view of the parameter table: the configuration structs the control code
+//! reads, filled from the values, and the values read back from them (the defaults).
+//!
+//! Every parameter maps onto one field (or, for `COLL_MIN`/`COLL_MAX`, `HEAD_RPM` and
+//! `TAIL_RPM`, a pair of fields); everything else keeps the preset's value. Angles are
+//! in degrees on the table and radians in the structs, converted with the same
+//! `π/180` the presets are written with, so the defaults give the preset bit for bit
+//! (tested for both presets).
+
+use sweephold_protocol::{Axis, ExcitationMode, InputKind, VehicleId};
+
+use super::table::{ParamId, COUNT};
+use crate::app::{AppConfig, AppConfigError};
+use crate::board_stack::StackConfig;
+use crate::config::ConfigError;
+use crate::filters::{FilterBank, FilterBankConfig, FilterError};
+use crate::imu::ImuRotation;
+use crate::mixer::ServoConfig;
+use crate::receiver::{ChannelMapError, ChannelSource};
+use crate::swash::{SwashError, SwashGeometry, SwashType};
+
+const DEG: f32 = core::f32::consts::PI / 180.0;
+
+/// The board's swash and tail servo frame rate before parameters existed \[Hz\].
+pub const DEFAULT_FRAME_HZ: u16 = 50;
+
+/// Everything the parameters set, typed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Params {
+    /// The sensor-to-servo stack's configuration (application, sequencer, mixer,
+    /// receiver, filters; its `orientation` is `imu_rotation`'s).
+    pub stack: StackConfig,
+    /// The IMU mounting.
+    pub imu_rotation: ImuRotation,
+    /// Swash servo frame rate \[Hz\].
+    pub swash_frame_hz: u16,
+    /// Tail servo frame rate \[Hz\].
+    pub tail_frame_hz: u16,
+}
+
+/// Why a set of values does not make a usable configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ParamsError {
+    /// A value is refused by its own definition (a table built unchecked).
+    Value(ParamId),
+    /// Swash type, phase or lead servo invalid.
+    Swash(SwashError),
+    /// A servo's limits do not surround its centre, or the mixer's scales are invalid.
+    Mixer,
+    /// Receiver channels repeat or the raw range is not increasing.
+    ChannelMap(ChannelMapError),
+    /// The notch frequencies cannot be designed at the IMU rate.
+    Filters(FilterError),
+    /// The test, the hold or the abort limits are refused.
+    Flight(ConfigError),
+    /// The application's settings are refused.
+    App(AppConfigError),
+}
+
+impl ParamsError {
+    /// Human-readable explanation.
+    pub const fn message(self) -> &'static str {
+        match self {
+            ParamsError::Value(_) => "a value is outside its parameter's range",
+            ParamsError::Swash(SwashError::PhaseOutOfRange) => "swash phase outside ±180°",
+            ParamsError::Swash(SwashError::LeadOutOfRange) => "swash lead servo not 1-3",
+            ParamsError::Mixer => "servo limits must surround the centre (min < max)",
+            ParamsError::ChannelMap(_) => "receiver channels must differ, min < mid < max",
+            ParamsError::Filters(_) => "rotor speeds give notches the filters cannot place",
+            ParamsError::Flight(error) => error.message(),
+            ParamsError::App(error) => error.message(),
+        }
+    }
+}
+
+impl Params {
+    /// The preset of `vehicle`: [`AppConfig::preset`] on the lateral axis in the board's
+    /// standard stack, no IMU rotation, 50 Hz servo frames.
+    pub const fn preset(vehicle: VehicleId) -> Self {
+        Params {
+            stack: StackConfig::with_app(AppConfig::preset(vehicle, Axis::Lat)),
+            imu_rotation: ImuRotation::None,
+            swash_frame_hz: DEFAULT_FRAME_HZ,
+            tail_frame_hz: DEFAULT_FRAME_HZ,
+        }
+    }
+
+    /// The configuration `values` describe on top of the preset of `vehicle`, checked
+    /// as a whole.
+    pub fn from_values(values: &[f32; COUNT], vehicle: VehicleId) -> Result<Self, ParamsError> {
+        for (id, value) in ParamId::ALL.iter().zip(values) {
+            id.def()
+                .check(*value)
+                .map_err(|_| ParamsError::Value(*id))?;
+        }
+        let v = |id: ParamId| values.get(id.index()).copied().unwrap_or(0.0);
+        let mut params = Params::preset(vehicle);
+        let stack = &mut params.stack;
+
+        let kind = SwashType::from_code(v(ParamId::SwashType) as u16)
+            .ok_or(ParamsError::Value(ParamId::SwashType))?;
+        let mixer = &mut stack.app.flight.mixer;
+        mixer.geometry =
+            SwashGeometry::new(kind, v(ParamId::SwashPhase), v(ParamId::SwashLead) as u8)
+                .map_err(ParamsError::Swash)?;
+        let servo_ids = [
+            [
+                ParamId::Servo1Dir,
+                ParamId::Servo1Mid,
+                ParamId::Servo1Min,
+                ParamId::Servo1Max,
+                ParamId::Servo1Throw,
+            ],
+            [
+                ParamId::Servo2Dir,
+                ParamId::Servo2Mid,
+                ParamId::Servo2Min,
+                ParamId::Servo2Max,
+                ParamId::Servo2Throw,
+            ],
+            [
+                ParamId::Servo3Dir,
+                ParamId::Servo3Mid,
+                ParamId::Servo3Min,
+                ParamId::Servo3Max,
+                ParamId::Servo3Throw,
+            ],
+        ];
+        for (servo, ids) in mixer.swash.iter_mut().zip(servo_ids) {
+            *servo = servo_from(ids.map(v));
+        }
+        mixer.tail = servo_from(
+            [
+                ParamId::TailDir,
+                ParamId::TailMid,
+                ParamId::TailMin,
+                ParamId::TailMax,
+                ParamId::TailThrow,
+            ]
+            .map(v),
+        );
+        let (coll_min, coll_max) = (v(ParamId::CollMin), v(ParamId::CollMax));
+        mixer.collective_scale = 0.5 * (coll_max - coll_min);
+        mixer.collective_offset = 0.5 * (coll_max + coll_min);
+        mixer.cyclic_scale = v(ParamId::CycScale);
+        mixer.pedal_scale = v(ParamId::PedScale);
+        mixer.cyclic_ring = v(ParamId::CycRing);
+        if !mixer.is_valid() {
+            return Err(ParamsError::Mixer);
+        }
+        params.swash_frame_hz = v(ParamId::ServoRate) as u16;
+        params.tail_frame_hz = v(ParamId::TailRate) as u16;
+
+        let map = &mut stack.channel_map;
+        let reversed = v(ParamId::RcRev) as u8;
+        let channel_ids = [
+            ParamId::RcLat,
+            ParamId::RcLon,
+            ParamId::RcThr,
+            ParamId::RcPed,
+            ParamId::RcArm,
+            ParamId::RcCol,
+            ParamId::RcTest,
+            ParamId::RcMode,
+        ];
+        let sources = [
+            &mut map.lateral,
+            &mut map.longitudinal,
+            &mut map.throttle,
+            &mut map.pedal,
+            &mut map.arm,
+            &mut map.collective,
+            &mut map.test,
+            &mut map.mode,
+        ];
+        for (bit, (source, id)) in sources.into_iter().zip(channel_ids).enumerate() {
+            *source = ChannelSource {
+                channel: v(id) as u8,
+                reversed: reversed & (1 << bit) != 0,
+            };
+        }
+        map.range.min = v(ParamId::RcMin) as u16;
+        map.range.centre = v(ParamId::RcMid) as u16;
+        map.range.max = v(ParamId::RcMax) as u16;
+        map.validate().map_err(ParamsError::ChannelMap)?;
+        stack.rc_timeout_us = v(ParamId::RcTimeout) as u32 * 1000;
+
+        params.imu_rotation = ImuRotation::from_code(v(ParamId::ImuRot) as u8)
+            .ok_or(ParamsError::Value(ParamId::ImuRot))?;
+        stack.orientation = params.imu_rotation.orientation();
+        stack.filters = FilterBankConfig::helicopter(
+            stack.filters.sample_rate_hz,
+            v(ParamId::HeadRpm) / 60.0,
+            v(ParamId::TailRpm) / 60.0,
+        );
+        FilterBank::new(stack.filters).map_err(ParamsError::Filters)?;
+
+        let flight = &mut stack.app.flight;
+        let gains = [
+            (
+                &mut flight.gains.lat,
+                [
+                    ParamId::HoldLatP,
+                    ParamId::HoldLatI,
+                    ParamId::HoldLatD,
+                    ParamId::HoldLatLim,
+                ],
+            ),
+            (
+                &mut flight.gains.lon,
+                [
+                    ParamId::HoldLonP,
+                    ParamId::HoldLonI,
+                    ParamId::HoldLonD,
+                    ParamId::HoldLonLim,
+                ],
+            ),
+            (
+                &mut flight.gains.ped,
+                [
+                    ParamId::HoldPedP,
+                    ParamId::HoldPedI,
+                    ParamId::HoldPedD,
+                    ParamId::HoldPedLim,
+                ],
+            ),
+        ];
+        for (axis, [p, i, d, limit]) in gains {
+            axis.kp = v(p);
+            axis.ki = v(i);
+            axis.kd = v(d);
+            axis.output_limit = v(limit);
+            // The integrator may not exceed the output limit (AxisGains::is_valid).
+            axis.integrator_limit = axis.integrator_limit.min(axis.output_limit);
+        }
+        let test = &mut flight.test;
+        test.hold_engage_rad = v(ParamId::HoldEngage) * DEG;
+        test.hold_release_rad = v(ParamId::HoldRelease) * DEG;
+        let safety = &mut flight.safety;
+        safety.attitude_limit_rad = v(ParamId::AbortAtt) * DEG;
+        safety.rate_limit_rad_s = [
+            v(ParamId::AbortRateRoll) * DEG,
+            v(ParamId::AbortRatePitch) * DEG,
+            v(ParamId::AbortRateYaw) * DEG,
+        ];
+        safety.pilot_override = v(ParamId::AbortStick);
+
+        test.primary = *Axis::ALL
+            .get(v(ParamId::TestAxis) as usize)
+            .ok_or(ParamsError::Value(ParamId::TestAxis))?;
+        test.input = *INPUTS
+            .get(v(ParamId::TestInput) as usize)
+            .ok_or(ParamsError::Value(ParamId::TestInput))?;
+        test.mode = *MODES
+            .get(v(ParamId::TestMode) as usize)
+            .ok_or(ParamsError::Value(ParamId::TestMode))?;
+        test.sweep.t_rec_s = v(ParamId::SweepRecord);
+        test.sweep.amplitude = v(ParamId::SweepAmp);
+        test.sweep.omega_min = v(ParamId::SweepOmegaMin);
+        test.sweep.omega_max = v(ParamId::SweepOmegaMax);
+        test.sweep.fade_s = v(ParamId::SweepFade);
+        test.sweep.start_hold_cycles = v(ParamId::SweepHold) as u8;
+        test.pulse.amplitude = v(ParamId::PulseAmp);
+        test.pulse.width_s = v(ParamId::PulseWidth);
+        test.noise_rms = v(ParamId::NoiseRms);
+        test.noise_cutoff_rad_s = v(ParamId::NoiseCutoff);
+        test.seed = v(ParamId::TestSeed) as u32;
+        test.freeze_in_band = v(ParamId::TestFreeze) != 0.0;
+        flight.test.warnings = flight.validate().map_err(ParamsError::Flight)?;
+        stack.app.validate().map_err(ParamsError::App)?;
+        Ok(params)
+    }
+}
+
+/// [`InputKind`] by its `TEST_INPUT` number.
+const INPUTS: [InputKind; 4] = [
+    InputKind::Sweep,
+    InputKind::Doublet,
+    InputKind::ThreeTwoOneOne,
+    InputKind::AdaptiveSweep,
+];
+/// [`ExcitationMode`] by its `TEST_MODE` number.
+const MODES: [ExcitationMode; 3] = [
+    ExcitationMode::ConditionalAttitudeHold,
+    ExcitationMode::Standard,
+    ExcitationMode::OffAxisNoise,
+];
+
+/// A servo from (direction, centre, min, max, throw).
+fn servo_from([direction, centre, min, max, throw]: [f32; 5]) -> ServoConfig {
+    ServoConfig {
+        centre_us: centre as u16,
+        throw_us: throw,
+        min_us: min as u16,
+        max_us: max as u16,
+        reversed: direction < 0.0,
+    }
+}
+
+/// (direction, centre, min, max, throw) of a servo.
+fn servo_values(servo: &ServoConfig) -> [f32; 5] {
+    [
+        if servo.reversed { -1.0 } else { 1.0 },
+        f32::from(servo.centre_us),
+        f32::from(servo.min_us),
+        f32::from(servo.max_us),
+        servo.throw_us,
+    ]
+}
+
+/// The table values of `params` (the inverse of [`Params::from_values`] on every
+/// field a parameter sets).
+pub fn values_of(params: &Params) -> [f32; COUNT] {
+    let mut values = [0.0; COUNT];
+    let mut put = |id: ParamId, value: f32| {
+        if let Some(slot) = values.get_mut(id.index()) {
+            *slot = value;
+        }
+    };
+    let stack = &params.stack;
+    let mixer = &stack.app.flight.mixer;
+    put(ParamId::SwashType, f32::from(mixer.geometry.kind().code()));
+    put(ParamId::SwashPhase, mixer.geometry.phase_deg());
+    put(ParamId::SwashLead, f32::from(mixer.geometry.lead()));
+    let servo_ids = [
+        [
+            ParamId::Servo1Dir,
+            ParamId::Servo1Mid,
+            ParamId::Servo1Min,
+            ParamId::Servo1Max,
+            ParamId::Servo1Throw,
+        ],
+        [
+            ParamId::Servo2Dir,
+            ParamId::Servo2Mid,
+            ParamId::Servo2Min,
+            ParamId::Servo2Max,
+            ParamId::Servo2Throw,
+        ],
+        [
+            ParamId::Servo3Dir,
+            ParamId::Servo3Mid,
+            ParamId::Servo3Min,
+            ParamId::Servo3Max,
+            ParamId::Servo3Throw,
+        ],
+        [
+            ParamId::TailDir,
+            ParamId::TailMid,
+            ParamId::TailMin,
+            ParamId::TailMax,
+            ParamId::TailThrow,
+        ],
+    ];
+    let [swash1, swash2, swash3] = mixer.swash;
+    let servos = [swash1, swash2, swash3, mixer.tail];
+    for (ids, servo) in servo_ids.into_iter().zip(servos) {
+        for (id, value) in ids.into_iter().zip(servo_values(&servo)) {
+            put(id, value);
+        }
+    }
+    put(ParamId::ServoRate, f32::from(params.swash_frame_hz));
+    put(ParamId::TailRate, f32::from(params.tail_frame_hz));
+    put(
+        ParamId::CollMin,
+        mixer.collective_offset - mixer.collective_scale,
+    );
+    put(
+        ParamId::CollMax,
+        mixer.collective_offset + mixer.collective_scale,
+    );
+    put(ParamId::CycScale, mixer.cyclic_scale);
+    put(ParamId::PedScale, mixer.pedal_scale);
+    put(ParamId::CycRing, mixer.cyclic_ring);
+
+    let map = &stack.channel_map;
+    let sources = [
+        (ParamId::RcLat, map.lateral),
+        (ParamId::RcLon, map.longitudinal),
+        (ParamId::RcThr, map.throttle),
+        (ParamId::RcPed, map.pedal),
+        (ParamId::RcArm, map.arm),
+        (ParamId::RcCol, map.collective),
+        (ParamId::RcTest, map.test),
+        (ParamId::RcMode, map.mode),
+    ];
+    let mut reversed = 0u8;
+    for (bit, (id, source)) in sources.into_iter().enumerate() {
+        put(id, f32::from(source.channel));
+        reversed |= u8::from(source.reversed) << bit;
+    }
+    put(ParamId::RcRev, f32::from(reversed));
+    put(ParamId::RcMin, f32::from(map.range.min));
+    put(ParamId::RcMid, f32::from(map.range.centre));
+    put(ParamId::RcMax, f32::from(map.range.max));
+    put(ParamId::RcTimeout, (stack.rc_timeout_us / 1000) as f32);
+
+    put(ParamId::ImuRot, f32::from(params.imu_rotation.code()));
+    let notch_hz = |i: usize| {
+        stack
+            .filters
+            .notches
+            .get(i)
+            .copied()
+            .flatten()
+            .map_or(0.0, |n| n.centre_hz)
+    };
+    put(ParamId::HeadRpm, notch_hz(0) * 60.0);
+    put(ParamId::TailRpm, notch_hz(2) * 60.0);
+
+    let flight = &stack.app.flight;
+    let gains = [
+        (
+            flight.gains.lat,
+            [
+                ParamId::HoldLatP,
+                ParamId::HoldLatI,
+                ParamId::HoldLatD,
+                ParamId::HoldLatLim,
+            ],
+        ),
+        (
+            flight.gains.lon,
+            [
+                ParamId::HoldLonP,
+                ParamId::HoldLonI,
+                ParamId::HoldLonD,
+                ParamId::HoldLonLim,
+            ],
+        ),
+        (
+            flight.gains.ped,
+            [
+                ParamId::HoldPedP,
+                ParamId::HoldPedI,
+                ParamId::HoldPedD,
+                ParamId::HoldPedLim,
+            ],
+        ),
+    ];
+    for (axis, [p, i, d, limit]) in gains {
+        put(p, axis.kp);
+        put(i, axis.ki);
+        put(d, axis.kd);
+        put(limit, axis.output_limit);
+    }
+    let test = &flight.test;
+    put(ParamId::HoldEngage, test.hold_engage_rad / DEG);
+    put(ParamId::HoldRelease, test.hold_release_rad / DEG);
+    let safety = &flight.safety;
+    put(ParamId::AbortAtt, safety.attitude_limit_rad / DEG);
+    let [roll, pitch, yaw] = safety.rate_limit_rad_s;
+    put(ParamId::AbortRateRoll, roll / DEG);
+    put(ParamId::AbortRatePitch, pitch / DEG);
+    put(ParamId::AbortRateYaw, yaw / DEG);
+    put(ParamId::AbortStick, safety.pilot_override);
+
+    let position = |axis: Axis| Axis::ALL.iter().position(|a| *a == axis).unwrap_or(0);
+    put(ParamId::TestAxis, position(test.primary) as f32);
+    let input = INPUTS.iter().position(|i| *i == test.input).unwrap_or(0);
+    put(ParamId::TestInput, input as f32);
+    let mode = MODES.iter().position(|m| *m == test.mode).unwrap_or(0);
+    put(ParamId::TestMode, mode as f32);
+    put(ParamId::SweepRecord, test.sweep.t_rec_s);
+    put(ParamId::SweepAmp, test.sweep.amplitude);
+    put(ParamId::SweepOmegaMin, test.sweep.omega_min);
+    put(ParamId::SweepOmegaMax, test.sweep.omega_max);
+    put(ParamId::SweepFade, test.sweep.fade_s);
+    put(ParamId::SweepHold, f32::from(test.sweep.start_hold_cycles));
+    put(ParamId::PulseAmp, test.pulse.amplitude);
+    put(ParamId::PulseWidth, test.pulse.width_s);
+    put(ParamId::NoiseRms, test.noise_rms);
+    put(ParamId::NoiseCutoff, test.noise_cutoff_rad_s);
+    put(ParamId::TestSeed, test.seed as f32);
+    put(
+        ParamId::TestFreeze,
+        if test.freeze_in_band { 1.0 } else { 0.0 },
+    );
+    values
+}

@@ -1,0 +1,129 @@
+//! Protocol 1.5's parameter frames: round trips, their place at the end of every
+//! enum (so the older encodings stay as they were), and parameter names.
+
+mod strategies;
+
+use postcard::experimental::max_size::MaxSize;
+use proptest::prelude::*;
+use strategies::*;
+use sweephold_protocol::*;
+
+fn postcard_bytes<T: serde::Serialize>(value: &T) -> Vec<u8> {
+    let mut buffer = [0u8; 256];
+    postcard::to_slice(value, &mut buffer).unwrap().to_vec()
+}
+
+fn round_trip(frame: &Frame) -> Frame {
+    let bytes = codec::encode_to_vec(frame).unwrap().to_vec();
+    let mut decoder = Decoder::new();
+    let frames: Vec<_> = decoder.feed(&bytes).collect();
+    assert_eq!(frames.len(), 1);
+    frames[0].expect("an intact frame decodes")
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    #[test]
+    fn requests_and_replies_round_trip(request in param_request(), reply in param_reply()) {
+        let frame = Frame::ParamRequest(request);
+        prop_assert_eq!(postcard_bytes(&round_trip(&frame)), postcard_bytes(&frame));
+        let frame = Frame::ParamReply(reply);
+        prop_assert_eq!(postcard_bytes(&round_trip(&frame)), postcard_bytes(&frame));
+    }
+
+    #[test]
+    fn names_round_trip(name in "[A-Z0-9_]{1,16}") {
+        let param = ParamName::new(&name).unwrap();
+        prop_assert_eq!(param.as_str(), Some(name.as_str()));
+        let back: ParamName = postcard::from_bytes(&postcard_bytes(&param)).unwrap();
+        prop_assert_eq!(back, param);
+    }
+}
+
+#[test]
+fn parameter_frames_are_appended_and_keep_the_older_encodings() {
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 5 });
+    // Frame: ConfigureResult stays variant 6, the new frames are 7 and 8.
+    let result = Frame::ConfigureResult(ConfigureResult {
+        accepted: true,
+        refusal: 0,
+    });
+    assert_eq!(postcard_bytes(&result), [6, 1, 0]);
+    let set = Frame::ParamRequest(ParamRequest::Set {
+        name: ParamName::new("SWASH_TYPE").unwrap(),
+        value: 140.0,
+    });
+    let mut expected = vec![7, 2];
+    expected.extend_from_slice(b"SWASH_TYPE\0\0\0\0\0\0");
+    expected.extend_from_slice(&140.0f32.to_le_bytes());
+    assert_eq!(postcard_bytes(&set), expected);
+    let refused = Frame::ParamReply(ParamReply::Refused {
+        op: ParamOp::Save,
+        name: ParamName::EMPTY,
+        reason: ParamRefusal::Armed,
+    });
+    let mut expected = vec![8, 2, 3];
+    expected.extend_from_slice(&[0; 16]);
+    expected.push(0);
+    assert_eq!(postcard_bytes(&refused), expected);
+    // Event: HostLinkIgnored stays 8, ParamStore is 9.
+    let store = Event::ParamStore {
+        tick: 5,
+        status: ParamStoreStatus::OtherVersion,
+    };
+    assert_eq!(postcard_bytes(&store), [9, 5, 3]);
+    // RefusedCheck: SequencerBusy stays 6, the new checks are 7 and 8.
+    assert_eq!(postcard_bytes(&RefusedCheck::SequencerBusy), [6]);
+    assert_eq!(postcard_bytes(&RefusedCheck::ParamsInvalid), [7]);
+    assert_eq!(postcard_bytes(&RefusedCheck::NotLevel), [8]);
+    // Board streams without the new events still announce 1.4.
+    assert_eq!(
+        ProtocolVersion::BOARD_APPLICATION,
+        ProtocolVersion { major: 1, minor: 4 }
+    );
+}
+
+#[test]
+fn the_largest_frame_is_not_a_parameter_frame() {
+    // The new variants do not raise the largest frame, so every buffer sized by
+    // MAX_FRAME_LEN keeps its size.
+    let older = [
+        Header::POSTCARD_MAX_SIZE,
+        Sample::POSTCARD_MAX_SIZE,
+        Event::POSTCARD_MAX_SIZE,
+        SensorIn::POSTCARD_MAX_SIZE,
+        ActuatorOut::POSTCARD_MAX_SIZE,
+        LinkConfig::POSTCARD_MAX_SIZE,
+        ConfigureResult::POSTCARD_MAX_SIZE,
+    ]
+    .into_iter()
+    .max()
+    .unwrap();
+    assert!(ParamRequest::POSTCARD_MAX_SIZE < older);
+    assert!(ParamReply::POSTCARD_MAX_SIZE < older);
+    assert_eq!(Frame::POSTCARD_MAX_SIZE, 1 + older);
+}
+
+#[test]
+fn names_are_checked() {
+    assert!(ParamName::new("ABCDEFGHIJKLMNOP").is_some());
+    assert!(ParamName::new("ABCDEFGHIJKLMNOPQ").is_none());
+    assert!(ParamName::new("").is_none());
+    assert!(ParamName::new("SWASH TYPE").is_none());
+    assert!(ParamName::new("SWASH_TYPÉ").is_none());
+    assert_eq!(ParamName::EMPTY.as_str(), Some(""));
+    // Bytes from the wire that are not a name: a gap, or a non-ASCII byte.
+    let mut gap = [0u8; 16];
+    gap[0] = b'A';
+    gap[2] = b'B';
+    let name: ParamName = postcard::from_bytes(&gap).unwrap();
+    assert_eq!(name.as_str(), None);
+    let mut high = [0u8; 16];
+    high[0] = 0xC3;
+    let name: ParamName = postcard::from_bytes(&high).unwrap();
+    assert_eq!(name.as_str(), None);
+    assert_eq!(ParamRefusal::NotAChoice.name(), "not_a_choice");
+    assert_eq!(ParamStoreStatus::FlashError.name(), "flash_error");
+    assert_eq!(RefusedCheck::ParamsInvalid.name(), "params_invalid");
+}
