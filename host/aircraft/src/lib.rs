@@ -18,11 +18,14 @@
 #![warn(missing_docs)]
 
 mod check;
+mod flight_controller;
 pub mod quantity;
+mod reader;
 mod schema;
 
 use std::path::{Path, PathBuf};
 
+pub use flight_controller::{FlightController, HoldGains, HoldReference, FIRMWARE_PRESETS};
 pub use quantity::{Dimension, Quantity};
 
 /// A helicopter as its aircraft file describes it. Values in SI units, body axes x
@@ -55,18 +58,6 @@ pub struct Aircraft {
     pub flight_controller: FlightController,
     /// How the campaign identifies it.
     pub identification: Identification,
-}
-
-/// The firmware presets a flight controller can fly: an aircraft names the one its
-/// controller's hold gains, limits, pedal scale and pilot mode come from (the board image
-/// is built with them; they are not yet parameters of the board).
-pub const FIRMWARE_PRESETS: [&str; 2] = ["bo105", "trex700l"];
-
-/// What the flight controller flies.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FlightController {
-    /// The firmware preset, one of [`FIRMWARE_PRESETS`].
-    pub preset: String,
 }
 
 /// The campaign's settings for this aircraft.
