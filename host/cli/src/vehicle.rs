@@ -166,6 +166,15 @@ impl Vehicle {
             .map(|[low, high]| (low, high))
     }
 
+    /// The a-priori constants the 9-DOF structure takes from the file, with their σ.
+    pub fn file_constants(&self) -> anyhow::Result<Vec<truth::FileConstant>> {
+        let structure = self.structure();
+        let shipped = truth::hybrid_structures()
+            .find(|file| file.name == structure)
+            .ok_or_else(|| anyhow::anyhow!("no shipped 9-DOF hybrid `{structure}`"))?;
+        Ok(truth::file_constants(shipped, &self.aircraft)?)
+    }
+
     /// The shipped 9-DOF hybrid structure the campaign fits.
     pub fn structure(&self) -> &str {
         &self.aircraft.identification.structure
