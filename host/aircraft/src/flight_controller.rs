@@ -16,8 +16,9 @@ use crate::schema::{self, Value, Values};
 use crate::AircraftError;
 
 /// The firmware presets a flight controller can fly: an aircraft names the one its
-/// controller's settings default to (the board image is built with one; it takes no
-/// parameters yet, so a board flies its preset whatever the file states).
+/// controller's settings default to. A board image is built with one preset and takes no
+/// parameters yet: the command line flies a file's own settings in-process and on the
+/// simulated board, and its links to a real or emulated board refuse them.
 pub const FIRMWARE_PRESETS: [&str; 2] = ["bo105", "trex700l"];
 
 /// What the flight controller flies. Each `Option` is `None` when the file leaves the
