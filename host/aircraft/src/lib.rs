@@ -18,11 +18,14 @@
 #![warn(missing_docs)]
 
 mod check;
+mod flight_controller;
 pub mod quantity;
+mod reader;
 mod schema;
 
 use std::path::{Path, PathBuf};
 
+pub use flight_controller::{FlightController, HoldGains, HoldReference, FIRMWARE_PRESETS};
 pub use quantity::{Dimension, Quantity};
 
 /// A helicopter as its aircraft file describes it. Values in SI units, body axes x
@@ -57,16 +60,60 @@ pub struct Aircraft {
     pub identification: Identification,
 }
 
-/// The firmware presets a flight controller can fly: an aircraft names the one its
-/// controller's hold gains, limits, pedal scale and pilot mode come from (the board image
-/// is built with them; they are not yet parameters of the board).
-pub const FIRMWARE_PRESETS: [&str; 2] = ["bo105", "trex700l"];
-
-/// What the flight controller flies.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FlightController {
-    /// The firmware preset, one of [`FIRMWARE_PRESETS`].
-    pub preset: String,
+impl Aircraft {
+    /// Every physical value of the file, each with its σ, in file order: for a caller that
+    /// propagates the file's uncertainties by varying one value at a time.
+    pub fn quantities_mut(&mut self) -> Vec<&mut Quantity> {
+        let Aircraft {
+            environment: e,
+            airframe: a,
+            main_rotor: m,
+            tail_rotor: t,
+            fin,
+            tailplane,
+            controls: c,
+            servos: s,
+            ..
+        } = self;
+        let mut all = vec![&mut e.air_density, &mut e.gravity];
+        all.extend([&mut a.mass, &mut a.ixx, &mut a.iyy, &mut a.izz, &mut a.ixz]);
+        all.extend(a.drag_area.iter_mut());
+        all.extend([
+            &mut m.radius,
+            &mut m.head_speed,
+            &mut m.chord,
+            &mut m.twist,
+            &mut m.lift_slope,
+            &mut m.flap_inertia,
+            &mut m.hub_stiffness,
+        ]);
+        all.extend(m.profile_drag.iter_mut());
+        all.extend(m.hub.iter_mut());
+        all.push(&mut m.shaft_tilt);
+        all.extend([&mut t.radius, &mut t.speed, &mut t.chord, &mut t.twist]);
+        all.push(&mut t.lift_slope);
+        all.extend(t.profile_drag.iter_mut());
+        all.extend(t.hub.iter_mut());
+        for surface in [fin, tailplane] {
+            all.extend([
+                &mut surface.area,
+                &mut surface.incidence,
+                &mut surface.lift_slope,
+                &mut surface.stall_angle,
+            ]);
+            all.extend(surface.position.iter_mut());
+        }
+        for gearing in [&mut c.lat, &mut c.lon, &mut c.ped, &mut c.col] {
+            all.extend([&mut gearing.centre, &mut gearing.per_stick]);
+        }
+        all.extend([
+            &mut s.natural_frequency,
+            &mut s.damping,
+            &mut s.rate_limit,
+            &mut s.transport_delay,
+        ]);
+        all
+    }
 }
 
 /// The campaign's settings for this aircraft.

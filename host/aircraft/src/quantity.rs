@@ -49,6 +49,10 @@ pub enum Dimension {
     PerAngle,
     /// N·m/rad (a hub spring).
     Stiffness,
+    /// 1/(rad·s) (an integral gain: stick fraction per radian-second).
+    PerAngleTime,
+    /// s/rad (a rate gain: stick fraction per rad/s).
+    TimePerAngle,
     /// s.
     Time,
     /// 1/s (a rate of a dimensionless quantity, e.g. stick fraction per second).
@@ -68,11 +72,13 @@ impl Dimension {
             Dimension::Area => &[("m^2", Si), ("cm^2", Per(1e4)), ("mm^2", Per(1e6))],
             Dimension::Inertia => &[("kg*m^2", Si), ("g*cm^2", Per(1e7)), ("kg*cm^2", Per(1e4))],
             Dimension::Angle => &[("rad", Si), ("deg", Degrees), ("°", Degrees)],
-            Dimension::AngularSpeed => &[("rad/s", Si), ("rpm", Rpm)],
+            Dimension::AngularSpeed => &[("rad/s", Si), ("rpm", Rpm), ("deg/s", Degrees)],
             Dimension::Density => &[("kg/m^3", Si)],
             Dimension::Acceleration => &[("m/s^2", Si)],
             Dimension::PerAngle => &[("/rad", Si), ("1/rad", Si)],
             Dimension::Stiffness => &[("N*m/rad", Si)],
+            Dimension::PerAngleTime => &[("/(rad*s)", Si), ("1/(rad*s)", Si)],
+            Dimension::TimePerAngle => &[("s/rad", Si)],
             Dimension::Time => &[("s", Si), ("ms", Per(1e3))],
             Dimension::PerTime => &[("/s", Si), ("1/s", Si)],
             Dimension::Dimensionless => &[],

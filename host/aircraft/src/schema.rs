@@ -52,6 +52,48 @@ pub(crate) struct File {
 #[serde(deny_unknown_fields)]
 pub(crate) struct FlightController {
     pub preset: Spanned<String>,
+    pub hold_reference: Option<Spanned<String>>,
+    pub hold_engage: Option<Value>,
+    pub hold_release: Option<Value>,
+    pub pulse_width: Option<Value>,
+    pub excitation_scale: Option<Values>,
+    pub command_slew: Option<PerControl>,
+    pub attitude_limit: Option<Value>,
+    pub rate_limits: Option<Values>,
+    pub pilot_override: Option<Value>,
+    pub hold: Option<Hold>,
+}
+
+/// A value per control, each optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PerControl {
+    pub lat: Option<Value>,
+    pub lon: Option<Value>,
+    pub ped: Option<Value>,
+    pub col: Option<Value>,
+}
+
+/// The attitude hold's gains of the three held axes, each optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Hold {
+    pub lat: Option<HoldAxis>,
+    pub lon: Option<HoldAxis>,
+    pub ped: Option<HoldAxis>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct HoldAxis {
+    pub kp: Option<Value>,
+    pub ki: Option<Value>,
+    pub kd: Option<Value>,
+    pub output_limit: Option<Value>,
+    pub integrator_limit: Option<Value>,
+    pub bumpless_time: Option<Value>,
+    pub release_time: Option<Value>,
+    pub reversed: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

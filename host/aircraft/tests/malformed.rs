@@ -279,3 +279,179 @@ fn the_shipped_files_read_and_a_file_on_disk_reads_like_its_text() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// (what is wrong, the `[flight_controller]` setting added after `preset`, fragment the
+/// message must hold)
+const SETTING_CASES: &[(&str, &str, &str)] = &[
+    (
+        "gain in the wrong unit",
+        "hold.lat = { kp = \"1.5 s/rad\" }",
+        "flight_controller.hold.lat.kp: `1.5 s/rad`: unit `s/rad` is not one of /rad, 1/rad",
+    ),
+    (
+        "gain without unit",
+        "hold.lon = { kd = 0.2 }",
+        "flight_controller.hold.lon.kd: `0.2` has no unit",
+    ),
+    (
+        "negative gain",
+        "hold.ped = { ki = \"-0.05 /(rad*s)\" }",
+        "flight_controller.hold.ped.ki: -0.05 must be between 0 and 100",
+    ),
+    (
+        "NaN gain",
+        "hold.lat = { kp = \"nan /rad\" }",
+        "flight_controller.hold.lat.kp: the value is not a finite number",
+    ),
+    (
+        "authority above full travel",
+        "hold.lat = { output_limit = 1.5 }",
+        "flight_controller.hold.lat.output_limit: 1.5 must be positive and at most 1",
+    ),
+    (
+        "integrator above the authority",
+        "hold.lon = { output_limit = 0.2, integrator_limit = 0.3 }",
+        "flight_controller.hold.lon.integrator_limit: must not exceed output_limit",
+    ),
+    (
+        "a gain with an uncertainty",
+        "hold.lat = { kp = \"1.5 ± 0.1 /rad\" }",
+        "flight_controller.hold.lat.kp: a flight-controller setting is chosen",
+    ),
+    (
+        "unknown hold key",
+        "hold.lat = { kf = \"1 /rad\" }",
+        "unknown field `kf`",
+    ),
+    (
+        "unknown held axis",
+        "hold.col = { kp = \"1 /rad\" }",
+        "unknown field `col`",
+    ),
+    (
+        "unknown setting",
+        "sweep_gain = 2",
+        "unknown field `sweep_gain`",
+    ),
+    (
+        "engage angle of zero",
+        "hold_engage = \"0 deg\"",
+        "flight_controller.hold_engage: 0 must be positive",
+    ),
+    (
+        "engage angle in metres",
+        "hold_engage = \"6 m\"",
+        "flight_controller.hold_engage: `6 m`: unit `m` is not one of rad, deg",
+    ),
+    (
+        "release beyond engage",
+        "hold_engage = \"5 deg\"\nhold_release = \"6 deg\"",
+        "flight_controller.hold_release: must not exceed hold_engage",
+    ),
+    (
+        "unknown hold reference",
+        "hold_reference = \"horizon\"",
+        "flight_controller.hold_reference: `horizon`: expected level or trim",
+    ),
+    (
+        "excitation scale above one",
+        "excitation_scale = [1.0, 1.2, 0.2, 1.0]",
+        "flight_controller.excitation_scale[1]: 1.2 must be positive and at most 1",
+    ),
+    (
+        "excitation scale of zero",
+        "excitation_scale = [1.0, 1.0, 0.0, 1.0]",
+        "flight_controller.excitation_scale[2]: 0 must be positive",
+    ),
+    (
+        "three excitation scales",
+        "excitation_scale = [1.0, 1.0, 0.2]",
+        "flight_controller.excitation_scale: expected 4 values, found 3",
+    ),
+    (
+        "slew without a rate unit",
+        "command_slew = { ped = \"4 s\" }",
+        "flight_controller.command_slew.ped: `4 s`: unit `s` is not one of /s, 1/s",
+    ),
+    (
+        "negative rate limit",
+        "rate_limits = [\"200 deg/s\", \"-200 deg/s\", \"250 deg/s\"]",
+        "flight_controller.rate_limits[1]: -3.49",
+    ),
+    (
+        "pulse width of a minute and more",
+        "pulse_width = \"61 s\"",
+        "flight_controller.pulse_width: 61 must be positive and at most 60",
+    ),
+    (
+        "attitude limit beyond 90 degrees",
+        "attitude_limit = \"100 deg\"",
+        "flight_controller.attitude_limit: 1.745",
+    ),
+    (
+        "negative fade",
+        "hold.lat = { release_time = \"-0.3 s\" }",
+        "flight_controller.hold.lat.release_time: -0.3 must be between 0 and 10",
+    ),
+];
+
+#[test]
+fn every_malformed_flight_controller_setting_is_refused_on_its_line() {
+    assert!(SETTING_CASES.len() >= 20);
+    let preset = "preset = \"trex700l\"\n";
+    assert!(TREX.contains(preset));
+    for (what, setting, expected) in SETTING_CASES {
+        let text = TREX.replacen(preset, &format!("{preset}{setting}\n"), 1);
+        let error = aircraft::parse(&text, "variant.toml")
+            .err()
+            .unwrap_or_else(|| panic!("{what}: accepted"))
+            .to_string();
+        assert!(
+            error.contains(expected),
+            "{what}: `{error}` lacks `{expected}`"
+        );
+        assert!(!error.contains('\n'), "{what}: more than one line: {error}");
+        // The line named is one of the lines added (after the preset's).
+        let first = 1 + text
+            .lines()
+            .position(|l| l.starts_with("preset ="))
+            .unwrap();
+        let added = first + 1..=first + setting.lines().count();
+        let line: usize = error.split(':').nth(1).unwrap().parse().unwrap();
+        assert!(added.contains(&line), "{what}: line {line} of {added:?}");
+    }
+}
+
+#[test]
+fn flight_controller_settings_read_in_si_and_default_to_none() {
+    let settings = "preset = \"trex700l\"\nhold_reference = \"level\"\nhold_engage = \"5 deg\"\n\
+         hold_release = \"3 deg\"\npulse_width = \"300 ms\"\n\
+         excitation_scale = [0.9, 0.8, 0.2, 1.0]\ncommand_slew = { ped = \"4 /s\" }\n\
+         attitude_limit = \"20 deg\"\nrate_limits = [\"180 deg/s\", \"3 rad/s\", \"250 deg/s\"]\n\
+         pilot_override = 0.1\n\
+         hold.lon = { kp = \"2.5 /rad\", ki = \"0.1 /(rad s)\", kd = \"0.2 s/rad\", reversed = true }\n";
+    let text = TREX.replacen("preset = \"trex700l\"\n", settings, 1);
+    let read = aircraft::parse(&text, "variant.toml")
+        .unwrap()
+        .flight_controller;
+    let deg = std::f64::consts::PI / 180.0;
+    assert_eq!(read.hold_reference, Some(aircraft::HoldReference::Level));
+    assert_eq!(read.hold_engage, Some(5.0 * deg));
+    assert_eq!(read.hold_release, Some(3.0 * deg));
+    assert_eq!(read.pulse_width, Some(0.3));
+    assert_eq!(read.excitation_scale, Some([0.9, 0.8, 0.2, 1.0]));
+    assert_eq!(read.command_slew, Some([None, None, Some(4.0), None]));
+    assert_eq!(read.rate_limits, Some([180.0 * deg, 3.0, 250.0 * deg]));
+    assert_eq!(read.pilot_override, Some(0.1));
+    let lon = read.hold[1];
+    assert_eq!(
+        (lon.kp, lon.ki, lon.kd, lon.reversed),
+        (Some(2.5), Some(0.1), Some(0.2), Some(true))
+    );
+    assert_eq!(lon.output_limit, None);
+    assert_eq!(read.hold[0], aircraft::HoldGains::default());
+    assert!(read.states_settings());
+    let shipped = aircraft::shipped("trex700l").unwrap().flight_controller;
+    assert!(!shipped.states_settings());
+    assert_eq!(shipped.preset, "trex700l");
+}

@@ -1,7 +1,9 @@
 //! The flown aircraft, and everything the command line takes from it: a shipped aircraft
 //! (`bo105`, `trex700l`, `fbl700`) or an aircraft file (`docs/formats.md`, "Aircraft files"), read
 //! once when the command line is. The simulator flies its physical description; the
-//! flight controller flies the firmware preset it names; the campaign takes its sweep
+//! flight controller flies the firmware preset it names with the settings the file states
+//! in its place (hold gains and thresholds, excitation scale, slew, abort limits); the
+//! campaign takes its sweep
 //! bands, 9-DOF structure, trim balance and valid-range source from it. This is the one
 //! place of the tool that turns an aircraft into those settings: the verbs ask it and do
 //! not branch on vehicles.
@@ -11,7 +13,7 @@ use std::sync::Arc;
 
 use aircraft::{Aircraft, TrimBalance, ValidRanges};
 use bo105::{ActuatorModel, Helicopter};
-use sweephold_firmware::Config;
+use sweephold_firmware::{Config, HoldReference};
 use sweephold_protocol::{Axis, VehicleId};
 use sysid::frf::RangeSource;
 
@@ -47,11 +49,24 @@ impl Vehicle {
                     .join(", ")
             ));
         }
-        Ok(Vehicle {
+        let vehicle = Vehicle {
             given: given.to_string(),
             aircraft: Arc::new(aircraft),
             preset,
-        })
+        };
+        // The file's settings are checked one by one when it is read; here, with the
+        // preset's in the places it leaves, as the firmware will check them.
+        for axis in Axis::ALL {
+            if let Err(error) = vehicle.firmware_config(axis).validate() {
+                return Err(format!(
+                    "aircraft `{}`: flight_controller: with preset `{}`'s other settings: \
+                     {error}",
+                    vehicle.name(),
+                    vehicle.aircraft.flight_controller.preset
+                ));
+            }
+        }
+        Ok(vehicle)
     }
 
     /// A shipped aircraft (`bo105`, `trex700l`, `fbl700`).
@@ -92,9 +107,55 @@ impl Vehicle {
         self.preset
     }
 
-    /// The firmware's configuration for a test of `axis`: its preset.
+    /// The firmware's configuration for a test of `axis`: its preset, with each setting the
+    /// file's `[flight_controller]` states in place of the preset's (the settings the file
+    /// leaves out stay the preset's to the bit).
     pub fn firmware_config(&self, axis: Axis) -> Config {
-        Config::preset(self.preset, axis)
+        let mut config = Config::preset(self.preset, axis);
+        let file = &self.aircraft.flight_controller;
+        let set = |slot: &mut f32, value: Option<f64>| {
+            if let Some(value) = value {
+                *slot = value as f32;
+            }
+        };
+        if let Some(reference) = file.hold_reference {
+            config.hold_reference = match reference {
+                aircraft::HoldReference::Level => HoldReference::Level,
+                aircraft::HoldReference::Trim => HoldReference::Trim,
+            };
+        }
+        set(&mut config.test.hold_engage_rad, file.hold_engage);
+        set(&mut config.test.hold_release_rad, file.hold_release);
+        set(&mut config.test.pulse.width_s, file.pulse_width);
+        if let Some(scale) = file.excitation_scale {
+            config.excitation_scale.per_axis = scale.map(|s| s as f32);
+        }
+        if let Some(slew) = file.command_slew {
+            config.slew.per_s = slew.map(|rate| rate.map_or(f32::INFINITY, |r| r as f32));
+        }
+        set(&mut config.safety.attitude_limit_rad, file.attitude_limit);
+        if let Some(limits) = file.rate_limits {
+            config.safety.rate_limit_rad_s = limits.map(|l| l as f32);
+        }
+        set(&mut config.safety.pilot_override, file.pilot_override);
+        let held = [
+            &mut config.gains.lat,
+            &mut config.gains.lon,
+            &mut config.gains.ped,
+        ];
+        for (gains, stated) in held.into_iter().zip(&file.hold) {
+            set(&mut gains.kp, stated.kp);
+            set(&mut gains.ki, stated.ki);
+            set(&mut gains.kd, stated.kd);
+            set(&mut gains.output_limit, stated.output_limit);
+            set(&mut gains.integrator_limit, stated.integrator_limit);
+            set(&mut gains.bumpless_time_s, stated.bumpless_time);
+            set(&mut gains.release_time_s, stated.release_time);
+            if let Some(reversed) = stated.reversed {
+                gains.reversed = reversed;
+            }
+        }
+        config
     }
 
     /// The two sweep bands flown per axis [rad/s].
@@ -103,6 +164,15 @@ impl Vehicle {
             .identification
             .sweep_bands
             .map(|[low, high]| (low, high))
+    }
+
+    /// The a-priori constants the 9-DOF structure takes from the file, with their σ.
+    pub fn file_constants(&self) -> anyhow::Result<Vec<truth::FileConstant>> {
+        let structure = self.structure();
+        let shipped = truth::hybrid_structures()
+            .find(|file| file.name == structure)
+            .ok_or_else(|| anyhow::anyhow!("no shipped 9-DOF hybrid `{structure}`"))?;
+        Ok(truth::file_constants(shipped, &self.aircraft)?)
     }
 
     /// The shipped 9-DOF hybrid structure the campaign fits.
@@ -164,6 +234,57 @@ mod tests {
         assert_eq!(trex.trim_balance(), TrimBalance::Joint);
         assert_eq!(trex.range_source(), RangeSource::Estimate);
         assert_eq!(trex.servos(), bo105::SimOptions::default().actuator);
+        // The third flies the TREX's preset with the gains and cyclic excitation its file
+        // states, and the preset's everything else.
+        let fbl = Vehicle::shipped("fbl700");
+        assert_eq!(fbl.preset(), VehicleId::Trex700l);
+        let own = fbl.firmware_config(Axis::Lat);
+        let mut expected = Config::trex700l_default(Axis::Lat);
+        expected.excitation_scale.per_axis = [0.7, 0.7, 0.2, 1.0];
+        for (gains, [kp, ki, kd]) in [
+            (&mut expected.gains.lat, [2.12, 0.07, 0.113]),
+            (&mut expected.gains.lon, [2.94, 0.074, 0.22]),
+            (&mut expected.gains.ped, [0.545, 0.045, 0.109]),
+        ] {
+            (gains.kp, gains.ki, gains.kd) = (kp, ki, kd);
+        }
+        assert_eq!(own, expected);
+    }
+
+    #[test]
+    fn a_files_flight_settings_replace_the_presets_and_only_those() {
+        let dir = std::env::temp_dir().join(format!("vehicle-fc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let trex = aircraft::SHIPPED[1].1;
+        let preset = "preset = \"trex700l\"\n";
+        let settings = "hold_engage = \"5 deg\"\nexcitation_scale = [0.8, 0.9, 0.2, 1.0]\n\
+             command_slew = { lon = \"3 /s\" }\nrate_limits = [\"3 rad/s\", \"3 rad/s\", \"4 rad/s\"]\n\
+             hold.lon = { kp = \"2.5 /rad\", release_time = \"0.2 s\" }\n";
+        let path = dir.join("tuned.toml");
+        std::fs::write(&path, trex.replace(preset, &format!("{preset}{settings}"))).unwrap();
+        let tuned = Vehicle::parse(path.to_str().unwrap()).unwrap();
+        let got = tuned.firmware_config(Axis::Lon);
+        let mut expected = Config::trex700l_default(Axis::Lon);
+        expected.test.hold_engage_rad = (5.0 * std::f64::consts::PI / 180.0) as f32;
+        expected.excitation_scale.per_axis = [0.8, 0.9, 0.2, 1.0];
+        expected.slew.per_s = [f32::INFINITY, 3.0, f32::INFINITY, f32::INFINITY];
+        expected.safety.rate_limit_rad_s = [3.0, 3.0, 4.0];
+        expected.gains.lon.kp = 2.5;
+        expected.gains.lon.release_time_s = 0.2;
+        assert_eq!(got, expected);
+        // A setting that is valid alone but not with the preset's others: one line.
+        let clash = "hold.lat = { integrator_limit = 0.5 }\n";
+        std::fs::write(&path, trex.replace(preset, &format!("{preset}{clash}"))).unwrap();
+        let error = Vehicle::parse(path.to_str().unwrap()).unwrap_err();
+        assert!(
+            error.contains(
+                "flight_controller: with preset `trex700l`'s other settings: \
+                 attitude-hold gains or limits invalid"
+            ),
+            "{error}"
+        );
+        assert!(!error.contains('\n'));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -125,6 +125,21 @@ fn an_aircraft_file_is_simulated_flown_and_identified_with_its_own_numbers() {
         .expect("the TREX hybrid's servos");
     let servo = actuators.iter().find(|a| !a.is_null()).expect("a servo");
     assert_eq!(servo["natural_frequency_rad_s"], 51.0, "{servo}");
+    // The file's σ reaches the constants it enters: the mass, written 5.6 ± 0.05 kg, makes
+    // M/I_yy = 5.6/0.48 uncertain by 0.05/0.48; the hub height has no σ in the file.
+    let constants = model["aircraft_constants"]
+        .as_array()
+        .expect("aircraft_constants: the file gives a σ");
+    let constant = |name: &str| {
+        constants
+            .iter()
+            .find(|c| c["name"] == name)
+            .unwrap_or_else(|| panic!("{name} in {constants:?}"))
+    };
+    let ratio = constant("mass_over_iyy");
+    assert!((ratio["value"].as_f64().unwrap() - 5.6 / 0.48).abs() < 1e-12);
+    assert!((ratio["sigma"].as_f64().unwrap() - 0.05 / 0.48).abs() < 1e-12);
+    assert_eq!(constant("hub_height").get("sigma"), None);
     // The flight controller flew the firmware preset the file names (the Header's vehicle).
     let jsonl = dir.join("lat-1.jsonl");
     let decode = sweephold(&[

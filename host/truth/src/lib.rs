@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod file_constants;
 mod flap_rows;
 mod folded_flapping;
 pub mod scoring;
@@ -29,6 +30,7 @@ pub mod vehicle_data;
 pub mod vehicle_truth;
 
 pub use error::Error;
+pub use file_constants::{file_constants, FileConstant};
 pub use scoring::{score_fit, score_fit_with_modes, ScoredFit, TRUTH_POINTS_PER_PAIR};
 pub use structure_truth::{structure_truth, StructureTruth};
 pub use vehicle_data::{hybrid_structures, nine_dof_hybrid, with_vehicle_data, TrimAttitude};

@@ -79,12 +79,35 @@ pub fn with_vehicle_data(
 ) -> Result<ModelStructure, StructureError> {
     let declared = shipped.parse()?.constants;
     let helicopter = Helicopter::from_aircraft(aircraft);
+    let mut constants = vehicle_constants(aircraft);
+    if let Some(trim) = trim {
+        for (name, value) in trim.constants() {
+            constants.insert(name.to_string(), value);
+        }
+    }
+    constants.retain(|name, _| declared.contains_key(name));
+    constants.extend(overrides.iter().map(|(name, &value)| (name.clone(), value)));
+    let mut structure = shipped.parse_with_constants(&constants)?;
+    if let Some(index) = structure.parameter_index("Kcs") {
+        let parameter = &mut structure.parameters[index];
+        // Only a fixed entry is a rotor-data prior; a free one stays the fit's to find.
+        if parameter.kind == ParameterKind::Fixed {
+            parameter.value = helicopter.flap_cross_coupling();
+        }
+    }
+    Ok(structure)
+}
+
+/// The constants a structure may declare that come from the aircraft file, by name, as
+/// [`with_vehicle_data`] puts them in (the trim attitude's and `Kcs` aside).
+pub(crate) fn vehicle_constants(aircraft: &Aircraft) -> BTreeMap<String, f64> {
+    let helicopter = Helicopter::from_aircraft(aircraft);
     // The hub is at body (x, z) = (hub[0], hub[2]) from the CG, z down: its height above
     // the CG is −hub[2].
     let hub = helicopter.main_rotor.hub;
     // The servos of the aircraft file, which `sweephold fly` flies with too.
     let servo = ActuatorModel::from_aircraft(aircraft);
-    let mut constants = BTreeMap::from([
+    BTreeMap::from([
         ("hub_height".to_string(), -hub[2]),
         ("hub_forward".to_string(), hub[0]),
         ("shaft_tilt_sine".to_string(), helicopter.shaft_tilt.sin()),
@@ -107,23 +130,7 @@ pub fn with_vehicle_data(
             "mass_over_iyy".to_string(),
             helicopter.mass / helicopter.iyy,
         ),
-    ]);
-    if let Some(trim) = trim {
-        for (name, value) in trim.constants() {
-            constants.insert(name.to_string(), value);
-        }
-    }
-    constants.retain(|name, _| declared.contains_key(name));
-    constants.extend(overrides.iter().map(|(name, &value)| (name.clone(), value)));
-    let mut structure = shipped.parse_with_constants(&constants)?;
-    if let Some(index) = structure.parameter_index("Kcs") {
-        let parameter = &mut structure.parameters[index];
-        // Only a fixed entry is a rotor-data prior; a free one stays the fit's to find.
-        if parameter.kind == ParameterKind::Fixed {
-            parameter.value = helicopter.flap_cross_coupling();
-        }
-    }
-    Ok(structure)
+    ])
 }
 
 #[cfg(test)]

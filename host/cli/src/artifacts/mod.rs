@@ -3,8 +3,10 @@
 //! ([`summary`]), `truth-model9.json` ([`truth_model`]), `verify.json` ([`verification`]),
 //! the stage names `summary.json` keys its timings by ([`stage`]), where each file lies
 //! ([`files`]), and what the report draws from the dumps ([`flown`]), which a campaign
-//! hands over as it decoded it.
+//! hands over as it decoded it; `model9.json`'s aircraft constants with their σ
+//! ([`aircraft_constants`]).
 
+pub mod aircraft_constants;
 pub mod files;
 pub mod flown;
 pub mod stage;

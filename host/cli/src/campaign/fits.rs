@@ -15,6 +15,7 @@ use sysid::fit::{fit_from_alternative_starts, start_from_quasi_steady, FitResult
 use sysid::models;
 
 use super::{verb_args, Campaign, TrimPointsArg};
+use crate::artifacts::aircraft_constants::write_model;
 use crate::artifacts::files;
 use crate::artifacts::stage::Stage;
 use crate::artifacts::summary::{
@@ -151,7 +152,11 @@ impl Campaign<'_> {
         ];
         let options = args.options(trim_points.clone());
         let (result, _outcomes) = fit_from_alternative_starts(&starts, frf, &options)?;
-        write_json(&out_path(&args)?, &result.to_document())?;
+        write_model(
+            &out_path(&args)?,
+            &result.to_document(),
+            &self.args.vehicle.file_constants()?,
+        )?;
         self.summary.fit = Some(fit_summary(&result, six.average_cost));
         let line = format!(
             "{}: J_ave {:.1}, {} reduction step(s)",

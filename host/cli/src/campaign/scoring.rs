@@ -8,6 +8,7 @@ use sysid::fit::FitResult;
 
 use super::fits::speed_derivatives;
 use super::Campaign;
+use crate::artifacts::aircraft_constants::write_model;
 use crate::artifacts::files;
 use crate::artifacts::truth_model::TruthModelDocument;
 use crate::output::write_json;
@@ -71,7 +72,11 @@ impl Campaign<'_> {
                 .map(|compared| compared.identified)
                 .unwrap_or_default(),
         };
-        write_json(&self.dir().join(files::MODEL_9DOF), &document)?;
+        write_model(
+            &self.dir().join(files::MODEL_9DOF),
+            &document,
+            &vehicle.file_constants()?,
+        )?;
         Ok(((), line))
     }
 }
