@@ -541,7 +541,7 @@ impl StagedFolder {
 }
 
 /// `DIR.<suffix>` beside `dir`.
-fn sibling(dir: &Path, suffix: &str) -> anyhow::Result<PathBuf> {
+pub(crate) fn sibling(dir: &Path, suffix: &str) -> anyhow::Result<PathBuf> {
     let name = dir
         .file_name()
         .filter(|n| !n.is_empty() && *n != "." && *n != "..")
