@@ -393,7 +393,7 @@ pub fn run(args: &DecodeArgs) -> anyhow::Result<()> {
     }
     if !args.quiet {
         for dump in &empty {
-            eprintln!("warning: no valid frame in {dump}");
+            crate::note!("warning: no valid frame in {dump}");
         }
     }
     Ok(())
@@ -418,8 +418,8 @@ fn print_summary(path: &Path, s: &DumpSummary, list_events: bool) {
     let duration = s
         .duration_s()
         .map_or("unknown".to_string(), |d| format!("{d:.3} s"));
-    eprintln!("{}:", path.display());
-    eprintln!(
+    crate::note!("{}:", path.display());
+    crate::note!(
         "  {} bytes, {} good frames ({} samples, {} events), {} corrupt frames skipped, {} tick gaps, {} tick steps back",
         st.bytes,
         st.good_frames,
@@ -429,12 +429,12 @@ fn print_summary(path: &Path, s: &DumpSummary, list_events: bool) {
         st.tick_gaps,
         st.tick_steps_back
     );
-    eprintln!(
+    crate::note!(
         "  duration {duration}, vehicle {vehicle}, rate {rate}, protocol {protocol}, firmware {firmware}"
     );
     if list_events {
         for event in &s.events {
-            eprintln!("  {}", event_text(event));
+            crate::note!("  {}", event_text(event));
         }
     }
 }

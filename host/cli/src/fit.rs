@@ -18,13 +18,12 @@ use sysid::fit::modes::{
     eigenvalue_text, hover_summary, mode_records, mode_table, origin_text, poles_at_origin,
     ModeComparison, ModeError, ModeRecord, HOVER_MODE_LIMIT_RAD_S,
 };
+use sysid::fit::plausible::{describe, implausible_parameters};
 use sysid::fit::report::{
     cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
     TruthSection,
 };
-use sysid::fit::trim::{
-    implausible_derivation, TrimBalance, TrimPoints, PLAUSIBLE_DERIVED_MAGNITUDE,
-};
+use sysid::fit::trim::{TrimBalance, TrimPoints};
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
 };
@@ -37,7 +36,11 @@ use sysid::fit::{
 paper's Table 2), trex700l-6dof and trex700l-9dof-hybrid (the same structures with the TREX \
 700L's geometry, flap cross-coupling and hover trim). The structure file format and the \
 model.json layout are described in the models README of the sysid crate.\n\nGuidelines (paper, Tischler & Remple): J_ave <= 100 acceptable, \
-<= 50 excellent; Cramér–Rao bound <= 20 %, insensitivity <= 10 %, |correlation| <= 0.9."
+<= 50 excellent; Cramér–Rao bound <= 20 %, insensitivity <= 10 %, |correlation| <= 0.9.\n\n\
+Physical ranges: every fitted parameter is judged by its part of each F or G entry against \
+that entry's dimension (e.g. 1000 m/s² per stick, 300 /s, 100 rad/s² per m/s); a fit outside \
+is run again with those parameters held at their start values, and exits 1 without a model \
+when that fails (docs/method.md, physical ranges)."
 )]
 pub struct FitArgs {
     /// Frequency responses to fit (`frf.json` as `sweephold frf` writes it).
@@ -89,8 +92,9 @@ pub struct FitArgs {
     /// parameters (the shipped 6-DOF: Lv Mu Nv Zw Nr; the hybrid: Mfu Lfu Nv Zw Nr) are
     /// derived from the steady-state balance at the points and held (status `trim`) until
     /// they settle; `--trim-balance` says what follows. Implausible, repeated or collinear
-    /// points are refused, and a fit whose derived parameters exceed 100 in magnitude is
-    /// degenerate: no model is written (the 6-DOF on the campaign's responses).
+    /// points are refused. Like any fit, one whose parameters land outside physical ranges
+    /// is run again with them held at their start values, and no model is written when
+    /// that does not bring them inside.
     #[arg(long, value_name = "FILE")]
     pub trim_points: Option<PathBuf>,
     /// How the trim points enter the fit: `hold` keeps the derived parameters at the
@@ -320,20 +324,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             args.frf.display()
         );
     }
-    if let Some(derived) = result.trim.as_ref().and_then(implausible_derivation) {
-        bail!(
-            "the fit is degenerate: the trim points gave `{}` = {:.3e}, orders of magnitude \
-             beyond a speed or rate derivative (|value| <= {}); the balance scales the \
-             fitted control derivatives, which {} leaves undetermined for {} (a degenerate \
-             minimum): fit without --trim-points or with a structure the responses \
-             determine; no model written",
-            derived.name,
-            derived.value,
-            PLAUSIBLE_DERIVED_MAGNITUDE,
-            args.frf.display(),
-            result.structure.name
-        );
-    }
+    refuse_implausible(&result, &args.frf)?;
     if let Some(path) = &args.out {
         let document = ScoredModelDocument {
             model: result.to_document(),
@@ -348,6 +339,29 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         let _ = writeln!(report, "\nwrote {}", path.display());
     }
     crate::output::print(&report)
+}
+
+/// Refuse a fit whose parameters lie outside their physical range
+/// ([`sysid::fit::plausible`]) even after the fit's recovery: a degenerate minimum is
+/// never written as a success. `frf` names the responses in the message.
+pub fn refuse_implausible(result: &sysid::fit::FitResult, frf: &Path) -> anyhow::Result<()> {
+    let found = implausible_parameters(&result.structure, &result.values);
+    if found.is_empty() {
+        return Ok(());
+    }
+    bail!(
+        "the fit is degenerate: {} of {} on {} lie orders of magnitude outside what a \
+         helicopter's model can hold (docs/method.md, physical ranges){}; no model written",
+        describe(&found),
+        result.structure.name,
+        frf.display(),
+        if result.trim.is_some() {
+            ": the trim balance scales the fitted control derivatives, which these \
+             responses leave undetermined"
+        } else {
+            ""
+        }
+    )
 }
 
 /// The modes of the fitted model, alone or against the truth's.
@@ -429,6 +443,16 @@ fn write_report(
             "NOT confirmed by a second start"
         }
     )?;
+    if !result.implausible_held.is_empty() {
+        writeln!(
+            out,
+            "  a degenerate minimum put parameters outside their physical range (value it \
+             gave below): fitted again with them held at their start values:"
+        )?;
+        for dropped in &result.implausible_held {
+            writeln!(out, "    {:<10} {:>14.6e}", dropped.name, dropped.value)?;
+        }
+    }
     if !result.reduction.is_empty() {
         writeln!(out, "\nreduction:")?;
         write!(out, "{}", reduction_table(&result.reduction))?;

@@ -274,7 +274,7 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     };
     write_json(&args.out, &analysis.document)?;
     if !args.quiet {
-        eprint!("{}", summary(&analysis, &args.out, plots));
+        crate::note_text!("{}", summary(&analysis, &args.out, plots));
     }
     Ok(())
 }

@@ -70,14 +70,14 @@ pub fn decode(
     }
     if !quiet {
         let with_data = log.topics.iter().filter(|t| !t.is_empty()).count();
-        eprintln!(
+        crate::note!(
             "{}: {}, {} bytes, {with_data} topics with messages",
             path.display(),
             log.format.name(),
             log.bytes
         );
         for line in &log.dropped {
-            eprintln!("  not read: {line}");
+            crate::note!("  not read: {line}");
         }
     }
     Ok(())

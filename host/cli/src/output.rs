@@ -69,6 +69,27 @@ fn mark_stdout(error: io::Error) -> io::Error {
     io::Error::new(error.kind(), StdoutFailed(error))
 }
 
+/// `eprintln!` that never panics: progress and warnings on standard error are best
+/// effort, and a standard error that cannot be written (full, closed) loses the line
+/// instead of ending the run with a panic (exit 101). The crate denies `eprintln!`
+/// (`clippy::print_stderr` in `lib.rs`) so that every line goes through here.
+#[macro_export]
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// [`note!`] without the line end (`eprint!`).
+#[macro_export]
+macro_rules! note_text {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// Write `text` to standard output and flush it.
 pub fn print(text: &str) -> anyhow::Result<()> {
     let mut out = StdoutWriter::lock();
@@ -541,7 +562,7 @@ impl StagedFolder {
 }
 
 /// `DIR.<suffix>` beside `dir`.
-fn sibling(dir: &Path, suffix: &str) -> anyhow::Result<PathBuf> {
+pub(crate) fn sibling(dir: &Path, suffix: &str) -> anyhow::Result<PathBuf> {
     let name = dir
         .file_name()
         .filter(|n| !n.is_empty() && *n != "." && *n != "..")

@@ -134,3 +134,89 @@ fn a_lock_file_left_by_a_killed_run_does_not_block() {
     assert!(!dir.join("o.lock").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Start `args` in `dir` paused at `point` of the test hook; return once it says so (the
+/// caller waits for it; a run that never pauses is killed and waited for here).
+#[allow(clippy::zombie_processes)]
+fn start_paused(dir: &Path, args: &[&str], point: &str) -> Child {
+    use std::io::{BufRead, BufReader};
+    let mut child = command(dir, args)
+        .env("SWEEPHOLD_TEST_PAUSE_AT", point)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    loop {
+        line.clear();
+        if stderr.read_line(&mut line).unwrap() == 0 {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{args:?} never paused at {point}");
+        }
+        if line.trim() == format!("paused at {point}") {
+            return child;
+        }
+    }
+}
+
+#[test]
+fn a_report_is_refused_while_a_campaign_runs_on_its_folder() {
+    use nix::sys::signal::{kill, Signal};
+    use nix::unistd::Pid;
+    let dir = scratch("report");
+    let done = sweephold(
+        &dir,
+        &[
+            "campaign", "--quick", "--quiet", "--seed", "11", "--out", "c",
+        ],
+    );
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    // Alone, the report takes the lock and releases it.
+    let alone = sweephold(&dir, &["report", "c"]);
+    assert!(
+        alone.status.success(),
+        "{}",
+        String::from_utf8_lossy(&alone.stderr)
+    );
+    assert!(!dir.join("c.lock").exists());
+    let report = std::fs::read(dir.join("c/report.html")).unwrap();
+
+    // A second campaign on c, held at its 6-DOF stage: the report is refused.
+    let running = start_paused(
+        &dir,
+        &[
+            "campaign", "--quick", "--quiet", "--seed", "12", "--out", "c",
+        ],
+        "fit_6dof",
+    );
+    let refused = sweephold(&dir, &["report", "c"]);
+    let stderr = String::from_utf8_lossy(&refused.stderr).trim().to_string();
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "error: output folder c is in use by another sweephold run (pid {})",
+            running.id()
+        )),
+        "{stderr}"
+    );
+    // `report .` inside the folder names the same lock.
+    let inside = command(&dir.join("c"), &["report", "."]).output().unwrap();
+    assert_eq!(inside.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&inside.stderr).contains("is in use"));
+    // The campaign ended by SIGTERM: the earlier result and its report untouched.
+    let pid = Pid::from_raw(i32::try_from(running.id()).unwrap());
+    kill(pid, Signal::SIGTERM).unwrap();
+    let ended = running.wait_with_output().unwrap();
+    assert!(!ended.status.success());
+    assert!(std::fs::read(dir.join("c/report.html")).unwrap() == report);
+    assert_eq!(seed_of(&dir.join("c/summary.json")), 11);
+    assert!(!dir.join("c.lock").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

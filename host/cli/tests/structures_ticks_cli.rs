@@ -413,7 +413,9 @@ fn fit_model_takes_a_shipped_name_a_file_wins_and_an_unknown_name_lists_them() {
     assert!((ratio - hub_height).abs() < 1e-9, "{ratio} vs {hub_height}");
 
     // Another name resolves to its own structure: the 6-DOF's pairs are in the data too,
-    // but it has no flapping, so it reports on its own terms (no file needed).
+    // but it has no flapping, so it reports on its own terms (no file needed). From one
+    // start on the TREX hybrid's exact responses it lands in a degenerate minimum (M_q of
+    // 10⁶) that holding those parameters does not cure: refused naming the structure.
     let out = sweephold_in(
         &dir.0,
         &[
@@ -427,11 +429,11 @@ fn fit_model_takes_a_shipped_name_a_file_wins_and_an_unknown_name_lists_them() {
         ],
         &[],
     );
-    assert!(out.status.success(), "{}", stderr(&out));
-    let report = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(
-        report.starts_with("structure bo105-6dof (8 states"),
-        "{report}"
+        stderr(&out).contains("of bo105-6dof on frf.json lie orders of magnitude outside"),
+        "{}",
+        stderr(&out)
     );
 
     // A file of that name in the current directory wins over the shipped structure.

@@ -135,7 +135,7 @@ pub struct CampaignOutcome {
 pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
     let outcome = campaign(args)?;
     if !args.quiet {
-        eprint!("{}", headline(&outcome.summary));
+        crate::note_text!("{}", headline(&outcome.summary));
     }
     crate::output::print(&format!("report: {}\n", outcome.report.display()))
 }

@@ -44,7 +44,7 @@ impl StageProgress {
         let seconds = self.started.elapsed().as_secs_f64();
         self.spinner.finish_and_clear();
         if !self.quiet {
-            eprintln!("{:<16} {:>6.2} s  {}", self.stage.name(), seconds, outcome);
+            crate::note!("{:<16} {:>6.2} s  {}", self.stage.name(), seconds, outcome);
         }
         seconds
     }

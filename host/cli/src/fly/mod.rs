@@ -512,7 +512,7 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                 .iter()
                 .map(|(k, v)| format!("{k} {v:.2}"))
                 .collect();
-            eprintln!(
+            crate::note!(
                 "{:>9}  {:6.1} s  {}  max |phi| {:4.1} deg, |theta| {:4.1} deg  cross-coherence: {}",
                 run.file,
                 run.duration_s,
@@ -523,19 +523,21 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
             );
             if let Some(estimator) = &run.estimator {
                 let e = estimator.max_error_deg;
-                eprintln!(
+                crate::note!(
                     "{:>9}  board estimate: max error phi {:.2} deg, theta {:.2} deg",
-                    "", e.phi, e.theta
+                    "",
+                    e.phi,
+                    e.theta
                 );
             }
             if let Some(after) = &run.after {
-                eprintln!(
+                crate::note!(
                     "{:>9}  after the test: {:.1} s in {}, max |phi| {:4.1} deg, |theta| {:4.1} deg",
                     "", after.duration_s, after.mode, after.max_abs_deg.phi, after.max_abs_deg.theta
                 );
             }
         }
-        eprintln!(
+        crate::note!(
             "wrote {} records and summary.json to {}",
             outcome.dumps.len(),
             args.out.display()

@@ -22,7 +22,9 @@ pub use inputs::{ReportError, ReportInputs};
 #[derive(Args, Debug, Clone)]
 #[command(
     after_help = "DIR is a folder written by `sweephold campaign`. Sections whose \
-stage did not complete say so; a file that exists but does not parse is an error."
+stage did not complete say so; a file that exists but does not parse is an error. The \
+report holds DIR.lock while it runs, as campaign and fly do: it is refused while a run \
+writes DIR, and a run on DIR is refused while it runs."
 )]
 pub struct ReportArgs {
     /// The campaign folder.
@@ -32,6 +34,23 @@ pub struct ReportArgs {
 
 /// Run `sweephold report`: write DIR/report.html and print its path.
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
+    // The folder's run lock (`DIR.lock`, as `campaign` and `fly` hold it): a report is
+    // refused while a run writes the folder, and a run while a report reads it. Taken only
+    // for an existing folder, so that a mistyped DIR creates nothing; `report .` locks
+    // the folder by its full name.
+    let _lock = if args.dir.is_dir() {
+        let lock_path = match crate::output::sibling(&args.dir, "lock") {
+            Ok(path) => path,
+            Err(_) => {
+                let full = std::fs::canonicalize(&args.dir)
+                    .map_err(|e| anyhow::anyhow!("cannot resolve {}: {e}", args.dir.display()))?;
+                crate::output::sibling(&full, "lock")?
+            }
+        };
+        Some(crate::run_lock::RunLock::acquire(&args.dir, &lock_path)?)
+    } else {
+        None
+    };
     let path = write_report(&args.dir)?;
     crate::output::print(&format!("report: {}\n", path.display()))
 }

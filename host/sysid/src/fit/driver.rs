@@ -5,7 +5,7 @@ use super::cost::{self, PairGrid};
 use super::error::FitError;
 use super::search::{finish_fit, fit_on_grids, search_minima, StartSearch};
 use super::structure::{self, ModelStructure, ParameterKind};
-use super::{reduce, trim, FitOptions, FitResult, SkippedPair, StartSetOutcome};
+use super::{plausible, reduce, trim, FitOptions, FitResult, SkippedPair, StartSetOutcome};
 use crate::document::FrfDocument;
 
 /// Fit `structure` to the responses in `data`.
@@ -21,8 +21,19 @@ pub fn fit(
         });
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
-    let mut result = fit_on_grids(&usable, &grids, &without_balances(options))?;
-    result = settle_and_release(result, &usable, &grids, options)?;
+    let run = |held: &[String]| {
+        let structure = held_at_start(&usable, held);
+        let result = fit_on_grids(&structure, &grids, &without_balances(options))?;
+        if degenerate_before_trim(&result, &structure, options)? {
+            return Ok((result, ()));
+        }
+        Ok((settle_and_release(result, &structure, &grids, options)?, ()))
+    };
+    let (mut result, ()) = if options.recover_implausible {
+        recover_plausible(&usable, run(&[])?, run)
+    } else {
+        run(&[])?
+    };
     result.skipped_pairs = skipped;
     Ok(result)
 }
@@ -52,6 +63,38 @@ pub fn fit_from_alternative_starts(
         });
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
+    let run = |held: &[String]| {
+        let starts: Vec<(String, ModelStructure)> = starts
+            .iter()
+            .map(|(label, structure)| (label.clone(), held_at_start(structure, held)))
+            .collect();
+        let (result, (outcomes, usable)) = best_of_start_sets(&starts, data, &grids, options)?;
+        if degenerate_before_trim(&result, &usable, options)? {
+            return Ok((result, outcomes));
+        }
+        Ok((
+            settle_and_release(result, &usable, &grids, options)?,
+            outcomes,
+        ))
+    };
+    let (mut result, outcomes) = if options.recover_implausible {
+        recover_plausible(first, run(&[])?, run)
+    } else {
+        run(&[])?
+    };
+    result.skipped_pairs = skipped;
+    Ok((result, outcomes))
+}
+
+/// The search of [`fit_from_alternative_starts`] over its start sets, before the trim
+/// points: the best result, what each set reached, and the best set's usable structure.
+#[allow(clippy::type_complexity)]
+fn best_of_start_sets(
+    starts: &[(String, ModelStructure)],
+    data: &FrfDocument,
+    grids: &[PairGrid],
+    options: &FitOptions,
+) -> Result<(FitResult, (Vec<StartSetOutcome>, ModelStructure)), FitError> {
     // The restart budget is shared: each set gets its part of `max_starts` (at least two,
     // so that each can still confirm its minimum). The set that reaches the lowest J_ave
     // gets the whole budget afterwards if its minimum was not found twice.
@@ -66,8 +109,8 @@ pub fn fit_from_alternative_starts(
     for (set, (label, structure)) in starts.iter().enumerate() {
         let (usable, _) = usable_pairs(structure, data, options.min_auto_range_ratio);
         let mut search = StartSearch::new(per_set.seed);
-        let fitted = search_minima(&usable, &grids, &per_set, per_set.max_starts, &mut search)
-            .and_then(|()| finish_fit(&usable, &grids, &per_set, search.clone()));
+        let fitted = search_minima(&usable, grids, &per_set, per_set.max_starts, &mut search)
+            .and_then(|()| finish_fit(&usable, grids, &per_set, search.clone()));
         match fitted {
             Ok(result) => {
                 outcomes.push(StartSetOutcome {
@@ -101,15 +144,124 @@ pub fn fit_from_alternative_starts(
     // where it stopped, so it keeps the minima it has and reaches at least the same one.
     if !result.minimum_confirmed && per_set.max_starts < options.max_starts {
         let options = without_balances(options);
-        search_minima(&usable, &grids, &options, options.max_starts, &mut search)?;
-        result = finish_fit(&usable, &grids, &options, search)?;
+        search_minima(&usable, grids, &options, options.max_starts, &mut search)?;
+        result = finish_fit(&usable, grids, &options, search)?;
         if let Some(outcome) = outcomes.get_mut(best_set) {
             outcome.average_cost = Ok(result.average_cost);
         }
     }
-    result = settle_and_release(result, &usable, &grids, options)?;
-    result.skipped_pairs = skipped;
-    Ok((result, outcomes))
+    Ok((result, (outcomes, usable)))
+}
+
+/// Most rounds of [`recover_plausible`]: each holds the parameters the last run put
+/// outside their range.
+const RECOVERY_ROUNDS: usize = 4;
+
+/// A recovered fit is kept when its J_ave is at most this (the guideline's "acceptable")
+/// or at most the degenerate fit's.
+const RECOVERED_ACCEPTABLE_COST: f64 = 100.0;
+
+/// A fit with parameters outside their physical range ([`plausible`]) sits in a
+/// degenerate minimum: the responses do not determine them (a control derivative of 10⁸
+/// that a coupling of 10⁻⁸ cancels fits as well as two ordinary values). Hold those
+/// parameters at their start values ([`held_at_start`]) and run the fit again from the
+/// same start sets (the file's, the equation-error or 6-DOF ones), up to
+/// [`RECOVERY_ROUNDS`] times while a run puts others outside. The first plausible result
+/// whose J_ave is acceptable ([`RECOVERED_ACCEPTABLE_COST`]) wins, recording what it held
+/// ([`FitResult::implausible_held`]); otherwise, or when a run fails, `first` is
+/// returned as it is and the caller refuses it. Only parameters `structure` has free and
+/// outside M are held (a trim-derived one follows the others; a time constant at zero
+/// would make M singular). `run(held)` fits with `held` at their start values.
+fn recover_plausible<X>(
+    structure: &ModelStructure,
+    first: (FitResult, X),
+    mut run: impl FnMut(&[String]) -> Result<(FitResult, X), FitError>,
+) -> (FitResult, X) {
+    let mut found = plausible::implausible_parameters(&first.0.structure, &first.0.values);
+    let mut held: Vec<plausible::HeldParameter> = Vec::new();
+    let acceptable = first.0.average_cost.max(RECOVERED_ACCEPTABLE_COST);
+    for _ in 0..RECOVERY_ROUNDS {
+        if found.is_empty() {
+            break;
+        }
+        let before = held.len();
+        for parameter in &found {
+            if plausible::droppable(structure, &parameter.name)
+                && !held.iter().any(|d| d.name == parameter.name)
+            {
+                held.push(plausible::HeldParameter {
+                    name: parameter.name.clone(),
+                    value: parameter.value,
+                });
+            }
+        }
+        if held.len() == before {
+            break;
+        }
+        let names: Vec<String> = held.iter().map(|d| d.name.clone()).collect();
+        let Ok(mut next) = run(&names) else {
+            break;
+        };
+        found = plausible::implausible_parameters(&next.0.structure, &next.0.values);
+        if found.is_empty() && next.0.average_cost <= acceptable {
+            next.0.implausible_held = held;
+            return next;
+        }
+    }
+    first
+}
+
+/// Whether the search's minimum already lies outside the physical ranges and the
+/// recovery is on: then the trim rounds are not run on it (the balance would scale its
+/// undetermined control derivatives into speed derivatives of 10¹⁵ and drive the refits
+/// further out); the recovery holds those parameters and runs again. The points are
+/// still checked, at `structure`'s start values, so that points that cannot inform the
+/// derived parameters (collinear, no climb) are named as such rather than as a
+/// degenerate fit.
+fn degenerate_before_trim(
+    result: &FitResult,
+    structure: &ModelStructure,
+    options: &FitOptions,
+) -> Result<bool, FitError> {
+    let Some(points) = &options.trim_points else {
+        return Ok(false);
+    };
+    if !options.recover_implausible
+        || plausible::implausible_parameters(&result.structure, &result.values).is_empty()
+    {
+        return Ok(false);
+    }
+    if !structure.trim_derived.is_empty() {
+        trim::derive(
+            structure,
+            &structure.values(),
+            points,
+            &structure.trim_derived,
+        )
+        .map_err(|e| FitError::TrimPoints(e.to_string()))?;
+    }
+    Ok(true)
+}
+
+/// `structure` with the parameters `names` fixed at their start values, or at zero where
+/// the start itself lies outside the physical range.
+fn held_at_start(structure: &ModelStructure, names: &[String]) -> ModelStructure {
+    let mut held = structure.clone();
+    let values = structure.values();
+    let outside: Vec<String> = plausible::implausible_parameters(structure, &values)
+        .into_iter()
+        .map(|p| p.name)
+        .collect();
+    for name in names {
+        if let Some(index) = held.parameter_index(name) {
+            let parameter = &mut held.parameters[index];
+            parameter.kind = ParameterKind::Fixed;
+            if outside.contains(name) {
+                parameter.value = 0.0;
+            }
+        }
+    }
+    held
 }
 
 /// `options` with the trim balances out of the cost (the search before the trim points

@@ -21,6 +21,7 @@ pub mod expression;
 pub mod model;
 pub mod modes;
 pub mod optimizer;
+pub mod plausible;
 pub mod reduce;
 pub mod report;
 mod result;
@@ -106,6 +107,10 @@ pub struct FitOptions {
     /// How the trim points enter the fit ([`trim::TrimBalance`]; default: held, status
     /// `trim`, as the paper fixes its speed derivatives).
     pub trim_balance: trim::TrimBalance,
+    /// Whether a fit whose parameters land outside their physical range is run again with
+    /// them held at their start values ([`plausible`]; the driver's recovery). Off only
+    /// where the fit gives start values and nothing else (the campaign's 6-DOF stage).
+    pub recover_implausible: bool,
 }
 
 impl Default for FitOptions {
@@ -129,6 +134,7 @@ impl Default for FitOptions {
             min_auto_range_ratio: 3.0,
             trim_points: None,
             trim_balance: trim::TrimBalance::Hold,
+            recover_implausible: true,
         }
     }
 }

@@ -136,6 +136,10 @@ pub struct ModelDocument {
     /// Parameters derived from trim points (absent without them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trim: Option<super::trim::TrimOutcome>,
+    /// Parameters held at their start values because a degenerate minimum put them
+    /// outside their physical range, with the values it gave them ([`super::plausible`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub implausible_held: Vec<super::plausible::HeldParameter>,
 }
 
 /// `model.json` with its optional `truth` section and the model's `modes`: the
@@ -276,6 +280,7 @@ impl ModelDocument {
             reduction: result.reduction.clone(),
             skipped_pairs: result.skipped_pairs.clone(),
             trim: result.trim.clone(),
+            implausible_held: result.implausible_held.clone(),
         }
     }
 

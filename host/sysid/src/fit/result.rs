@@ -197,6 +197,10 @@ pub struct FitResult {
     pub skipped_pairs: Vec<SkippedPair>,
     /// What the trim points gave (None without trim points or `trim_derived`).
     pub trim: Option<trim::TrimOutcome>,
+    /// Parameters a degenerate minimum put outside their physical range, with the values
+    /// it gave them; the fit was repeated with them held at their start values
+    /// ([`super::plausible`]; empty when none).
+    pub implausible_held: Vec<super::plausible::HeldParameter>,
     /// The trim balances' share of the cost, Σ e² ([`trim::joint`]; 0 when the cost does
     /// not carry them).
     pub balance_cost: f64,

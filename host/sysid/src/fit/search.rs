@@ -250,6 +250,7 @@ pub(super) fn finish_fit(
         reduction: Vec::new(),
         skipped_pairs: Vec::new(),
         trim: None,
+        implausible_held: Vec::new(),
         balance_cost,
     })
 }

@@ -249,6 +249,7 @@ mod tests {
             reduction: Vec::new(),
             skipped_pairs: Vec::new(),
             trim: None,
+            implausible_held: Vec::new(),
         }
     }
 

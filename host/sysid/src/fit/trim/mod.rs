@@ -68,13 +68,6 @@ pub const PLAUSIBLE_RANGES: [(&str, &[&str], f64, &str); 4] = [
     ("a stick", &["lat", "lon", "ped", "col"], 1.0, "of travel"),
 ];
 
-/// Largest magnitude a trim-derived parameter may take for a fit to count as a success.
-/// They are speed and rate derivatives (1/s, or rad/s² per m/s): the shipped aircraft's
-/// campaigns derive 0.002–1.4 (`model9.json` `trim`), and 100 is two orders beyond. A fit
-/// whose balance gives more landed in a degenerate minimum (module documentation of
-/// [`implausible_derivation`]).
-pub const PLAUSIBLE_DERIVED_MAGNITUDE: f64 = 100.0;
-
 /// Smallest singular value, relative to the largest, of the balance's matrix with its
 /// columns scaled to unit length, for the derived parameters to count as independently
 /// informed: collinear points give exactly dependent columns (rounding, ~10⁻¹⁶), the
@@ -341,19 +334,6 @@ fn check_plausible(line: usize, states: &[f64; 8], controls: &[f64; 4]) -> Resul
     Ok(())
 }
 
-/// The first derived parameter whose value is not finite or lies beyond
-/// [`PLAUSIBLE_DERIVED_MAGNITUDE`]: the sign of a degenerate fit. The balance multiplies
-/// the stick gradients of the points by the fitted control derivatives (M_u = −M_lon
-/// ∂δ_lon/∂u, …); when the responses leave those undetermined — the Bo-105 6-DOF
-/// structure lands in a minimum with X_ped, Z_ped of 10⁶–10⁹ — the derived speed
-/// derivatives are as absurd, and holding them drives the refit further away.
-pub fn implausible_derivation(outcome: &TrimOutcome) -> Option<&TrimDerivation> {
-    outcome
-        .parameters
-        .iter()
-        .find(|d| !d.value.is_finite() || d.value.abs() > PLAUSIBLE_DERIVED_MAGNITUDE)
-}
-
 /// One parameter derived from trim points.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrimDerivation {
@@ -565,12 +545,13 @@ pub fn derive(
         rows,
     } = balance_rows(structure, values, names)?;
     let r0 = residuals(structure, &base, points)?;
+    let step = derivation_step(&r0);
     let mut columns: Vec<Vec<DVector<f64>>> = Vec::with_capacity(indices.len());
     for &k in &indices {
         let mut one = base.clone();
-        one[k] = 1.0;
+        one[k] = step;
         let r1 = residuals(structure, &one, points)?;
-        columns.push(r1.iter().zip(&r0).map(|(a, b)| a - b).collect());
+        columns.push(r1.iter().zip(&r0).map(|(a, b)| (a - b) / step).collect());
     }
     let n_obs = rows.len() * points.points.len();
     let a = DMatrix::from_fn(n_obs, indices.len(), |obs, k| {
@@ -606,6 +587,26 @@ pub fn derive(
         })
         .collect())
 }
+
+/// The step of a derived parameter that reads its column of the balance,
+/// `(r(θ_k = h) − r(0))/h`: exact for any h (the balance is affine), but the difference
+/// keeps only the digits by which `h·c_k` exceeds the rounding of r(0), ε·‖r(0)‖. With
+/// h = 1 a degenerate minimum (other parameters of 10¹⁵, r(0) of 10¹⁶–10²²) rounds a
+/// column of order 1 to exactly 0, and the rank check then blames the points. So h is
+/// relative to the residual, `max(1, 10⁻⁶·‖r(0)‖∞)`, which keeps ten digits of a column of
+/// order 1 whatever the residual; the floor of 1 leaves every balance with residuals below
+/// 10⁶ (every non-degenerate one) computed as before.
+fn derivation_step(r0: &[DVector<f64>]) -> f64 {
+    let largest = r0.iter().map(|r| r.amax()).fold(0.0, f64::max);
+    if largest.is_finite() {
+        (DERIVATION_STEP_RELATIVE * largest).max(1.0)
+    } else {
+        1.0
+    }
+}
+
+/// [`derivation_step`]'s step relative to the largest residual.
+const DERIVATION_STEP_RELATIVE: f64 = 1e-6;
 
 /// Refuse a balance whose derived parameters the points cannot tell apart: the matrix
 /// `a` of [`derive`] (one column per parameter), each column scaled to unit length so

@@ -329,29 +329,33 @@ fn collinear_points_are_refused_naming_what_they_fail_to_vary() {
 }
 
 #[test]
-fn derived_parameters_orders_of_magnitude_off_mark_the_fit_degenerate() {
-    let outcome = |values: &[f64]| TrimOutcome {
-        points: 9,
-        rounds: 2,
-        settled: true,
-        parameters: values
+fn a_huge_residual_does_not_round_a_derived_parameters_column_to_zero() {
+    // The toy with M_lon = 10²⁰ (a degenerate minimum's size): the balance's residual
+    // with M_u at 0 is M_lon·Δlon ≈ 10¹⁸, where a unit step of M_u (a change of Δu ≈ 1)
+    // is lost to rounding and the column read exactly zero ("the points do not vary what
+    // `Mu` multiplies"). The scaled step keeps it, and the paper's formula comes back.
+    let structure = pitch_toy(true);
+    let mut values = structure.values();
+    let m_lon = 1e20;
+    values[structure.parameter_index("Mlon").unwrap()] = m_lon;
+    let gradient = -0.011;
+    let points = TrimPoints {
+        points: [-1.0, 0.0, 2.0]
             .iter()
-            .zip(["Lv", "Mu", "Nv"])
-            .map(|(&value, name)| TrimDerivation {
-                name: name.into(),
-                value,
+            .map(|&u| TrimPoint {
+                label: String::new(),
+                states: [u, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -0.02 * u / 9.81],
+                controls: [0.0, gradient * u, 0.0, 0.0],
             })
             .collect(),
     };
-    // The shipped aircraft's campaigns: ≤ 1.4.
-    assert!(implausible_derivation(&outcome(&[-0.3, 0.05, 1.4])).is_none());
-    // The Bo-105 6-DOF with the simulator's trim points: L_v = 1.6·10⁴, M_u = 8.2·10¹⁵.
-    let off = outcome(&[1.6e4, 8.2e15, 3.3e3]);
-    assert_eq!(implausible_derivation(&off).unwrap().name, "Lv");
-    assert_eq!(
-        implausible_derivation(&outcome(&[0.1, f64::NAN, 0.0]))
-            .unwrap()
-            .name,
-        "Mu"
+    let derived = derive(&structure, &values, &points, &names(&["Mu"])).unwrap();
+    let want = -m_lon * gradient;
+    assert!(
+        (derived[0].value - want).abs() <= 1e-9 * want,
+        "{derived:?} vs {want}"
     );
+    // The step stays 1 below residuals of 10⁶, so ordinary balances are computed as before.
+    assert_eq!(derivation_step(&[DVector::from_element(3, 9.9e5)]), 1.0);
+    assert_eq!(derivation_step(&[DVector::from_element(3, 1e18)]), 1e12);
 }

@@ -1,0 +1,149 @@
+//! Degenerate minima (issue 42): a fit whose parameters land orders of magnitude outside
+//! what a helicopter's model can hold is never written as a success. Two valid command
+//! lines that were refused with a misleading trim-point message ("the trim points do not
+//! vary what `Nr` multiplies") now run again with those parameters held and give a model
+//! inside the physical ranges; where that fails, one line names the worst parameters.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use sysid::fit::plausible::implausible_parameters;
+
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!(
+            "sweephold-degenerate-{name}-{}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.0).ok();
+    }
+}
+
+fn sweephold(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sweephold"))
+        .args(args)
+        .output()
+        .expect("run sweephold")
+}
+
+/// The parameters of `model.json` at `path` outside the physical ranges of its shipped
+/// structure (judged by the library's rule on the file's values).
+fn outside_physical_ranges(path: &Path) -> Vec<String> {
+    let document: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let name = document["structure"].as_str().unwrap();
+    let structure = sysid::models::shipped(name)
+        .unwrap_or_else(|| panic!("{name} is shipped"))
+        .parse()
+        .unwrap();
+    let mut values = structure.values();
+    for parameter in document["parameters"].as_array().unwrap() {
+        if let Some(index) = structure.parameter_index(parameter["name"].as_str().unwrap()) {
+            values[index] = parameter["value"].as_f64().unwrap();
+        }
+    }
+    implausible_parameters(&structure, &values)
+        .into_iter()
+        .map(|p| format!("{} = {}", p.name, p.value))
+        .collect()
+}
+
+#[test]
+fn an_adaptive_board_sim_campaign_whose_hybrid_went_degenerate_completes() {
+    // Seed 4: on main the hybrid's trim rounds drove it into a degenerate minimum and the
+    // rank check blamed the points ("do not vary what `Nv` multiplies"), exit 1.
+    let dir = TempDir::new("campaign");
+    let out = dir.0.join("c");
+    let run = sweephold(&[
+        "campaign",
+        "--quick",
+        "--amplitude",
+        "adaptive",
+        "--fc",
+        "board-sim",
+        "--seed",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    let outside = outside_physical_ranges(&out.join("model9.json"));
+    assert!(outside.is_empty(), "{outside:?}");
+}
+
+#[test]
+fn the_six_dof_from_an_equation_error_start_with_trim_points_is_recovered_or_refused() {
+    let dir = TempDir::new("fit");
+    let campaign = dir.0.join("c");
+    let run = sweephold(&["campaign", "--quick", "--out", campaign.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let frf = campaign.join("frf.json");
+    let points = campaign.join("trim-points.csv");
+    let fit = |seed: &str, out: &Path| {
+        sweephold(&[
+            "fit",
+            "--frf",
+            frf.to_str().unwrap(),
+            "--model",
+            "bo105-6dof",
+            "--equation-error-start",
+            "--trim-points",
+            points.to_str().unwrap(),
+            "--seed",
+            seed,
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+
+    // Seed 1: the search lands outside (X_ped, Z_ped, X_col of 10⁶–10¹¹); held at their
+    // starts, the fit gives a model inside every range, the held ones reported.
+    let model = dir.0.join("m6.json");
+    let run = fit("1", &model);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        stdout.contains("a degenerate minimum put parameters outside their physical range"),
+        "{stdout}"
+    );
+    let outside = outside_physical_ranges(&model);
+    assert!(outside.is_empty(), "{outside:?}");
+    let document: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert!(document["average_cost"].as_f64().unwrap() <= 100.0);
+    assert!(!document["implausible_held"].as_array().unwrap().is_empty());
+
+    // Seed 3: the runs with held parameters land outside too: refused in one line naming
+    // the worst parameters, no model written.
+    let refused = dir.0.join("refused.json");
+    let run = fit("3", &refused);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("error: the fit is degenerate: `"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("(|value| <= "), "{stderr}");
+    assert!(!refused.exists());
+}
