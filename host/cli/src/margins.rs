@@ -242,10 +242,20 @@ fn cell(figure: &Figure, decimals: usize) -> String {
 fn table(result: &MarginsDocument, vehicle: &str, model: &std::path::Path) -> String {
     let mut text = String::new();
     let law = &result.law;
+    let spread = if result.drawn_parameters == 0 {
+        "no spread".to_string()
+    } else {
+        format!(
+            "spread over {} draws of {} parameters (seed {})",
+            result.samples - result.failed_draws,
+            result.drawn_parameters,
+            result.seed
+        )
+    };
     let _ = writeln!(
         text,
         "{} ({}), {} law: tick {:.1} ms, filter bank {}, compute delay {:.1} ms, servo frame {}; \
-         spread over {} draws of {} parameters (seed {})",
+         {spread}",
         model.display(),
         result.structure,
         vehicle,
@@ -254,9 +264,6 @@ fn table(result: &MarginsDocument, vehicle: &str, model: &std::path::Path) -> St
         law.compute_delay_s * 1e3,
         law.servo_frame_hz
             .map_or("none".to_string(), |hz| format!("{hz} Hz")),
-        result.samples - result.failed_draws,
-        result.drawn_parameters,
-        result.seed,
     );
     let _ = writeln!(
         text,

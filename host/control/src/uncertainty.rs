@@ -88,6 +88,9 @@ impl ParameterSampler {
                 }
             }
         }
+        if n == 0 {
+            return Err("no free parameter has a finite Cramér–Rao bound".to_string());
+        }
         let eigen = SymmetricEigen::new(covariance);
         let roots = eigen.eigenvalues.map(|l| l.max(0.0).sqrt());
         let factor = &eigen.eigenvectors * DMatrix::from_diagonal(&roots);
