@@ -70,12 +70,20 @@ pub struct MarginsArgs {
     #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::arg_values::non_negative, allow_hyphen_values = true)]
     pub compute_delay: f64,
     /// Servo pulse frame rate [Hz] (held for a frame); none by default, as the simulator.
-    #[arg(long, value_name = "HZ", value_parser = crate::arg_values::positive_seconds, allow_hyphen_values = true)]
+    #[arg(long, value_name = "HZ", value_parser = positive_hz, allow_hyphen_values = true)]
     pub servo_frame_hz: Option<f64>,
     /// Write the broken loops and sensitivities sampled on the analysis grid (JSON:
     /// omega, re, im per loop) to this file, for an outside check.
     #[arg(long, value_name = "FILE")]
     pub export_loops: Option<PathBuf>,
+}
+
+/// `--servo-frame-hz`: a finite frequency > 0.
+fn positive_hz(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(hz) if hz.is_finite() && hz > 0.0 => Ok(hz),
+        _ => Err("expected a frequency in Hz > 0".to_string()),
+    }
 }
 
 /// Run `sweephold margins`.

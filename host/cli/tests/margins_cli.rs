@@ -83,3 +83,17 @@ fn bad_inputs_end_in_one_error_line() {
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
     }
 }
+
+#[test]
+fn a_servo_frame_rate_that_is_not_positive_is_refused_with_its_range() {
+    for bad in ["0", "-50", "nan", "inf", "fast"] {
+        let output = sweephold(&["margins", "missing.json", "--servo-frame-hz", bad]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(
+            stderr.contains("expected a frequency in Hz > 0"),
+            "{stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+}
