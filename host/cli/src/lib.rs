@@ -23,6 +23,7 @@ pub mod fly;
 pub mod frf;
 pub mod interrupt;
 pub mod logs;
+pub mod margins;
 pub mod output;
 pub mod plot;
 pub mod report;
@@ -64,6 +65,8 @@ pub enum Command {
     Fly(fly::FlyArgs),
     /// Frequency responses (Chirp-Z, multi-window, MISO, composite) from dumps or CSV.
     Frf(frf::FrfArgs),
+    /// Loop margins and handling qualities of the board's pilot-mode loops on an identified model.
+    Margins(margins::MarginsArgs),
     /// Regenerate report.html of a campaign folder from its files.
     Report(report::ReportArgs),
     /// Trim and linearize a simulated helicopter (a shipped aircraft or an aircraft file).
@@ -93,6 +96,7 @@ fn run_verb(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(args) => fit::run(&args),
         Command::Fly(args) => fly::run(&args),
         Command::Frf(args) => frf::run(&args),
+        Command::Margins(args) => margins::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Sim(args) => sim::run(&args),
         Command::Verify(args) => verify::run(&args),

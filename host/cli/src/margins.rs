@@ -1,0 +1,326 @@
+//! `sweephold margins`: the loop margins and handling qualities of the board's pilot-mode
+//! loops predicted from an identified model (`control` crate: method in its module
+//! documentation and docs/method.md, "Loop margins and handling qualities").
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::fs;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, Context};
+use clap::Args;
+use control::analysis::{self, AnalysisOptions, Figure, MarginsDocument};
+use control::law::BoardLaw;
+use control::Plant;
+use serde::Serialize;
+use sweephold_firmware::app::AppConfig;
+use sweephold_firmware::board_stack::StackConfig;
+use sweephold_protocol::Axis;
+use sysid::fit::model::Actuator;
+use sysid::fit::{ModelDocument, ModelStructure};
+use sysid::models;
+
+use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
+use crate::structures;
+use crate::vehicle::Vehicle;
+
+/// Arguments of `sweephold margins`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Each loop is broken at its actuator input (the command the board \
+sends to the servo) with the other loops closed: roll_rate, pitch_rate, yaw_rate with the \
+Rate stick (mode switch Low; the pedal outside its dead band), roll_attitude, pitch_attitude, \
+heading with the Level stick and the heading hold (Middle, High; pedal centred). Per loop: \
+gain crossover wc, phase margin PM, gain margin GM at the phase crossover w180, and the \
+disturbance-rejection bandwidth DRB (|1/(1+L)| = -3 dB). Per stick: the ADS-33E-PRF \
+bandwidth wBW and phase delay tau_p of the attitude response, and its level for hover and \
+low speed (target acquisition and tracking / all other MTEs; boundaries in docs/method.md). \
+Each figure's spread (+-) is the standard deviation over models drawn from the fit's \
+Cramer-Rao bounds and correlations (--samples, --seed).\n\nThe law is the firmware preset's \
+that the vehicle names (gains, 200 Hz tick with its zero-order hold), with the board's IMU \
+filter bank (--no-filters: raw sensors, as the simulator's in-process link), \
+--compute-delay and --servo-frame-hz (the shipped boards drive the servos at 50 Hz). Where \
+the model has neither a servo nor a delay for a control, the vehicle's servo is added."
+)]
+pub struct MarginsArgs {
+    /// The identified model (`model.json`, `model9.json`, `model6.json`).
+    #[arg(value_name = "MODEL.json")]
+    pub model: PathBuf,
+    /// The aircraft whose firmware preset flies the loops and whose servo is added where
+    /// the model has none: a shipped name (bo105, trex700l, fbl700) or an aircraft file.
+    /// Default: the one the model's structure is named after (bo105 or trex700l).
+    #[arg(long, value_name = "NAME|FILE", value_parser = Vehicle::parse)]
+    pub vehicle: Option<Vehicle>,
+    /// Write the figures as JSON (margins.json, docs/formats.md) to this file.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Print the JSON document on standard output instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Models drawn for the spreads (0: none).
+    #[arg(long, default_value_t = 200, value_parser = crate::arg_values::count::<0, 10000>, allow_hyphen_values = true)]
+    pub samples: usize,
+    /// Seed of the draws.
+    #[arg(long, default_value_t = 1, value_parser = crate::arg_values::seed, allow_hyphen_values = true)]
+    pub seed: u64,
+    /// Leave the board's IMU filter bank out (raw sensors).
+    #[arg(long)]
+    pub no_filters: bool,
+    /// Computation delay from the sensor sample to the command [s].
+    #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::arg_values::non_negative, allow_hyphen_values = true)]
+    pub compute_delay: f64,
+    /// Servo pulse frame rate [Hz] (held for a frame); none by default, as the simulator.
+    #[arg(long, value_name = "HZ", value_parser = positive_hz, allow_hyphen_values = true)]
+    pub servo_frame_hz: Option<f64>,
+    /// Write the broken loops and sensitivities sampled on the analysis grid (JSON:
+    /// omega, re, im per loop) to this file, for an outside check.
+    #[arg(long, value_name = "FILE")]
+    pub export_loops: Option<PathBuf>,
+}
+
+/// `--servo-frame-hz`: a finite frequency > 0.
+fn positive_hz(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(hz) if hz.is_finite() && hz > 0.0 => Ok(hz),
+        _ => Err("expected a frequency in Hz > 0".to_string()),
+    }
+}
+
+/// Run `sweephold margins`.
+pub fn run(args: &MarginsArgs) -> anyhow::Result<()> {
+    check_input_file("model", &args.model)?;
+    let outputs: Vec<(&str, &std::path::Path)> =
+        [("--out", &args.out), ("--export-loops", &args.export_loops)]
+            .into_iter()
+            .filter_map(|(name, path)| path.as_deref().map(|p| (name, p)))
+            .collect();
+    refuse_inputs_as_outputs(&[args.model.as_path()], &outputs)?;
+    let text = fs::read_to_string(&args.model)
+        .with_context(|| format!("cannot read {}", args.model.display()))?;
+    let document: ModelDocument = serde_json::from_str(&text)
+        .map_err(|e| anyhow!("{}: not a model.json: {e}", args.model.display()))?;
+    let vehicle = match &args.vehicle {
+        Some(vehicle) => vehicle.clone(),
+        None if document.structure.starts_with("trex700l") => Vehicle::shipped("trex700l"),
+        None => Vehicle::shipped("bo105"),
+    };
+    let law = board_law(&vehicle, args);
+    let servos = vehicle.servos();
+    let vehicle_servo = (servos.natural_frequency_rad_s.is_finite()
+        && servos.natural_frequency_rad_s > 0.0)
+        .then_some(Actuator {
+            natural_frequency_rad_s: servos.natural_frequency_rad_s,
+            damping: servos.damping,
+        });
+    let structure = structure_of(&document, &vehicle);
+    let options = AnalysisOptions {
+        samples: args.samples,
+        seed: args.seed,
+        ..AnalysisOptions::default()
+    };
+    let mut result = analysis::analyse(
+        &document,
+        structure.as_ref().ok(),
+        &law,
+        vehicle_servo,
+        &options,
+    )
+    .map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
+    if let Err(why) = &structure {
+        result.notes.push(format!("no spread: {why}"));
+    }
+    if let Some(path) = &args.export_loops {
+        write_json(
+            path,
+            &exported_loops(&document, &law, vehicle_servo, &options)?,
+        )?;
+    }
+    if let Some(path) = &args.out {
+        write_json(path, &result)?;
+    }
+    if args.json {
+        let mut text = serde_json::to_string_pretty(&result)?;
+        text.push('\n');
+        crate::output::print(&text)
+    } else {
+        crate::output::print(&table(&result, vehicle.name(), &args.model))
+    }
+}
+
+/// The firmware preset's pilot-mode law of `vehicle` on the board.
+fn board_law(vehicle: &Vehicle, args: &MarginsArgs) -> BoardLaw {
+    let app = AppConfig::preset(vehicle.preset(), Axis::Lat);
+    let stack = StackConfig::with_app(app);
+    BoardLaw {
+        gains: app.pilot,
+        tick_s: f64::from(app.flight.dt_s()),
+        filters: (!args.no_filters).then_some(stack.filters),
+        compute_delay_s: args.compute_delay,
+        servo_frame_hz: args.servo_frame_hz,
+        servos: [None; 3],
+    }
+}
+
+/// The structure `document` was fitted with, for the spread: the 6-DOF, the vehicle's
+/// own hybrid (its numbers), or a shipped structure of that name.
+fn structure_of(document: &ModelDocument, vehicle: &Vehicle) -> Result<ModelStructure, String> {
+    let structure = if document.structure == models::BO105_6DOF.name {
+        structures::six_dof().map_err(anyhow::Error::from)
+    } else if document.structure == vehicle.structure() {
+        structures::nine_dof_hybrid(vehicle.aircraft(), None).map_err(anyhow::Error::from)
+    } else {
+        structures::shipped(&document.structure, &BTreeMap::new())
+            .unwrap_or_else(|| Err(anyhow!("structure `{}` is not shipped", document.structure)))
+    };
+    structure.map_err(|e| format!("{e:#}"))
+}
+
+/// One sampled response of the export.
+#[derive(Serialize)]
+struct ExportedResponse {
+    name: String,
+    omega: Vec<f64>,
+    re: Vec<f64>,
+    im: Vec<f64>,
+}
+
+/// The nominal model's broken loops and sensitivities on the analysis grid.
+#[derive(Serialize)]
+struct ExportedLoops {
+    structure: String,
+    loops: Vec<ExportedResponse>,
+    sensitivities: Vec<ExportedResponse>,
+    sticks: Vec<ExportedResponse>,
+}
+
+fn exported_loops(
+    document: &ModelDocument,
+    law: &BoardLaw,
+    vehicle_servo: Option<Actuator>,
+    options: &AnalysisOptions,
+) -> anyhow::Result<ExportedLoops> {
+    let model = document
+        .model()
+        .ok_or_else(|| anyhow!("model.json: a matrix has the wrong size"))?;
+    let mut law = law.clone();
+    law.servos = analysis::added_servos(&model, vehicle_servo);
+    let grid = analysis::grid(&law, options);
+    let plant = Plant::new(model).map_err(|e| anyhow!(e))?;
+    let sets = analysis::evaluate(&plant, &law, &grid).map_err(|e| anyhow!(e))?;
+    let mut loops = Vec::new();
+    let mut sensitivities = Vec::new();
+    for (name, config, axis) in analysis::LOOP_NAMES {
+        let set = &sets[analysis::configuration_index(config)];
+        let export = |sampled: &control::loops::Sampled| ExportedResponse {
+            name: name.to_string(),
+            omega: sampled.omega.clone(),
+            re: sampled.values.iter().map(|v| v.re).collect(),
+            im: sampled.values.iter().map(|v| v.im).collect(),
+        };
+        loops.push(export(&set.broken[axis]));
+        sensitivities.push(export(&set.sensitivity[axis]));
+    }
+    let mut sticks = Vec::new();
+    for (name, config, axis) in analysis::STICK_NAMES {
+        let sampled = &sets[analysis::configuration_index(config)].stick_attitude[axis];
+        sticks.push(ExportedResponse {
+            name: name.to_string(),
+            omega: sampled.omega.clone(),
+            re: sampled.values.iter().map(|v| v.re).collect(),
+            im: sampled.values.iter().map(|v| v.im).collect(),
+        });
+    }
+    Ok(ExportedLoops {
+        structure: document.structure.clone(),
+        loops,
+        sensitivities,
+        sticks,
+    })
+}
+
+fn cell(figure: &Figure, decimals: usize) -> String {
+    match (figure.value, figure.spread) {
+        (Some(v), Some(s)) => format!("{v:.decimals$} ± {s:.decimals$}"),
+        (Some(v), None) => format!("{v:.decimals$}"),
+        (None, _) => "—".to_string(),
+    }
+}
+
+/// The table on standard output.
+fn table(result: &MarginsDocument, vehicle: &str, model: &std::path::Path) -> String {
+    let mut text = String::new();
+    let law = &result.law;
+    let spread = if result.drawn_parameters == 0 {
+        "no spread".to_string()
+    } else {
+        format!(
+            "spread over {} draws of {} parameters (seed {})",
+            result.samples - result.failed_draws,
+            result.drawn_parameters,
+            result.seed
+        )
+    };
+    let _ = writeln!(
+        text,
+        "{} ({}), {} law: tick {:.1} ms, filter bank {}, compute delay {:.1} ms, servo frame {}; \
+         {spread}",
+        model.display(),
+        result.structure,
+        vehicle,
+        law.tick_s * 1e3,
+        if law.filter_bank { "on" } else { "off" },
+        law.compute_delay_s * 1e3,
+        law.servo_frame_hz
+            .map_or("none".to_string(), |hz| format!("{hz} Hz")),
+    );
+    let _ = writeln!(
+        text,
+        "\n{:<15} {:<4} {:>15} {:>14} {:>14} {:>14} {:>15} {:>14}",
+        "loop",
+        "at",
+        "wc [rad/s]",
+        "PM [deg]",
+        "min PM [deg]",
+        "GM [dB]",
+        "w180 [rad/s]",
+        "DRB [rad/s]"
+    );
+    for l in &result.loops {
+        let _ = writeln!(
+            text,
+            "{:<15} {:<4} {:>15} {:>14} {:>14} {:>14} {:>15} {:>14}",
+            l.name,
+            l.broken_at,
+            cell(&l.crossover_rad_s, 2),
+            cell(&l.phase_margin_deg, 1),
+            cell(&l.min_phase_margin_deg, 1),
+            cell(&l.gain_margin_db, 1),
+            cell(&l.phase_crossover_rad_s, 2),
+            cell(&l.drb_rad_s, 2),
+        );
+    }
+    let _ = writeln!(
+        text,
+        "\n{:<6} {:<6} {:>16} {:>18} {:>10}",
+        "stick", "mode", "wBW [rad/s]", "tau_p [s]", "level T/O"
+    );
+    for h in &result.handling {
+        let level = |l: Option<u8>| l.map_or("—".to_string(), |l| l.to_string());
+        let _ = writeln!(
+            text,
+            "{:<6} {:<6} {:>16} {:>18} {:>10}",
+            h.axis,
+            match h.mode {
+                control::law::LoopMode::Rate => "rate",
+                control::law::LoopMode::Level => "level",
+            },
+            cell(&h.bandwidth_rad_s, 2),
+            cell(&h.phase_delay_s, 3),
+            format!("{}/{}", level(h.level_tracking), level(h.level_other)),
+        );
+    }
+    for note in &result.notes {
+        let _ = writeln!(text, "note: {note}");
+    }
+    text
+}
