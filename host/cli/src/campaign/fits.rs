@@ -10,6 +10,7 @@ use anyhow::anyhow;
 use sysid::document::FrfDocument;
 use sysid::fit::equation_error::equation_error_start;
 use sysid::fit::modes::{mode_records, poles_at_origin};
+use sysid::fit::plausible::{implausible_parameters, HeldParameter};
 use sysid::fit::trim::TrimPoints;
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, FitResult, ModelStructure,
@@ -121,9 +122,20 @@ impl Campaign<'_> {
             ..args.options(None)
         };
         let (result, _outcomes) = fit_from_alternative_starts(&starts, frf, &options)?;
-        write_json(&out_path(&args)?, &result.to_document())?;
+        // Written as it is, but never as a usable model: what lies outside its physical
+        // range is named in the file and on the console.
+        let outside: Vec<HeldParameter> = implausible_parameters(&result.structure, &result.values)
+            .into_iter()
+            .map(|found| HeldParameter {
+                name: found.name,
+                value: found.value,
+            })
+            .collect();
+        let mut document = result.to_document();
+        document.outside_physical_range = outside.clone();
+        write_json(&out_path(&args)?, &document)?;
         let line = format!(
-            "{}: J_ave {:.1}, {} pairs{}",
+            "{}: J_ave {:.1}, {} pairs{}{}",
             result.structure.name,
             result.average_cost,
             result.pairs.len(),
@@ -131,6 +143,20 @@ impl Campaign<'_> {
                 ", equation-error start"
             } else {
                 ""
+            },
+            if outside.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; degenerate, a start only ({} outside the physical ranges: {})",
+                    outside.len(),
+                    outside
+                        .iter()
+                        .take(3)
+                        .map(|held| format!("{} = {:.3e}", held.name, held.value))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
             }
         );
         Ok((result, line))

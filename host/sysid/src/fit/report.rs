@@ -140,6 +140,11 @@ pub struct ModelDocument {
     /// outside their physical range, with the values it gave them ([`super::plausible`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub implausible_held: Vec<super::plausible::HeldParameter>,
+    /// Parameters this model keeps outside their physical range (a degenerate minimum
+    /// written as it is, never as a usable model: the campaign's 6-DOF start, which
+    /// only starts the hybrid; [`super::plausible`]). Left out when there are none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outside_physical_range: Vec<super::plausible::HeldParameter>,
 }
 
 /// `model.json` with its optional `truth` section and the model's `modes`: the
@@ -281,6 +286,7 @@ impl ModelDocument {
             skipped_pairs: result.skipped_pairs.clone(),
             trim: result.trim.clone(),
             implausible_held: result.implausible_held.clone(),
+            outside_physical_range: Vec::new(),
         }
     }
 

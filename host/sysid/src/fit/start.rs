@@ -250,6 +250,7 @@ mod tests {
             skipped_pairs: Vec::new(),
             trim: None,
             implausible_held: Vec::new(),
+            outside_physical_range: Vec::new(),
         }
     }
 
