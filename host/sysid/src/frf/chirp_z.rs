@@ -378,7 +378,7 @@ mod tests {
             assert!(len >= n + m - 1);
             let mut rest = len;
             for p in [2, 3, 5] {
-                while rest % p == 0 {
+                while rest.is_multiple_of(p) {
                     rest /= p;
                 }
             }
