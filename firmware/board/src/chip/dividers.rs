@@ -77,7 +77,7 @@ pub fn usart_brr(pclk_hz: u32, baud: u32) -> Result<u32, DividerError> {
 /// and the flight logic at `rate_hz`: None unless `rate_hz` divides `timer_hz`, since
 /// the control tick must fall on an IMU sample every time.
 pub fn ticks_per_control(timer_hz: u32, rate_hz: u32) -> Option<u32> {
-    (rate_hz > 0 && timer_hz % rate_hz == 0).then(|| timer_hz / rate_hz)
+    (rate_hz > 0 && timer_hz.is_multiple_of(rate_hz)).then(|| timer_hz / rate_hz)
 }
 
 /// SPI baud-rate field CR1.BR (RM0090 §28.5.1): the SPI clock is f_pclk / 2^(BR+1),

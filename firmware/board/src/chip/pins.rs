@@ -119,7 +119,7 @@ impl Crystal {
     /// A crystal of `hz`; stops the build for one the clock tree cannot use.
     pub const fn hz(hz: u32) -> Crystal {
         assert!(
-            hz >= 4_000_000 && hz <= 26_000_000 && hz % 2_000_000 == 0,
+            hz >= 4_000_000 && hz <= 26_000_000 && hz.is_multiple_of(2_000_000),
             "the crystal must be a multiple of 2 MHz from 4 to 26 MHz"
         );
         Crystal(hz)
