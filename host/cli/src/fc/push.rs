@@ -19,7 +19,7 @@ pub struct Pushed {
 }
 
 /// The changes `file` asks of a board holding `board`: `(name, old, new)` for each value
-/// that differs, or why the file cannot be pushed (nothing written).
+/// that differs, in the board's order, or why the file cannot be pushed (nothing written).
 pub fn plan(board: &[BoardValue], file: &[BoardValue]) -> anyhow::Result<Vec<(String, f32, f32)>> {
     check_same_table(board)?;
     let mut changes = Vec::new();
@@ -49,6 +49,8 @@ pub fn plan(board: &[BoardValue], file: &[BoardValue]) -> anyhow::Result<Vec<(St
             changes.push((entry.name.clone(), current.value, entry.value));
         }
     }
+    // Set in the board's order, whatever the file's.
+    changes.sort_by_key(|(name, _, _)| board.iter().position(|b| &b.name == name));
     Ok(changes)
 }
 
