@@ -9,7 +9,7 @@
 //! table holds.
 //!
 //! Bounded work: a `Get`, `Set` or `Reset` is answered at once with one frame; a `List`
-//! is answered one reply per control tick (80 values then Done, 0.4 s at 200 Hz), so it
+//! is answered one reply per control tick (81 ticks for 80 values and Done), so it
 //! never adds more than one frame to a tick's telemetry. A reply that finds the transmit
 //! ring full is sent again on the next tick rather than dropped. A new `List` restarts
 //! the walk; arming in the middle of one ends it with an `Armed` refusal.
