@@ -707,3 +707,6 @@ fn qemu_arm_by_sbus_then_a_host_sensor_in_is_ignored() {
         "disarmed, the SensorIn is answered"
     );
 }
+
+#[path = "qemu_params.rs"]
+mod qemu_params;

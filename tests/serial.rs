@@ -3,7 +3,8 @@
 //! board image does (`firmware/board/src/image/runner.rs`): a Configure builds the vehicle's
 //! preset with the received rate and test and is answered by Header + ConfigureResult;
 //! each SensorIn steps the flight logic, whose Events and Sample go out, then the
-//! ActuatorOut answering its `seq`. The host opens the slave side as the board's tty.
+//! ActuatorOut answering its `seq`; a ParamRequest is answered by the firmware's
+//! `ParamLink` (`sweephold fc params`). The host opens the slave side as the board's tty.
 
 use std::fs::File;
 use std::io::{Read, Write};
@@ -14,9 +15,13 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use clap::Parser;
+use sweephold_firmware::params::link::ParamLink;
+use sweephold_firmware::params::no_flash::NoFlash;
 use sweephold_firmware::{Config, FlightController};
 use sweephold_protocol::codec::encode_to_vec;
-use sweephold_protocol::{ConfigureResult, Decoder, Frame, LinkConfig, ProtocolVersion, VehicleId};
+use sweephold_protocol::{
+    ConfigureResult, Decoder, Frame, LinkConfig, ParamRequest, ProtocolVersion, VehicleId,
+};
 use sweephold_tests::{fly, fly_args, Scratch};
 
 /// How the fake board answers.
@@ -28,6 +33,9 @@ enum Board {
     Silent,
     /// Answers a Configure with a Header of protocol major 2.
     ProtocolMajor2,
+    /// The firmware library, but its third parameter Set is refused as armed (an arm
+    /// switch flipped in the middle of a push).
+    ArmsAtThirdSet,
 }
 
 /// A pseudo-terminal whose master side a thread drives as a board.
@@ -103,6 +111,10 @@ fn put(out: &mut Vec<u8>, frame: &Frame) {
 fn play_board(mut master: File, behaviour: Board, stop: &AtomicBool) {
     let mut decoder = Decoder::new();
     let mut fc: Option<FlightController> = None;
+    // The parameters in RAM, answered as the board image does (`image/params.rs`), but a
+    // List all at once.
+    let mut params: ParamLink<NoFlash> = ParamLink::boot(None, VehicleId::Trex700l);
+    let mut sets = 0;
     let mut chunk = [0u8; 4096];
     while !stop.load(Ordering::Relaxed) {
         let mut poll = libc::pollfd {
@@ -151,6 +163,15 @@ fn play_board(mut master: File, behaviour: Board, stop: &AtomicBool) {
                             &Frame::ActuatorOut(output.actuator_out(tick, input.seq)),
                         );
                     }
+                }
+                (Board::Firmware | Board::ArmsAtThirdSet, Ok(Frame::ParamRequest(request))) => {
+                    if matches!(request, ParamRequest::Set { .. }) {
+                        sets += 1;
+                    }
+                    let disarmed = behaviour == Board::Firmware || sets != 3;
+                    params.handle(&request, disarmed, |reply| {
+                        put(&mut answer, &Frame::ParamReply(reply))
+                    });
                 }
                 (Board::ProtocolMajor2, Ok(Frame::Configure(request))) => {
                     let controller =
@@ -297,4 +318,67 @@ fn a_malformed_fc_value_is_a_usage_error() {
             .to_string();
         assert!(error.contains("--fc"), "{fc}: {error}");
     }
+}
+
+/// `sweephold fc params` as separate commands on one board (its RAM outlives each
+/// connection): a pushed file comes back from `pull` value for value, `diff` then finds
+/// no difference, and `get` reads one value.
+#[test]
+fn params_push_then_pull_over_a_serial_port() {
+    let board = FakeBoard::start(Board::Firmware);
+    let fc = board.fc_arg();
+    let scratch = Scratch::new("serial-params");
+    let path = |name: &str| scratch.path().join(name).display().to_string();
+    run_cli(&["fc", "params", "pull", &path("before.toml"), "--fc", &fc]).expect("pull");
+    let before = std::fs::read_to_string(path("before.toml")).unwrap();
+    let changed = before
+        .replace("SWASH_TYPE = 120\n", "SWASH_TYPE = 140\n")
+        .replace("SWASH_PHASE = 0\n", "SWASH_PHASE = -12.5\n");
+    assert_ne!(changed, before, "the defaults are as expected");
+    std::fs::write(path("pushed.toml"), &changed).unwrap();
+    run_cli(&["fc", "params", "push", &path("pushed.toml"), "--fc", &fc]).expect("push");
+    run_cli(&["fc", "params", "pull", &path("after.toml"), "--fc", &fc]).expect("pull");
+    let after = std::fs::read_to_string(path("after.toml")).unwrap();
+    assert_eq!(after, changed, "pull gives back the pushed set");
+    run_cli(&["fc", "params", "diff", &path("pushed.toml"), "--fc", &fc]).expect("diff");
+    // The pushed file is an input: not modified.
+    assert_eq!(
+        std::fs::read_to_string(path("pushed.toml")).unwrap(),
+        changed
+    );
+}
+
+/// A push whose third set is refused (the board armed mid-way) puts back the two values
+/// it had changed: the board holds what it held before, and the error says so.
+#[test]
+fn a_push_refused_mid_way_restores_the_board() {
+    let board = FakeBoard::start(Board::ArmsAtThirdSet);
+    let fc = board.fc_arg();
+    let scratch = Scratch::new("serial-params-midway");
+    let path = |name: &str| scratch.path().join(name).display().to_string();
+    run_cli(&["fc", "params", "pull", &path("before.toml"), "--fc", &fc]).expect("pull");
+    let before = std::fs::read_to_string(path("before.toml")).unwrap();
+    let changed = before
+        .replace("SWASH_TYPE = 120\n", "SWASH_TYPE = 140\n")
+        .replace("SWASH_PHASE = 0\n", "SWASH_PHASE = -12.5\n")
+        .replace("SWASH_LEAD = 1\n", "SWASH_LEAD = 2\n");
+    std::fs::write(path("pushed.toml"), &changed).unwrap();
+    let error = run_cli(&["fc", "params", "push", &path("pushed.toml"), "--fc", &fc])
+        .expect_err("the third set is refused");
+    assert!(
+        error.contains("setting SWASH_LEAD failed")
+            && error.contains("armed")
+            && error.contains("restored"),
+        "{error}"
+    );
+    run_cli(&["fc", "params", "pull", &path("after.toml"), "--fc", &fc]).expect("pull");
+    assert_eq!(std::fs::read_to_string(path("after.toml")).unwrap(), before);
+}
+
+/// Run `sweephold ARGS` in-process; the error as its one line.
+fn run_cli(args: &[&str]) -> Result<(), String> {
+    let cli =
+        sweephold::Cli::try_parse_from(std::iter::once("sweephold").chain(args.iter().copied()))
+            .map_err(|e| e.to_string())?;
+    sweephold::run(cli).map_err(|e| format!("{e:#}"))
 }

@@ -120,10 +120,11 @@ impl<F: NorFlash> ParamLink<F> {
         }
         match *request {
             ParamRequest::List => {
-                for id in ParamId::ALL {
-                    reply(self.value(id));
+                for index in 0..=COUNT {
+                    if let Some(entry) = self.list_entry(index) {
+                        reply(entry);
+                    }
                 }
-                reply(ParamReply::Done { op });
             }
             ParamRequest::Get { name } => match lookup(&name) {
                 Some(id) => reply(self.value(id)),
@@ -158,6 +159,20 @@ impl<F: NorFlash> ParamLink<F> {
                 self.table = ParamTable::defaults(self.vehicle);
                 reply(ParamReply::Done { op });
             }
+        }
+    }
+
+    /// The reply at position `index` of a `List`: the Value of the parameter at
+    /// `index`, the closing Done at `COUNT`, nothing after. A board that answers a
+    /// `List` one reply per tick (bounded work per tick) walks `index` from 0 itself;
+    /// [`ParamLink::handle`] sends them all at once.
+    pub fn list_entry(&self, index: usize) -> Option<ParamReply> {
+        match ParamId::from_index(index) {
+            Some(id) => Some(self.value(id)),
+            None if index == COUNT => Some(ParamReply::Done {
+                op: sweephold_protocol::ParamOp::List,
+            }),
+            None => None,
         }
     }
 

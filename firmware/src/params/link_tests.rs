@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::params::mock_flash::{MockFlash, PAGE, PAGES};
+use crate::params::no_flash::NoFlash;
 use crate::params::DEFS;
 use sweephold_protocol::ParamOp;
 
@@ -122,6 +123,40 @@ fn list_gives_every_parameter_in_table_order_then_done() {
         assert_eq!(value, link.table().values()[i]);
     }
     assert_eq!(out[COUNT], ParamReply::Done { op: ParamOp::List });
+}
+
+#[test]
+fn list_entries_one_at_a_time_are_the_list_reply() {
+    let mut link = link(MockFlash::new());
+    link.handle(
+        &ParamRequest::Set {
+            name: name("SWASH_PHASE"),
+            value: 5.0,
+        },
+        true,
+        |_| {},
+    );
+    let whole = replies(&mut link, ParamRequest::List, true);
+    let stepped: Vec<ParamReply> = (0..).map_while(|i| link.list_entry(i)).collect();
+    assert_eq!(stepped, whole);
+    assert_eq!(link.list_entry(COUNT + 1), None);
+}
+
+#[test]
+fn a_link_without_store_refuses_save_and_lists_the_defaults() {
+    let mut link: ParamLink<NoFlash> = ParamLink::boot(None, VEHICLE);
+    assert!(link.params_valid());
+    assert_eq!(*link.table(), ParamTable::defaults(VEHICLE));
+    let mut out = Vec::new();
+    link.handle(&ParamRequest::Save, true, |reply| out.push(reply));
+    assert_eq!(
+        out,
+        [ParamReply::Refused {
+            op: ParamOp::Save,
+            name: ParamName::EMPTY,
+            reason: ParamRefusal::NoStore,
+        }]
+    );
 }
 
 #[test]

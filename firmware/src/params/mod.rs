@@ -16,6 +16,7 @@
 //!   defaults give the preset exactly.
 //! * [`store`] — the set in flash, versioned, CRC-checked and wear-levelled.
 //! * [`link`] — the host's parameter requests (protocol 1.5), obeyed only disarmed.
+//! * [`no_flash`] — the flash type of a board that keeps its parameters in RAM only.
 //!
 //! Every value is an `f32`, as ArduPilot's parameters travel over MAVLink: whole
 //! numbers up to 2²⁴ are exact, which covers every integer parameter here.
@@ -23,6 +24,7 @@
 pub mod link;
 #[cfg(test)]
 pub(crate) mod mock_flash;
+pub mod no_flash;
 pub mod store;
 pub mod table;
 #[cfg(test)]

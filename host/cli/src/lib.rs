@@ -18,6 +18,7 @@ pub mod artifacts;
 pub mod campaign;
 pub mod csv_args;
 pub mod decode;
+pub mod fc;
 pub mod fit;
 pub mod fly;
 pub mod frf;
@@ -59,6 +60,8 @@ pub enum Command {
     Campaign(campaign::CampaignArgs),
     /// Decode telemetry dumps into CSV or JSON lines (one row per Sample).
     Decode(decode::DecodeArgs),
+    /// Set up the flight controller over its link: `fc params list|get|set|save|reset|pull|push|diff`.
+    Fc(fc::FcArgs),
     /// Fit a state-space model structure to frequency responses (CIFER DERIVID-like).
     Fit(fit::FitArgs),
     /// Fly sweep records with the flight controller in the loop and the simulator as the aircraft.
@@ -93,6 +96,7 @@ fn run_verb(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Campaign(args) => campaign::run(&args),
         Command::Decode(args) => decode::run(&args),
+        Command::Fc(args) => fc::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Fly(args) => fly::run(&args),
         Command::Frf(args) => frf::run(&args),

@@ -1,6 +1,6 @@
 //! The image logic, the same on every board: the boot and the control loop
 //! ([`runner`]: what the flight controller does each tick in either run mode), the frame
-//! link to the host ([`link`]), the QEMU-only semihosting transport ([`semihosting`]),
+//! link to the host ([`link`]), the host's parameter requests on it ([`params`]), the QEMU-only semihosting transport ([`semihosting`]),
 //! the defmt logger ([`log`]) and the flight configuration the image is built with
 //! ([`config`]).
 //!
@@ -11,5 +11,6 @@
 pub mod config;
 pub mod link;
 pub mod log;
+pub mod params;
 pub mod runner;
 pub mod semihosting;

@@ -36,6 +36,10 @@
 //! chosen on the ground, never a takeover in flight. The first such frame of each armed
 //! period is reported with an Event (`HostLinkIgnored`), every one is counted.
 //!
+//! **Parameters** (protocol 1.5): ParamRequest frames are answered through
+//! [`crate::image::params`] in the board application while it is disarmed (refused as
+//! armed otherwise, and in the loop); a List is answered one reply per control tick.
+//!
 //! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the in-the-loop
 //! configuration at run time. The image builds the preset of the frame's vehicle for
 //! its test's primary axis, puts the frame's rate and test in, and restarts the flight
@@ -69,6 +73,7 @@ use crate::chip::watchdog::Watchdog;
 use crate::image::config::{image_config, link_config, stack_config};
 use crate::image::link::{self, FrameScratch, Inbound, Telemetry};
 use crate::image::log;
+use crate::image::params::HostParams;
 use crate::image::semihosting;
 
 /// Host silence after which the loop steps on its own again [s].
@@ -149,6 +154,8 @@ pub struct Runner {
     /// Fed by every fresh sample (board application: an IMU sample; in the loop: a
     /// SensorIn).
     watchdog: Watchdog,
+    /// The parameter table the host's ParamRequest frames read and set.
+    params: HostParams,
 }
 
 impl Runner {
@@ -251,6 +258,9 @@ impl Runner {
         let control_due = self.since_control >= self.control_period;
         if control_due {
             self.since_control = 0;
+            let disarmed = self.params_allowed();
+            self.params
+                .on_control_tick(disarmed, &mut self.tx, &mut self.scratch);
         }
         match self.mode {
             Mode::BoardApplication => {
@@ -326,6 +336,13 @@ impl Runner {
         false
     }
 
+    /// Whether the host's parameter requests are obeyed: in the board application while
+    /// it is disarmed (in the loop the host's simulation flies the servos: refused as
+    /// armed).
+    fn params_allowed(&self) -> bool {
+        self.mode == Mode::BoardApplication && self.stack.app().host_link_allowed()
+    }
+
     /// Leave the board application for the loop: the ESC to the cut, the link timer's
     /// silence count from zero.
     fn enter_the_loop(&mut self) {
@@ -399,6 +416,11 @@ impl Runner {
                 self.watchdog.fed_by_fresh_sample();
             }
             Ok(Frame::Configure(request)) => self.configure(&request),
+            Ok(Frame::ParamRequest(request)) => {
+                let disarmed = self.params_allowed();
+                self.params
+                    .on_request(&request, disarmed, &mut self.tx, &mut self.scratch);
+            }
             Ok(_) => self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1),
             // The decoder has resynchronised on the next delimiter already.
             Err(_) => self.stats.bad_frames = self.stats.bad_frames.wrapping_add(1),
@@ -467,6 +489,7 @@ pub fn run() -> ! {
         host_ignored_reported: false,
         scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
         watchdog,
+        params: HostParams::new(image_config().vehicle),
     };
     runner.announce();
 

@@ -94,6 +94,16 @@ impl<W: ByteWire> FrameChannel<W> {
         &mut self.wire
     }
 
+    /// The same channel (bytes received and not handed out kept) over the wire `wrap`
+    /// makes of this one's.
+    pub fn map_wire<V>(self, wrap: impl FnOnce(W) -> V) -> FrameChannel<V> {
+        FrameChannel {
+            wire: wrap(self.wire),
+            pending: self.pending,
+            scanned: self.scanned,
+        }
+    }
+
     /// Encode and send `frame`.
     pub fn send(&mut self, frame: &Frame) -> anyhow::Result<()> {
         let bytes = encode_to_vec(frame).map_err(|e| anyhow!("cannot encode {e:?}"))?;

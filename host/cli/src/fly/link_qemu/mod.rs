@@ -48,8 +48,9 @@ use super::defmt_log::{write_log, DefmtTable};
 use super::frame_channel::{check_configure_answer, link_config};
 use super::link::FlightControllerLink;
 pub use image::{check_image, default_image, IMAGE_ENV, IMAGE_IN_TARGET_DIR};
+use process::CONFIGURE_TIMEOUT;
 pub use process::{extra_args_from_env, qemu_available, QemuTransport, QEMU};
-use process::{start_session, Session, CONFIGURE_TIMEOUT};
+pub use process::{start_session, QemuProcess, Session};
 
 /// How long the image may take to answer one SensorIn. A tick needs well under a
 /// millisecond of emulated time; this only catches a dead or wedged emulator.

@@ -82,7 +82,7 @@ const SEMIHOSTING_MAILBOX: [(u32, u32); 2] =
     [(0x2001_0000, 0x5348_5354), (0x2001_0004, !0x5348_5354)];
 
 /// One QEMU process running the image, and the byte stream to it.
-pub(super) struct QemuProcess {
+pub struct QemuProcess {
     child: Child,
     /// Killed by a run ended at once by a signal (`crate::interrupt`); otherwise on drop.
     _registration: crate::interrupt::Registration,
@@ -91,7 +91,7 @@ pub(super) struct QemuProcess {
 }
 
 /// The frame exchange with one QEMU.
-pub(super) type Session = FrameChannel<QemuProcess>;
+pub type Session = FrameChannel<QemuProcess>;
 
 impl QemuProcess {
     /// Append what the image has logged since the last call to `bytes`.
@@ -127,7 +127,7 @@ impl ByteWire for QemuProcess {
 
 /// Boot `image` in QEMU and connect to its USART1. `extra_args` go to QEMU as they
 /// are (e.g. `-icount shift=0`).
-pub(super) fn start_session(
+pub fn start_session(
     image: &Path,
     transport: QemuTransport,
     extra_args: &[String],

@@ -1,0 +1,321 @@
+//! `sweephold fc`: set up the flight controller over its link. `fc params` lists, reads,
+//! sets, saves and resets the board's parameters (protocol 1.5's parameter frames),
+//! pulls them into a params file, pushes such a file (all or nothing) and compares one
+//! with the board, over `--fc qemu-usart` (the board image in QEMU, its USART1 on a
+//! socket) or `--fc serial:PATH[@BAUD]` (a board on a serial port).
+//!
+//! Its parts: [`client`] (the frames), [`params_file`] (the file format) and [`push`]
+//! (checking a file against the board, then writing it all or nothing).
+
+pub mod client;
+pub mod params_file;
+pub mod push;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand};
+
+use crate::fly::frame_channel::{ByteWire, FrameChannel};
+use crate::fly::link_qemu::{self, QemuProcess, QemuTransport};
+use crate::fly::link_serial::{SerialPort, SerialWire};
+use crate::output;
+use client::{BoardValue, ParamBoard, ParamClient};
+use params_file::Source;
+
+/// `sweephold fc`.
+#[derive(Args, Debug)]
+pub struct FcArgs {
+    /// What to set up.
+    #[command(subcommand)]
+    pub command: FcCommand,
+}
+
+/// The parts of the flight controller `sweephold fc` sets up.
+#[derive(Subcommand, Debug)]
+pub enum FcCommand {
+    /// The board's parameters (list, get, set, save, reset, pull, push, diff).
+    Params(ParamsArgs),
+}
+
+/// `sweephold fc params`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Parameters change only while the board is disarmed (every request is \
+refused while armed) and only in its RAM until `save`. `push` reads the board's list first, \
+refuses unknown names and out-of-range values before writing anything, sets only the values \
+that differ, and puts the old values back if a set fails mid-way."
+)]
+pub struct ParamsArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub action: ParamsAction,
+    /// The flight controller: `qemu-usart` (the board image in qemu-system-arm, frames
+    /// over its USART1; its parameters live as long as that QEMU, i.e. this command) or
+    /// `serial:PATH[@BAUD]` (a board on a serial port, default 460800 Bd).
+    #[arg(long, value_name = "FC", global = true, value_parser = parse_fc)]
+    pub fc: Option<FcLink>,
+    /// Board image for `--fc qemu-usart` [default: $SWEEPHOLD_FC_ELF, else
+    /// target/thumbv7em-none-eabihf/firmware/sweephold-fc of the workspace this binary
+    /// was built in, else of the current folder].
+    #[arg(long, value_name = "PATH", global = true)]
+    pub elf: Option<PathBuf>,
+}
+
+/// What `fc params` does.
+#[derive(Subcommand, Debug)]
+pub enum ParamsAction {
+    /// Print every parameter as `NAME = value`, in the board's order.
+    List,
+    /// Print one parameter's value.
+    Get {
+        /// The parameter's name (upper case, e.g. SWASH_TYPE).
+        name: String,
+    },
+    /// Set one parameter in the board's RAM and print the value it now holds.
+    Set {
+        /// The parameter's name.
+        name: String,
+        /// Its new value.
+        #[arg(allow_hyphen_values = true)]
+        value: f32,
+    },
+    /// Write the set in the board's RAM to its flash.
+    Save,
+    /// Put the defaults in the board's RAM (`save` makes that permanent).
+    Reset,
+    /// Write every parameter into a params file (TOML, docs/formats.md).
+    Pull {
+        /// The params file to write (replaced atomically).
+        file: PathBuf,
+    },
+    /// Set the board's RAM to a params file's values, all or nothing.
+    Push {
+        /// The params file to read.
+        file: PathBuf,
+    },
+    /// Show where the board and a params file differ.
+    Diff {
+        /// The params file to compare with.
+        file: PathBuf,
+    },
+}
+
+/// A flight controller `fc` reaches.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FcLink {
+    /// The board image in QEMU over its USART1.
+    QemuUsart,
+    /// A board on a serial port.
+    Serial(SerialPort),
+}
+
+impl FcLink {
+    fn name(&self) -> String {
+        match self {
+            FcLink::QemuUsart => "qemu-usart".to_string(),
+            FcLink::Serial(port) => format!("serial:{port}"),
+        }
+    }
+}
+
+/// Parse `--fc` of `fc`: `qemu-usart` or `serial:PATH[@BAUD]`.
+pub fn parse_fc(text: &str) -> Result<FcLink, String> {
+    if text == "qemu-usart" {
+        return Ok(FcLink::QemuUsart);
+    }
+    match text.strip_prefix("serial:") {
+        Some(port) => SerialPort::parse(port)
+            .map(FcLink::Serial)
+            .map_err(|e| e.to_string()),
+        None => Err(format!(
+            "unknown flight controller `{text}` (expected qemu-usart or serial:PATH[@BAUD])"
+        )),
+    }
+}
+
+/// The byte stream to the board: either link.
+pub enum FcWire {
+    /// QEMU running the image.
+    Qemu(QemuProcess),
+    /// A serial port.
+    Serial(SerialWire),
+}
+
+impl ByteWire for FcWire {
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        match self {
+            FcWire::Qemu(wire) => wire.send(bytes),
+            FcWire::Serial(wire) => wire.send(bytes),
+        }
+    }
+
+    fn recv(&mut self, buf: &mut [u8], timeout: std::time::Duration) -> std::io::Result<usize> {
+        match self {
+            FcWire::Qemu(wire) => wire.recv(buf, timeout),
+            FcWire::Serial(wire) => wire.recv(buf, timeout),
+        }
+    }
+
+    fn failure(&mut self, what: &str) -> anyhow::Error {
+        match self {
+            FcWire::Qemu(wire) => wire.failure(what),
+            FcWire::Serial(wire) => wire.failure(what),
+        }
+    }
+}
+
+/// `sweephold fc`.
+pub fn run(args: &FcArgs) -> anyhow::Result<()> {
+    match &args.command {
+        FcCommand::Params(params) => run_params(params),
+    }
+}
+
+fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
+    let Some(fc) = &args.fc else {
+        bail!("--fc is required (qemu-usart or serial:PATH[@BAUD])");
+    };
+    // Inputs are read, and outputs checked, before the board is reached.
+    let file_values = match &args.action {
+        ParamsAction::Push { file } | ParamsAction::Diff { file } => Some(read_params_file(file)?),
+        _ => None,
+    };
+    if let ParamsAction::Pull { file } = &args.action {
+        output::refuse_inputs_as_outputs(&[], &[("FILE", file)])?;
+    }
+    let (mut client, source) = connect(fc, args.elf.as_deref())?;
+    match &args.action {
+        ParamsAction::List => output::print(&listing(&client.list()?)),
+        ParamsAction::Get { name } => output::print(&format!("{}\n", client.get(name)?)),
+        ParamsAction::Set { name, value } => {
+            local_check(name, *value)?;
+            let held = client.set(name, *value)?;
+            output::print(&format!("{name} = {held}\n"))
+        }
+        ParamsAction::Save => {
+            client.save()?;
+            output::print("saved\n")
+        }
+        ParamsAction::Reset => {
+            client.reset()?;
+            output::print("defaults in RAM (not saved)\n")
+        }
+        ParamsAction::Pull { file } => {
+            let values = client.list()?;
+            client::check_same_table(&values)?;
+            output::write_atomic(file, params_file::write(&source, &values).as_bytes())?;
+            output::print(&format!(
+                "{} parameters -> {}\n",
+                values.len(),
+                file.display()
+            ))
+        }
+        ParamsAction::Push { .. } => {
+            let values = file_values.unwrap_or_default();
+            let pushed = push::push(&mut client, &values)?;
+            output::print(&format!(
+                "{} changed, {} already held (in RAM: `sweephold fc params save` to keep them)\n",
+                pushed.changed, pushed.unchanged
+            ))
+        }
+        ParamsAction::Diff { .. } => {
+            let board = client.list()?;
+            output::print(&diff(&board, &file_values.unwrap_or_default()))
+        }
+    }
+}
+
+/// A value the host's copy of the firmware's table refuses is refused here, with the
+/// range, before the board is asked; unknown names are left to the board (its table may
+/// be newer).
+fn local_check(name: &str, value: f32) -> anyhow::Result<()> {
+    let Some(id) = sweephold_firmware::params::ParamId::from_name(name) else {
+        return Ok(());
+    };
+    let def = id.def();
+    def.check(value).map_err(|error| {
+        anyhow::anyhow!(
+            "{name} = {value}: {} ({} … {} {})",
+            error.message(),
+            def.min,
+            def.max,
+            def.unit
+        )
+    })
+}
+
+fn read_params_file(path: &Path) -> anyhow::Result<Vec<BoardValue>> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        anyhow::anyhow!("cannot read {}: {}", path.display(), output::io_reason(&e))
+    })?;
+    params_file::parse(&text, &path.display().to_string())
+}
+
+/// Reach the board over `fc`.
+fn connect(fc: &FcLink, elf: Option<&Path>) -> anyhow::Result<(ParamClient<FcWire>, Source)> {
+    match fc {
+        FcLink::QemuUsart => {
+            let image = match elf {
+                Some(path) => path.to_path_buf(),
+                None => link_qemu::default_image()?,
+            };
+            let session = link_qemu::start_session(
+                &image,
+                QemuTransport::Usart,
+                &link_qemu::extra_args_from_env(),
+            )?;
+            let channel = session.map_wire(FcWire::Qemu);
+            let source = Source {
+                fc: fc.name(),
+                image: Some(image.display().to_string()),
+            };
+            Ok((ParamClient::new(channel), source))
+        }
+        FcLink::Serial(port) => {
+            let wire = SerialWire::open(port)
+                .with_context(|| format!("cannot reach the flight controller on {port}"))?;
+            let channel = FrameChannel::new(FcWire::Serial(wire));
+            let source = Source {
+                fc: fc.name(),
+                image: None,
+            };
+            Ok((ParamClient::new(channel), source))
+        }
+    }
+}
+
+/// `NAME = value` lines.
+fn listing(values: &[BoardValue]) -> String {
+    values
+        .iter()
+        .map(|v| format!("{} = {}\n", v.name, v.value))
+        .collect()
+}
+
+/// The differences between the board and a file, one line each.
+pub fn diff(board: &[BoardValue], file: &[BoardValue]) -> String {
+    let mut text = String::new();
+    for entry in file {
+        match board.iter().find(|b| b.name == entry.name) {
+            Some(b) if b.value.to_bits() == entry.value.to_bits() => {}
+            Some(b) => text.push_str(&format!(
+                "{}: board {} file {}\n",
+                entry.name, b.value, entry.value
+            )),
+            None => text.push_str(&format!(
+                "{}: not on the board, file {}\n",
+                entry.name, entry.value
+            )),
+        }
+    }
+    for b in board {
+        if !file.iter().any(|entry| entry.name == b.name) {
+            text.push_str(&format!("{}: board {}, not in the file\n", b.name, b.value));
+        }
+    }
+    if text.is_empty() {
+        text.push_str(&format!("no difference ({} parameters)\n", file.len()));
+    }
+    text
+}
