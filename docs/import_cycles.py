@@ -12,7 +12,7 @@ import os
 import re
 import sys
 
-CRATES = ["shared", "firmware", "firmware/board", "host/bo105", "host/sysid", "host/cli", "host/truth"]
+CRATES = ["shared", "firmware", "firmware/board", "host/rotorsim", "host/sysid", "host/cli", "host/truth"]
 
 
 def module_of(src, path):

@@ -102,7 +102,7 @@ impl Gains {
     /// Small integral gains trim out offsets over tens of seconds; authority ±0.3 of
     /// stick around trim; bumpless hand-over in τ_b = 0.1 s.
     ///
-    /// Release fade τ_r = 2 s (see `controller`). Tuned against `host/bo105` in hover
+    /// Release fade τ_r = 2 s (see `controller`). Tuned against `host/rotorsim` in hover
     /// with sensor noise, pilot sticks at trim, the paper's two sweeps per axis in CAH
     /// mode with off-axis noise RMS 0.03 (`sweephold fly`, seeds 1–3): no abort, |φ| and
     /// |θ| at most 9°, the hold engaged ~10–15 % of the excitation on the lateral records.

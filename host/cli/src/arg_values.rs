@@ -46,9 +46,9 @@ pub fn window_overlap(text: &str) -> Result<f64, String> {
 }
 
 /// A trim speed in knots, from 0 (hover) to the simulator's largest
-/// ([`bo105::trim::MAX_TRIM_SPEED_KT`]).
+/// ([`rotorsim::trim::MAX_TRIM_SPEED_KT`]).
 pub fn trim_speed_kt(text: &str) -> Result<f64, String> {
-    let max = bo105::trim::MAX_TRIM_SPEED_KT;
+    let max = rotorsim::trim::MAX_TRIM_SPEED_KT;
     number_in(
         text,
         Some(0.0),

@@ -1,4 +1,4 @@
-//! `sweephold sim`: trim and linearize a simulated helicopter (crate `bo105`): a shipped
+//! `sweephold sim`: trim and linearize a simulated helicopter (crate `rotorsim`): a shipped
 //! aircraft or an aircraft file.
 //!
 //! ```text
@@ -17,8 +17,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use crate::vehicle::Vehicle;
-use bo105::{linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim};
 use clap::{Args, Subcommand};
+use rotorsim::{linearize_with, trim, trim_steady, Helicopter, Linearization, SteadyFlight, Trim};
 use serde_json::{json, Map, Value};
 use sysid::fit::trim::{TrimPoint, TrimPoints};
 

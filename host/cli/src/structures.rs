@@ -49,7 +49,7 @@ fn shipped_for_its_vehicle(
 ) -> anyhow::Result<ModelStructure> {
     let vehicle = aircraft::shipped(shipped.vehicle)
         .ok_or_else(|| anyhow!("{}: no aircraft `{}`", shipped.name, shipped.vehicle))?;
-    let trim = bo105::trim(&bo105::Helicopter::from_aircraft(&vehicle), 0.0)
+    let trim = rotorsim::trim(&rotorsim::Helicopter::from_aircraft(&vehicle), 0.0)
         .map_err(|e| anyhow!("{} does not trim in hover: {e}", vehicle.name))?;
     let trim = TrimAttitude {
         phi: trim.phi,
@@ -104,8 +104,8 @@ mod tests {
 
         // The TREX's hybrid: its geometry and rotor, and its simulator's hover trim.
         let trex = by_name("trex700l-9dof-hybrid");
-        let heli = bo105::Helicopter::trex700l();
-        let hover = bo105::trim(&heli, 0.0).unwrap();
+        let heli = rotorsim::Helicopter::trex700l();
+        let hover = rotorsim::trim(&heli, 0.0).unwrap();
         let campaign = nine_dof_hybrid(
             &aircraft::shipped("trex700l").unwrap(),
             Some(TrimAttitude {

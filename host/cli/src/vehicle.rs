@@ -12,7 +12,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use aircraft::{Aircraft, TrimBalance, ValidRanges};
-use bo105::{ActuatorModel, Helicopter};
+use rotorsim::{ActuatorModel, Helicopter};
 use sweephold_firmware::{Config, HoldReference};
 use sweephold_protocol::{Axis, VehicleId};
 use sysid::frf::RangeSource;
@@ -233,7 +233,7 @@ mod tests {
         assert_eq!(trex.structure(), sysid::models::TREX700L_9DOF_HYBRID.name);
         assert_eq!(trex.trim_balance(), TrimBalance::Joint);
         assert_eq!(trex.range_source(), RangeSource::Estimate);
-        assert_eq!(trex.servos(), bo105::SimOptions::default().actuator);
+        assert_eq!(trex.servos(), rotorsim::SimOptions::default().actuator);
         // The third flies the TREX's preset with the gains and cyclic excitation its file
         // states, and the preset's everything else.
         let fbl = Vehicle::shipped("fbl700");

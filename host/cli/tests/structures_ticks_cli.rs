@@ -408,7 +408,7 @@ fn fit_model_takes_a_shipped_name_a_file_wins_and_an_unknown_name_lists_them() {
             .as_f64()
             .unwrap()
     };
-    let hub_height = -bo105::Helicopter::trex700l().main_rotor.hub[2];
+    let hub_height = -rotorsim::Helicopter::trex700l().main_rotor.hub[2];
     let ratio = at("b1c", "p") / at("b1c", "v");
     assert!((ratio - hub_height).abs() < 1e-9, "{ratio} vs {hub_height}");
 

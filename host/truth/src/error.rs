@@ -1,6 +1,6 @@
 //! Why the truth of a vehicle or a structure could not be computed.
 
-use bo105::TrimError;
+use rotorsim::TrimError;
 use sysid::fit::FitError;
 
 /// What stops the truth mapping or the scoring against it.

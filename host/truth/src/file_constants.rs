@@ -10,7 +10,7 @@
 //! inputs carries a σ has none.
 
 use aircraft::Aircraft;
-use bo105::Helicopter;
+use rotorsim::Helicopter;
 use sysid::fit::structure::ParameterKind;
 use sysid::fit::StructureError;
 use sysid::models::ShippedStructure;

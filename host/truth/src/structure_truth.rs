@@ -227,7 +227,7 @@ pub fn structure_truth(
 mod tests {
     use super::*;
     use crate::test_support::{shipped, worst_errors};
-    use bo105::Helicopter;
+    use rotorsim::Helicopter;
 
     fn bo105_aircraft() -> aircraft::Aircraft {
         aircraft::shipped("bo105").unwrap()

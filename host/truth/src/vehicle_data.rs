@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 use aircraft::Aircraft;
-use bo105::{ActuatorModel, Helicopter};
+use rotorsim::{ActuatorModel, Helicopter};
 use sysid::fit::structure::ParameterKind;
 use sysid::fit::{ModelStructure, StructureError};
 use sysid::models::{self, ShippedStructure};
@@ -43,7 +43,7 @@ impl TrimAttitude {
 /// `aircraft` in it — its geometry
 /// constants (`hub_height`, `hub_forward`, `shaft_tilt_sine`), gravity, the servos' ω_n
 /// and ζ where the file models them, the flap cross-coupling `Kcs` the file fixes from
-/// rotor theory ([`bo105::Rotor::flap_cross_coupling`]) — and `trim`: the captured trim
+/// rotor theory ([`rotorsim::Rotor::flap_cross_coupling`]) — and `trim`: the captured trim
 /// attitude, when known (else the file's).
 pub fn nine_dof_hybrid(
     aircraft: &Aircraft,
@@ -155,14 +155,14 @@ mod tests {
         };
         let file = models::BO105_9DOF_HYBRID.parse().unwrap();
         let in_file = file.parameters[file.parameter_index("Kcs").unwrap()].value;
-        let bo105_rotor = bo105::Helicopter::bo105().flap_cross_coupling();
+        let bo105_rotor = rotorsim::Helicopter::bo105().flap_cross_coupling();
         // The file's number is the Bo-105 rotor's, rounded to the digits written.
         assert!(
             (in_file - bo105_rotor).abs() < 5e-5,
             "{in_file} vs {bo105_rotor}"
         );
         assert_eq!(kcs(&bo105_aircraft()), bo105_rotor);
-        let trex = bo105::Helicopter::trex700l().flap_cross_coupling();
+        let trex = rotorsim::Helicopter::trex700l().flap_cross_coupling();
         assert_eq!(kcs(&trex_aircraft()), trex);
         assert!(
             (trex - bo105_rotor).abs() > 0.01,
@@ -184,7 +184,7 @@ mod tests {
         // θ̇ = cos φ0 q − sin φ0 r and v̇ ∋ g cos φ0 cos θ0 φ.
         let f = |row: &str, column: &str| model.f[(state(row), state(column))];
         assert!((f("theta", "r") - 0.1f64.sin()).abs() < 1e-15);
-        let g = bo105::Helicopter::bo105().gravity;
+        let g = rotorsim::Helicopter::bo105().gravity;
         assert!((f("v", "phi") - g * 0.1f64.cos() * 0.2f64.cos()).abs() < 1e-12);
         // Without one, the file's Bo-105 hover trim stays.
         let file = nine_dof_hybrid(&bo105_aircraft(), None).unwrap();
@@ -197,7 +197,7 @@ mod tests {
         let bo105 = nine_dof_hybrid(&bo105_aircraft(), None).unwrap();
         let trex = nine_dof_hybrid(&trex_aircraft(), None).unwrap();
         // The file's numbers are the Bo-105's geometry (to the digits written).
-        let bo105_data = bo105::Helicopter::bo105();
+        let bo105_data = rotorsim::Helicopter::bo105();
         for (name, value) in [
             ("hub_height", -bo105_data.main_rotor.hub[2]),
             ("hub_forward", bo105_data.main_rotor.hub[0]),
@@ -206,7 +206,7 @@ mod tests {
             assert!((file.constants[name] - value).abs() < 5e-4, "{name}");
             assert_eq!(bo105.constants[name], value, "{name}");
         }
-        let trex_hub = -bo105::Helicopter::trex700l().main_rotor.hub[2];
+        let trex_hub = -rotorsim::Helicopter::trex700l().main_rotor.hub[2];
         assert_eq!(trex.constants["hub_height"], trex_hub);
         assert!(trex_hub > 0.0 && trex_hub < 0.5, "{trex_hub}");
         // It reaches the model: Kpq = hub_height·Lfu.
@@ -221,7 +221,7 @@ mod tests {
         let nb1s = |s: &ModelStructure| s.parameter_value("Nb1s", &s.values()).unwrap();
         let lb1s = |s: &ModelStructure| s.parameter_value("Lb1s", &s.values()).unwrap();
         let trex = nine_dof_hybrid(&trex_aircraft(), None).unwrap();
-        let data = bo105::Helicopter::trex700l();
+        let data = rotorsim::Helicopter::trex700l();
         assert_eq!(trex.constants["inertia_xz_over_zz"], data.ixz / data.izz);
         // Derived, not a base parameter the fit could move.
         assert!(trex.parameter_index("Nb1s").is_none());
@@ -263,7 +263,7 @@ mod tests {
         close("N_p", a("r", "p"), height * a("r", "v"));
         close("N_r", a("r", "r"), -arm * a("r", "v"));
         close("L_r", a("p", "r"), height * c("izz_over_ixx") * a("r", "v"));
-        let data = bo105::Helicopter::trex700l();
+        let data = rotorsim::Helicopter::trex700l();
         close(
             "N_v",
             a("r", "v"),

@@ -2,7 +2,7 @@
 //! equivalent delay, and the simulator's names for the body states and controls.
 
 use aircraft::Aircraft;
-use bo105::{linearize, trim, ActuatorModel, Helicopter, Linearization};
+use rotorsim::{linearize, trim, ActuatorModel, Helicopter, Linearization};
 use sysid::fit::Model;
 
 use crate::Error;

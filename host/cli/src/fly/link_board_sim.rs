@@ -62,8 +62,8 @@
 //! the emulator's fault from record time T on; `missing` without a time: no chip from
 //! power-on (the boot fails). Record time counts the record's ticks from its first.
 
-use bo105::{Helicopter, Sim, SimOptions, Trim};
 use embedded_hal::delay::DelayNs;
+use rotorsim::{Helicopter, Sim, SimOptions, Trim};
 use sweephold_firmware::app::{AppConfig, Mode, TickOutput};
 use sweephold_firmware::board_stack::{BoardStack, BootState, StackConfig};
 use sweephold_firmware::imu::emulator::{Fault, Icm42688Emulator, Imperfections};
@@ -449,12 +449,12 @@ impl BoardSimLink {
             reading = sim.step(board.dt, out.command.to_array().map(f64::from));
             let mut state = sim.state();
             for i in [
-                bo105::model::U,
-                bo105::model::V,
-                bo105::model::W,
-                bo105::model::NORTH,
-                bo105::model::EAST,
-                bo105::model::DOWN,
+                rotorsim::model::U,
+                rotorsim::model::V,
+                rotorsim::model::W,
+                rotorsim::model::NORTH,
+                rotorsim::model::EAST,
+                rotorsim::model::DOWN,
             ] {
                 state.0[i] = held.0[i];
             }

@@ -585,7 +585,7 @@ pub fn fly_board_sim(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
 /// The board-sim link's settings for `args`.
 pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::BoardSimSettings> {
     let heli = args.vehicle.helicopter();
-    let trim = bo105::trim(&heli, 0.0)
+    let trim = rotorsim::trim(&heli, 0.0)
         .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
     Ok(link_board_sim::BoardSimSettings {
         heli,
@@ -598,14 +598,14 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
 }
 
 /// The simulator's options for `args` (before the seed and the disturbances).
-fn sim_options(args: &FlyArgs) -> bo105::SimOptions {
-    let mut sim_options = bo105::SimOptions {
+fn sim_options(args: &FlyArgs) -> rotorsim::SimOptions {
+    let mut sim_options = rotorsim::SimOptions {
         actuator: args.vehicle.servos(),
-        ..bo105::SimOptions::default()
+        ..rotorsim::SimOptions::default()
     };
     if args.perfect_sensors {
         // Sensors only: the actuators keep their servo dynamics and delay.
-        sim_options.sensor_noise = bo105::SensorNoise::perfect();
+        sim_options.sensor_noise = rotorsim::SensorNoise::perfect();
     }
     sim_options.linearized_plant = args.linearized_plant;
     sim_options
@@ -647,7 +647,7 @@ pub fn fly_with_workers(
 ) -> anyhow::Result<FlyOutcome> {
     validate(args)?;
     let heli = args.vehicle.helicopter();
-    let trim = bo105::trim(&heli, 0.0)
+    let trim = rotorsim::trim(&heli, 0.0)
         .map_err(|e| anyhow::anyhow!("{} does not trim in hover: {e}", args.vehicle.name()))?;
     let plans = args.plans();
     std::fs::create_dir_all(&args.out)

@@ -1,6 +1,6 @@
 //! Flying one record: the simulator and a flight-controller link in lockstep.
 
-use bo105::{Helicopter, Sim, SimOptions, Trim};
+use rotorsim::{Helicopter, Sim, SimOptions, Trim};
 use sweephold_firmware::Config;
 use sweephold_protocol::{
     Controls, Decoder, Event, Frame, HoldState, Measurements, Phase, PilotInput, Sample, SensorIn,
@@ -145,7 +145,7 @@ impl TelemetryMonitor {
         }
         let m = &sample.meas;
         let psi0 = *start_psi.get_or_insert(m.psi);
-        let dpsi = bo105::sim::wrap_angle(f64::from(m.psi) - f64::from(psi0));
+        let dpsi = rotorsim::sim::wrap_angle(f64::from(m.psi) - f64::from(psi0));
         max_abs.phi = max_abs.phi.max(f64::from(m.phi).abs().to_degrees());
         max_abs.theta = max_abs.theta.max(f64::from(m.theta).abs().to_degrees());
         max_abs.psi = max_abs.psi.max(dpsi.abs().to_degrees());
@@ -182,7 +182,7 @@ struct AttitudeErrors {
 impl AttitudeErrors {
     fn add(&mut self, sample: &Sample, truth: [f64; 3]) {
         let error = |measured: f32, truth: f64| {
-            bo105::sim::wrap_angle(f64::from(measured) - truth)
+            rotorsim::sim::wrap_angle(f64::from(measured) - truth)
                 .abs()
                 .to_degrees()
         };
@@ -352,7 +352,7 @@ pub fn fly_record(
 }
 
 /// The simulator's sensor reading as the firmware receives it.
-pub fn measurements(r: &bo105::SensorReading) -> Measurements {
+pub fn measurements(r: &rotorsim::SensorReading) -> Measurements {
     Measurements {
         p: r.p as f32,
         q: r.q as f32,

@@ -77,7 +77,7 @@ pub fn paper_table1_range(output: &str, input: &str) -> Option<[f64; 2]> {
         .map(|(_, _, range)| *range)
 }
 
-/// A Bo-105 hover parameter set for `bo105-9dof-hybrid.toml`: the simulator's (`host/bo105`)
+/// A Bo-105 hover parameter set for `bo105-9dof-hybrid.toml`: the simulator's (`host/rotorsim`)
 /// linearization at hover mapped onto the structure (`sweephold fit --truth bo105` prints
 /// the same values; a test in `host/cli/src/truth.rs` keeps them within 0.1 % of that
 /// mapping), rounded to five significant figures. It is the "truth" of synthetic tests and

@@ -4,12 +4,12 @@
 //! ratio to the 2000× target. On a shared machine the wall clock also counts time the
 //! thread spent waiting for a core, so the ratio to the thread's own CPU time (Linux
 //! `/proc/thread-self/schedstat`, nanoseconds on a core) is printed beside it.
-//! Run: `cargo bench -p bo105 --bench realtime`.
+//! Run: `cargo bench -p rotorsim --bench realtime`.
 
 use std::hint::black_box;
 use std::time::Instant;
 
-use bo105::{trim, Helicopter, Sim, SimOptions};
+use rotorsim::{trim, Helicopter, Sim, SimOptions};
 
 const SIMULATED_S: f64 = 20.0;
 const LOOP_DT: f64 = 0.005;

@@ -3,7 +3,7 @@
 //! compiled parameter sets, kept as the reference. A campaign of a shipped vehicle is
 //! byte-identical only if these hold.
 
-use bo105::{Gearing, Helicopter, Rotor, Surface};
+use rotorsim::{Gearing, Helicopter, Rotor, Surface};
 
 fn bo105_as_compiled() -> Helicopter {
     let deg = std::f64::consts::PI / 180.0;

@@ -1,4 +1,5 @@
-//! Nonlinear helicopter simulation (Bo-105, TREX 700L class) with trim and linearization.
+//! Nonlinear single-main-rotor helicopter simulation of any aircraft file (the shipped
+//! Bo-105, TREX 700L and fbl700) with trim and linearization.
 //!
 //! A minimum-complexity model after Heffley & Mnich (NASA CR-177476) with Padfield's Bo-105
 //! data: six-degree-of-freedom rigid body with Euler angles and position, first-order
