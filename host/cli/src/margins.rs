@@ -66,10 +66,10 @@ pub struct MarginsArgs {
     /// Leave the board's IMU filter bank out (raw sensors).
     #[arg(long)]
     pub no_filters: bool,
-    /// Computation delay from the sensor sample to the command [s].
+    /// Computation delay from the sensor sample to the command \[s\].
     #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::arg_values::non_negative, allow_hyphen_values = true)]
     pub compute_delay: f64,
-    /// Servo pulse frame rate [Hz] (held for a frame); none by default, as the simulator.
+    /// Servo pulse frame rate \[Hz\] (held for a frame); none by default, as the simulator.
     #[arg(long, value_name = "HZ", value_parser = positive_hz, allow_hyphen_values = true)]
     pub servo_frame_hz: Option<f64>,
     /// Write the broken loops and sensitivities sampled on the analysis grid (JSON:

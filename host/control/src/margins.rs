@@ -92,7 +92,7 @@ pub fn margins(loop_response: &Sampled) -> Margins {
     }
 }
 
-/// Every gain crossover of `loop_response`: (ω_c [rad/s], phase margin [deg]), in
+/// Every gain crossover of `loop_response`: (ω_c \[rad/s\], phase margin \[deg\]), in
 /// increasing frequency.
 pub fn gain_crossovers(loop_response: &Sampled) -> Vec<(f64, f64)> {
     let omega = &loop_response.omega;

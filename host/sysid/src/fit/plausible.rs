@@ -12,9 +12,9 @@
 //! coefficient each (a structure entry is a linear expression of parameters). Each F or
 //! G entry has a physical dimension, the unit of the row's state derivative over the
 //! unit of the column's state or control; its part `coefficient · value` must stay
-//! within the limit of that dimension ([`limit`]):
+//! within the limit of that dimension (`limit`):
 //!
-//! | row \ column | speed [m/s] | rate [rad/s] | angle \[rad\] | stick [travel] |
+//! | row \ column | speed [m/s] | rate [rad/s] | angle \[rad\] | stick \[travel\] |
 //! |---|---|---|---|---|
 //! | speed [m/s²] | 300 /s | 300 m | 1000 m/s² | 1000 m/s² |
 //! | rate [rad/s²] | 100 /(m·s) | 300 /s | 9·10⁴ /s² | 10⁴ rad/s² |
