@@ -72,6 +72,12 @@ fn no_verb_panics_when_its_standard_error_is_full() {
         ),
         (vec!["verify", "--model", "missing.json", dump], 1),
         (vec!["report", "missing"], 1),
+        (vec!["margins", "missing.json"], 1),
+        (vec!["margins", "c/model9.json", "--out", "m.json"], 0),
+        (
+            vec!["fc", "params", "list", "--fc", "serial:/nonexistent"],
+            1,
+        ),
         (
             vec![
                 "fly",

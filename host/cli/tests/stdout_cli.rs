@@ -62,6 +62,10 @@ fn every_verb_that_prints_fails_in_one_line_when_stdout_is_full() {
         ],
         &["fit", "--frf", "c/frf.json", "--model", "bo105-6dof"],
         &["report", "c"],
+        &["margins", "c/model9.json"],
+        &["margins", "c/model9.json", "--json"],
+        &["margins", "--help"],
+        &["fc", "params", "--help"],
         &["campaign", "--quick", "--quiet", "--out", "c2"],
     ];
     for args in cases {
