@@ -19,6 +19,40 @@ use crate::mixer::ServoConfig;
 use crate::receiver::{ChannelMapError, ChannelSource};
 use crate::swash::{SwashError, SwashGeometry, SwashType};
 
+/// Each swash output's parameters: direction, centre, limits, throw.
+const SWASH_SERVO_IDS: [[ParamId; 5]; 3] = [
+    [
+        ParamId::Servo1Dir,
+        ParamId::Servo1Mid,
+        ParamId::Servo1Min,
+        ParamId::Servo1Max,
+        ParamId::Servo1Throw,
+    ],
+    [
+        ParamId::Servo2Dir,
+        ParamId::Servo2Mid,
+        ParamId::Servo2Min,
+        ParamId::Servo2Max,
+        ParamId::Servo2Throw,
+    ],
+    [
+        ParamId::Servo3Dir,
+        ParamId::Servo3Mid,
+        ParamId::Servo3Min,
+        ParamId::Servo3Max,
+        ParamId::Servo3Throw,
+    ],
+];
+
+/// The tail servo's parameters, in the same order.
+const TAIL_SERVO_IDS: [ParamId; 5] = [
+    ParamId::TailDir,
+    ParamId::TailMid,
+    ParamId::TailMin,
+    ParamId::TailMax,
+    ParamId::TailThrow,
+];
+
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
 /// The board's swash and tail servo frame rate before parameters existed \[Hz\].
@@ -104,42 +138,10 @@ impl Params {
         mixer.geometry =
             SwashGeometry::new(kind, v(ParamId::SwashPhase), v(ParamId::SwashLead) as u8)
                 .map_err(ParamsError::Swash)?;
-        let servo_ids = [
-            [
-                ParamId::Servo1Dir,
-                ParamId::Servo1Mid,
-                ParamId::Servo1Min,
-                ParamId::Servo1Max,
-                ParamId::Servo1Throw,
-            ],
-            [
-                ParamId::Servo2Dir,
-                ParamId::Servo2Mid,
-                ParamId::Servo2Min,
-                ParamId::Servo2Max,
-                ParamId::Servo2Throw,
-            ],
-            [
-                ParamId::Servo3Dir,
-                ParamId::Servo3Mid,
-                ParamId::Servo3Min,
-                ParamId::Servo3Max,
-                ParamId::Servo3Throw,
-            ],
-        ];
-        for (servo, ids) in mixer.swash.iter_mut().zip(servo_ids) {
+        for (servo, ids) in mixer.swash.iter_mut().zip(SWASH_SERVO_IDS) {
             *servo = servo_from(ids.map(v));
         }
-        mixer.tail = servo_from(
-            [
-                ParamId::TailDir,
-                ParamId::TailMid,
-                ParamId::TailMin,
-                ParamId::TailMax,
-                ParamId::TailThrow,
-            ]
-            .map(v),
-        );
+        mixer.tail = servo_from(TAIL_SERVO_IDS.map(v));
         let (coll_min, coll_max) = (v(ParamId::CollMin), v(ParamId::CollMax));
         mixer.collective_scale = 0.5 * (coll_max - coll_min);
         mixer.collective_offset = 0.5 * (coll_max + coll_min);
@@ -323,36 +325,8 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
     put(ParamId::SwashType, f32::from(mixer.geometry.kind().code()));
     put(ParamId::SwashPhase, mixer.geometry.phase_deg());
     put(ParamId::SwashLead, f32::from(mixer.geometry.lead()));
-    let servo_ids = [
-        [
-            ParamId::Servo1Dir,
-            ParamId::Servo1Mid,
-            ParamId::Servo1Min,
-            ParamId::Servo1Max,
-            ParamId::Servo1Throw,
-        ],
-        [
-            ParamId::Servo2Dir,
-            ParamId::Servo2Mid,
-            ParamId::Servo2Min,
-            ParamId::Servo2Max,
-            ParamId::Servo2Throw,
-        ],
-        [
-            ParamId::Servo3Dir,
-            ParamId::Servo3Mid,
-            ParamId::Servo3Min,
-            ParamId::Servo3Max,
-            ParamId::Servo3Throw,
-        ],
-        [
-            ParamId::TailDir,
-            ParamId::TailMid,
-            ParamId::TailMin,
-            ParamId::TailMax,
-            ParamId::TailThrow,
-        ],
-    ];
+    let [first, second, third] = SWASH_SERVO_IDS;
+    let servo_ids = [first, second, third, TAIL_SERVO_IDS];
     let [swash1, swash2, swash3] = mixer.swash;
     let servos = [swash1, swash2, swash3, mixer.tail];
     for (ids, servo) in servo_ids.into_iter().zip(servos) {
