@@ -613,28 +613,7 @@ fn qemu_arm_by_sbus_then_a_host_sensor_in_is_ignored() {
     };
     let mut board = Board::boot(&image);
     let mut rc = RcInput::NEUTRAL;
-    let calibrated = |board: &Board| {
-        board.events().iter().any(|e| {
-            matches!(
-                e,
-                Event::ImuHealthChange {
-                    health: ImuHealth::Ok,
-                    ..
-                }
-            )
-        })
-    };
-    for _ in 0..50 {
-        if calibrated(&board) {
-            break;
-        }
-        board.run(0.2, Some(&rc));
-    }
-    assert!(
-        calibrated(&board),
-        "the gyro never calibrated: {:?}",
-        board.events()
-    );
+    wait_until_calibrated(&mut board, &rc);
     rc.arm = true;
     board.run(0.3, Some(&rc));
     let modes = |board: &Board| -> Vec<(FlightMode, FlightMode)> {
@@ -705,6 +684,33 @@ fn qemu_arm_by_sbus_then_a_host_sensor_in_is_ignored() {
             .iter()
             .any(|f| matches!(f, Frame::ActuatorOut(out) if out.seq == 3)),
         "disarmed, the SensorIn is answered"
+    );
+}
+
+/// Runs the bench board on neutral sticks (`rc`) until its gyro has calibrated (an
+/// `ImuHealthChange` to `Ok`), at most 10 s of board time; fails the test otherwise.
+fn wait_until_calibrated(board: &mut Board, rc: &RcInput) {
+    let calibrated = |board: &Board| {
+        board.events().iter().any(|e| {
+            matches!(
+                e,
+                Event::ImuHealthChange {
+                    health: ImuHealth::Ok,
+                    ..
+                }
+            )
+        })
+    };
+    for _ in 0..50 {
+        if calibrated(board) {
+            return;
+        }
+        board.run(0.2, Some(rc));
+    }
+    assert!(
+        calibrated(board),
+        "the gyro never calibrated: {:?}",
+        board.events()
     );
 }
 

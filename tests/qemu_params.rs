@@ -211,24 +211,7 @@ fn qemu_params_while_armed_a_push_changes_nothing() {
     };
     let mut board = Board::boot(&image);
     let mut rc = RcInput::NEUTRAL;
-    let calibrated = |board: &Board| {
-        board.events().iter().any(|e| {
-            matches!(
-                e,
-                Event::ImuHealthChange {
-                    health: ImuHealth::Ok,
-                    ..
-                }
-            )
-        })
-    };
-    for _ in 0..50 {
-        if calibrated(&board) {
-            break;
-        }
-        board.run(0.2, Some(&rc));
-    }
-    assert!(calibrated(&board), "the gyro never calibrated");
+    wait_until_calibrated(&mut board, &rc);
     let replies = |board: &Board, from: usize| -> Vec<ParamReply> {
         board.frames[from..]
             .iter()
