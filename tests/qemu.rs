@@ -496,8 +496,17 @@ fn qemu_imu_missing_is_reported_at_boot() {
         );
     };
     assert_eq!(header.protocol, ProtocolVersion::BOARD_APPLICATION);
+    // Then what the parameter store held at boot, then the IMU's absence.
+    assert!(
+        matches!(
+            board.frames.get(1),
+            Some(Frame::Event(Event::ParamStore { tick: 0, .. }))
+        ),
+        "{:?}",
+        board.frames.get(1)
+    );
     assert_eq!(
-        board.frames.get(1),
+        board.frames.get(2),
         Some(&Frame::Event(Event::ImuHealthChange {
             tick: 0,
             health: ImuHealth::Missing
@@ -515,7 +524,7 @@ fn qemu_imu_missing_is_reported_at_boot() {
     assert!(samples
         .iter()
         .all(|s| s.command == Controls::default() && s.phase == Phase::Idle));
-    assert_eq!(board.events().len(), 1, "{:?}", board.events());
+    assert_eq!(board.events().len(), 2, "{:?}", board.events());
 }
 
 /// SBUS and arming: frames fed on the second `-serial` (USART2) reach the board

@@ -31,7 +31,10 @@ pub mod table;
 mod tests;
 pub mod typed;
 
-pub use table::{ParamDef, ParamId, ParamKind, COUNT, DEFS, MAX_NAME_LEN, TABLE_VERSION};
+pub use table::{
+    frame_code, frame_vehicle, ParamDef, ParamId, ParamKind, COUNT, DEFS, MAX_NAME_LEN,
+    TABLE_VERSION,
+};
 pub use typed::{Params, ParamsError};
 
 use sweephold_protocol::VehicleId;
@@ -120,7 +123,7 @@ pub struct ParamTable {
 impl ParamTable {
     /// The defaults: the preset of `vehicle` ([`crate::board_stack::StackConfig`] with
     /// [`crate::app::AppConfig::preset`], test axis lat, the board's frame rates and
-    /// mounting).
+    /// mounting), `FRAME` naming it.
     pub fn defaults(vehicle: VehicleId) -> Self {
         ParamTable {
             values: typed::values_of(&Params::preset(vehicle)),
@@ -168,8 +171,15 @@ impl ParamTable {
         self.set(id, value)
     }
 
-    /// The typed view, if the whole set is consistent.
-    pub fn params(&self, vehicle: VehicleId) -> Result<Params, ParamsError> {
-        Params::from_values(&self.values, vehicle)
+    /// The typed view (on top of the preset `FRAME` names), if the whole set is
+    /// consistent.
+    pub fn params(&self) -> Result<Params, ParamsError> {
+        Params::from_values(&self.values)
+    }
+
+    /// The vehicle whose preset `FRAME` names (TREX 700L for a value the table would
+    /// refuse, which [`ParamTable::set`] never stores).
+    pub fn frame(&self) -> VehicleId {
+        table::frame_vehicle(self.get(ParamId::Frame)).unwrap_or(VehicleId::Trex700l)
     }
 }

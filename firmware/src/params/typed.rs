@@ -9,7 +9,7 @@
 
 use sweephold_protocol::{Axis, ExcitationMode, InputKind, VehicleId};
 
-use super::table::{ParamId, COUNT};
+use super::table::{frame_code, frame_vehicle, ParamId, COUNT};
 use crate::app::{AppConfig, AppConfigError};
 use crate::board_stack::StackConfig;
 use crate::config::ConfigError;
@@ -120,15 +120,16 @@ impl Params {
         }
     }
 
-    /// The configuration `values` describe on top of the preset of `vehicle`, checked
-    /// as a whole.
-    pub fn from_values(values: &[f32; COUNT], vehicle: VehicleId) -> Result<Self, ParamsError> {
+    /// The configuration `values` describe on top of the preset their `FRAME` names,
+    /// checked as a whole.
+    pub fn from_values(values: &[f32; COUNT]) -> Result<Self, ParamsError> {
         for (id, value) in ParamId::ALL.iter().zip(values) {
             id.def()
                 .check(*value)
                 .map_err(|_| ParamsError::Value(*id))?;
         }
         let v = |id: ParamId| values.get(id.index()).copied().unwrap_or(0.0);
+        let vehicle = frame_vehicle(v(ParamId::Frame)).ok_or(ParamsError::Value(ParamId::Frame))?;
         let mut params = Params::preset(vehicle);
         let stack = &mut params.stack;
 
@@ -451,5 +452,6 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
         ParamId::TestFreeze,
         if test.freeze_in_band { 1.0 } else { 0.0 },
     );
+    put(ParamId::Frame, frame_code(flight.vehicle));
     values
 }

@@ -70,7 +70,7 @@ use crate::chip::servo::{self, ServoChannel, Servos, ESC_CUT_US};
 use crate::chip::ticker::Ticker;
 use crate::chip::usart::{self, UsartTx};
 use crate::chip::watchdog::Watchdog;
-use crate::image::config::{image_config, link_config, stack_config};
+use crate::image::config::{fallback_params, link_config};
 use crate::image::link::{self, FrameScratch, Inbound, Telemetry};
 use crate::image::log;
 use crate::image::params::HostParams;
@@ -197,6 +197,7 @@ impl Runner {
     /// `docs/board_tick_instructions.py`.
     #[inline(never)]
     fn control_tick(&mut self) {
+        self.apply_params();
         let mut received = [0u8; sbus_uart::RX_CAPACITY];
         let count = self.sbus.take(&mut received);
         let tick = self.stack.app().flight_controller().tick();
@@ -222,6 +223,44 @@ impl Runner {
         }
         if out.refused.is_some() {
             defmt::warn!("request refused in mode {=str}", out.mode.name());
+        }
+    }
+
+    /// On the ground, the parameters as the host left them: the pre-arm flag (a save
+    /// makes the set valid), and a table changed by a Set or Reset rebuilt into the
+    /// board application (restarted Disarmed on it, its Header sent, the failsafe
+    /// pulses its mixer's). Armed, nothing changes: a change waits for the ground (the
+    /// link refuses them armed anyway). A set the typed view or the stack refuses (a
+    /// push half-way through, servo limits crossing their centre for a moment) keeps
+    /// the running configuration until a later change makes it whole.
+    fn apply_params(&mut self) {
+        if !self.stack.app().host_link_allowed() {
+            return;
+        }
+        self.stack.set_params_valid(self.params.valid());
+        if !self.params.take_changed() {
+            return;
+        }
+        let applied = self
+            .params
+            .params()
+            .map_err(|error| error.message())
+            .and_then(|params| {
+                self.stack
+                    .reconfigure(params.stack)
+                    .map_err(|error| error.message())
+            });
+        match applied {
+            Ok(()) => {
+                let neutral = sweephold_firmware::mix(
+                    &self.stack.config().app.flight.mixer,
+                    &Controls::default(),
+                );
+                servo::set_failsafe(neutral);
+                defmt::info!("parameters applied");
+                self.send_header(self.stack.app().header());
+            }
+            Err(message) => defmt::warn!("parameters not applied yet: {=str}", message),
         }
     }
 
@@ -443,14 +482,23 @@ pub fn run() -> ! {
     } = devices::bring_up(&BOARD);
     let clocks = boot.clocks;
 
-    let fc = match FlightController::new(image_config()) {
+    let params = HostParams::boot(None);
+    let flown = params.params().unwrap_or_else(|error| {
+        defmt::error!("parameter set refused: {=str}", error.message());
+        fallback_params()
+    });
+    let fc = match FlightController::new(flown.stack.app.flight) {
         Ok(fc) => fc,
         Err(error) => defmt::panic!("flight configuration refused: {=str}", error.message()),
     };
-    let mut stack = match Stack::new(imu, BusyDelay::new(clocks.hclk_hz), stack_config()) {
+    let mut stack = match Stack::new(imu, BusyDelay::new(clocks.hclk_hz), flown.stack) {
         Ok(stack) => stack,
         Err(error) => defmt::panic!("board configuration refused: {=str}", error.message()),
     };
+    stack.set_params_valid(params.valid());
+    if !params.valid() {
+        defmt::warn!("no valid parameter set stored: defaults, arming refused until a save");
+    }
     // From now on a panic or fault puts the servos where the mixer puts centred sticks:
     // the board application's disarmed output.
     let neutral = sweephold_firmware::mix(&fc.config().mixer, &Controls::default());
@@ -489,9 +537,11 @@ pub fn run() -> ! {
         host_ignored_reported: false,
         scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
         watchdog,
-        params: HostParams::new(image_config().vehicle),
+        params,
     };
     runner.announce();
+    let event = runner.params.store_event(0);
+    link::send(&mut runner.tx, &mut runner.scratch, &Frame::Event(event));
 
     let ticker = match Ticker::start(tim5, &mut boot, TIMER_HZ) {
         Ok(ticker) => ticker,
