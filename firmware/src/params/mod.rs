@@ -17,6 +17,8 @@
 //! * [`store`] — the set in flash, versioned, CRC-checked and wear-levelled.
 //! * [`link`] — the host's parameter requests (protocol 1.5), obeyed only disarmed.
 //! * [`no_flash`] — the flash type of a board that keeps its parameters in RAM only.
+//! * `ram_flash` (host only) — a NOR flash in RAM and the bytes a store region holds
+//!   after a save (the QEMU tests preload a board's store with them).
 //!
 //! Every value is an `f32`, as ArduPilot's parameters travel over MAVLink: whole
 //! numbers up to 2²⁴ are exact, which covers every integer parameter here.
@@ -25,6 +27,8 @@ pub mod link;
 #[cfg(test)]
 pub(crate) mod mock_flash;
 pub mod no_flash;
+#[cfg(any(test, feature = "std"))]
+pub mod ram_flash;
 pub mod store;
 pub mod table;
 #[cfg(test)]

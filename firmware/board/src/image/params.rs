@@ -4,13 +4,16 @@
 //! is disarmed (in the loop the host's simulation flies the servos, and the requests are
 //! refused as armed).
 //!
-//! At boot the table is loaded from the parameter store ([`Store`]): a valid set is
+//! At boot the table is loaded from the parameter store ([`Store`], the chip's flash
+//! sectors 10 and 11, `memory.x`): a valid set is
 //! flown; a missing, corrupt, old-version or refused one gives the defaults of
 //! [`DEFAULT_FRAME`], an Event says which ([`HostParams::store_event`]), and the
 //! application refuses to arm (`params_invalid`) until a valid set is saved. A Set or
 //! Reset accepted on the ground is flown from the next disarmed control tick on
 //! ([`HostParams::take_changed`]: the runner rebuilds the board application from it);
-//! armed, nothing changes.
+//! armed, nothing changes. A `Save` writes the table to the flash (the loop stalls
+//! while a sector is erased, up to 2 s: the runner stretches the watchdog around it);
+//! a flash that does not keep what is programmed (QEMU's) refuses it `store_failed`.
 //!
 //! Bounded work: a `Get`, `Set` or `Reset` is answered at once with one frame; a `List`
 //! is answered one reply per control tick (COUNT + 1 ticks for the values and Done), so
@@ -19,17 +22,19 @@
 //! restarts the walk; arming in the middle of one ends it with an `Armed` refusal.
 
 use sweephold_firmware::params::link::ParamLink;
-use sweephold_firmware::params::store::ParamStore;
+use sweephold_firmware::params::store::{LoadStatus, ParamStore};
 use sweephold_firmware::params::{Params, ParamsError};
 use sweephold_protocol::{
     Event, Frame, ParamName, ParamOp, ParamRefusal, ParamReply, ParamRequest,
 };
 
+use crate::chip::flash::{F405Flash, Registers, STORE_REGION};
 use crate::chip::usart::UsartTx;
 use crate::image::config::DEFAULT_FRAME;
 use crate::image::link::{self, FrameScratch};
 
-pub use sweephold_firmware::params::no_flash::NoFlash as Store;
+/// The flash the store lives in: the chip's, sectors 10 and 11 ([`STORE_REGION`]).
+pub type Store = F405Flash<Registers>;
 
 /// The parameter table, its store, and the `List` being answered.
 pub struct HostParams {
@@ -39,13 +44,24 @@ pub struct HostParams {
 }
 
 impl HostParams {
-    /// The set `store` holds, or the defaults of [`DEFAULT_FRAME`]; nothing being
-    /// listed.
-    pub fn boot(store: Option<ParamStore<Store>>) -> Self {
+    /// The set the store in `flash` holds, or the defaults of [`DEFAULT_FRAME`] and
+    /// why; nothing being listed.
+    pub fn boot(flash: Store) -> Self {
+        // The region is a constant the host tests build the same store on
+        // (`chip::flash` tests): it is always usable.
+        let store = match ParamStore::new(flash, STORE_REGION) {
+            Ok(store) => store,
+            Err(_) => defmt::panic!("parameter store region unusable"),
+        };
         HostParams {
-            link: ParamLink::boot(store, DEFAULT_FRAME),
+            link: ParamLink::boot(Some(store), DEFAULT_FRAME),
             listing: None,
         }
+    }
+
+    /// What the store held at boot (`Loaded` after a save).
+    pub fn status(&self) -> LoadStatus {
+        self.link.load_status()
     }
 
     /// The typed view of the table.

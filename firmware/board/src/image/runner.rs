@@ -54,7 +54,7 @@ use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_H
 use sweephold_firmware::FlightController;
 use sweephold_protocol::{
     ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, Header, HostFrame,
-    LinkConfig, SensorIn,
+    LinkConfig, ParamRequest, SensorIn,
 };
 
 use crate::boards::BOARD;
@@ -457,8 +457,17 @@ impl Runner {
             Ok(Frame::Configure(request)) => self.configure(&request),
             Ok(Frame::ParamRequest(request)) => {
                 let disarmed = self.params_allowed();
+                // A save may erase a flash sector: the loop stalls up to 2 s (disarmed
+                // only; the link refuses a save armed before touching the flash).
+                let saving = disarmed && matches!(request, ParamRequest::Save);
+                if saving {
+                    self.watchdog.stretch_for_flash();
+                }
                 self.params
                     .on_request(&request, disarmed, &mut self.tx, &mut self.scratch);
+                if saving {
+                    self.watchdog.restore_after_save();
+                }
             }
             Ok(_) => self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1),
             // The decoder has resynchronised on the next delimiter already.
@@ -478,11 +487,16 @@ pub fn run() -> ! {
         sbus,
         imu,
         watchdog,
+        flash,
         tim5,
     } = devices::bring_up(&BOARD);
     let clocks = boot.clocks;
 
-    let params = HostParams::boot(None);
+    let params = HostParams::boot(flash);
+    defmt::info!(
+        "parameter store: {}",
+        sweephold_firmware::params::link::store_status(params.status())
+    );
     let flown = params.params().unwrap_or_else(|error| {
         defmt::error!("parameter set refused: {=str}", error.message());
         fallback_params()
