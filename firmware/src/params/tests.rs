@@ -63,7 +63,8 @@ fn the_defaults_are_the_presets_bit_for_bit() {
         ("ABORT_RATE_Y", 250.0),
         ("RC_MODE", 8.0),
         ("IMU_ROT", 0.0),
-        ("SERVO_RATE", 50.0),
+        ("SERVO_RATE", 333.0),
+        ("TAIL_RATE", 333.0),
     ] {
         assert_eq!(table.get_by_name(name), Ok(value), "{name}");
     }
@@ -182,7 +183,8 @@ fn a_set_round_trips_by_name() {
         ("TAIL_MID", 760.0),
         ("TAIL_MIN", 560.0),
         ("TAIL_MAX", 960.0),
-        ("SERVO_RATE", 333.0),
+        ("SERVO_RATE", 200.0),
+        ("TAIL_RATE", 50.0),
         ("IMU_ROT", 27.0),
     ] {
         table.set_by_name(name, value).unwrap();
@@ -193,7 +195,7 @@ fn a_set_round_trips_by_name() {
     assert_eq!(mixer.geometry.kind(), crate::swash::SwashType::H3_140);
     assert!(mixer.swash[1].reversed && !mixer.swash[0].reversed);
     assert_eq!(mixer.tail.centre_us, 760);
-    assert_eq!(params.swash_frame_hz, 333);
+    assert_eq!((params.swash_frame_hz, params.tail_frame_hz), (200, 50));
     // ArduPilot's PITCH_180_YAW_270 is ROLL_180_YAW_90.
     assert_eq!(params.imu_rotation, crate::imu::ImuRotation::Roll180Yaw90);
     assert_eq!(

@@ -36,9 +36,14 @@
 //! chosen on the ground, never a takeover in flight. The first such frame of each armed
 //! period is reported with an Event (`HostLinkIgnored`), every one is counted.
 //!
-//! **Parameters** (protocol 1.5): ParamRequest frames are answered through
+//! **Parameters** (protocol 1.5): the board application (and the in-the-loop flight
+//! logic's first configuration) is built from the typed view of the table the store held
+//! at boot, its servo timers run at the table's frame rates, and the store's status goes
+//! out as an Event after the boot Header. ParamRequest frames are answered through
 //! [`crate::image::params`] in the board application while it is disarmed (refused as
-//! armed otherwise, and in the loop); a List is answered one reply per control tick.
+//! armed otherwise, and in the loop); a List is answered one reply per control tick. A
+//! Set or Reset is applied on the next disarmed control tick (`Runner::apply_params`);
+//! a Save stretches the watchdog around the flash erase.
 //!
 //! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the in-the-loop
 //! configuration at run time. The image builds the preset of the frame's vehicle for
@@ -51,6 +56,7 @@
 use embedded_hal::pwm::SetDutyCycle;
 use sweephold_firmware::app::Mode as AppMode;
 use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_HZ};
+use sweephold_firmware::params::Params;
 use sweephold_firmware::FlightController;
 use sweephold_protocol::{
     ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, Header, HostFrame,
@@ -58,7 +64,7 @@ use sweephold_protocol::{
 };
 
 use crate::boards::BOARD;
-use crate::chip::clocks::ClockSource;
+use crate::chip::clocks::{ClockSource, Clocks};
 use crate::chip::delay::BusyDelay;
 use crate::chip::devices::{self, Devices};
 use crate::chip::dividers;
@@ -156,6 +162,8 @@ pub struct Runner {
     watchdog: Watchdog,
     /// The parameter table the host's ParamRequest frames read and set.
     params: HostParams,
+    /// The clock tree (the servo timers' dividers).
+    clocks: Clocks,
 }
 
 impl Runner {
@@ -248,7 +256,9 @@ impl Runner {
             .and_then(|params| {
                 self.stack
                     .reconfigure(params.stack)
-                    .map_err(|error| error.message())
+                    .map_err(|error| error.message())?;
+                self.apply_frame_rates(&params);
+                Ok(())
             });
         match applied {
             Ok(()) => {
@@ -261,6 +271,23 @@ impl Runner {
                 self.send_header(self.stack.app().header());
             }
             Err(message) => defmt::warn!("parameters not applied yet: {=str}", message),
+        }
+    }
+
+    /// The servo frame rates of `params` on the output timers (a rate the dividers
+    /// refuse, never expected for 50–333 Hz, keeps the running ones and is logged).
+    fn apply_frame_rates(&mut self, params: &Params) {
+        let (swash_hz, tail_hz) = (
+            u32::from(params.swash_frame_hz),
+            u32::from(params.tail_frame_hz),
+        );
+        match self.servos.set_frame_rates(&self.clocks, swash_hz, tail_hz) {
+            Ok(()) => defmt::info!(
+                "servo frames: swash {=u32} Hz, tail {=u32} Hz",
+                swash_hz,
+                tail_hz
+            ),
+            Err(error) => defmt::warn!("servo frame rates refused: {}", error),
         }
     }
 
@@ -552,7 +579,9 @@ pub fn run() -> ! {
         scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
         watchdog,
         params,
+        clocks,
     };
+    runner.apply_frame_rates(&flown);
     runner.announce();
     let event = runner.params.store_event(0);
     link::send(&mut runner.tx, &mut runner.scratch, &Frame::Event(event));
