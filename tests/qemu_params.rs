@@ -9,7 +9,8 @@ use sweephold::fc::{params_file, push, FcWire};
 use sweephold::fly::link_qemu::{self, QemuTransport};
 use sweephold_firmware::params::ParamTable;
 use sweephold_protocol::{
-    ParamName, ParamOp, ParamRefusal, ParamReply, ParamRequest, ParamStoreStatus, VehicleId,
+    Axis, Header, ParamName, ParamOp, ParamRefusal, ParamReply, ParamRequest, ParamStoreStatus,
+    VehicleId,
 };
 
 use super::*;
@@ -402,4 +403,59 @@ impl BoardParams<'_> {
             other => panic!("Get {name} answered {other:?}"),
         }
     }
+}
+
+/// One image for every aircraft: on the ground a Set is flown from the next control
+/// tick. FRAME 1 and TEST_AXIS 1 make the board application a Bo-105 flying a
+/// longitudinal test, announced by its new Header; a set the typed view refuses as a
+/// whole is not flown (no Header) until it is whole again.
+#[test]
+fn qemu_params_a_set_on_the_ground_is_flown_from_the_next_tick() {
+    let Some(image) = image_or_skip("qemu_params_a_set_on_the_ground_is_flown_from_the_next_tick")
+    else {
+        return;
+    };
+    let mut board = Board::boot(&image);
+    board.run(0.5, None);
+    let headers = |board: &Board, from: usize| -> Vec<Header> {
+        board.frames[from..]
+            .iter()
+            .filter_map(|f| match f {
+                Frame::Header(header) => Some(*header),
+                _ => None,
+            })
+            .collect()
+    };
+    let boot = headers(&board, 0);
+    assert_eq!(boot.len(), 1, "{boot:?}");
+    assert_eq!(boot[0].vehicle, VehicleId::Trex700l);
+    assert_eq!(boot[0].test.primary, Axis::Lat);
+    let set = |board: &mut Board, name: &str, value: f32| {
+        board.send(&Frame::ParamRequest(ParamRequest::Set {
+            name: ParamName::new(name).unwrap(),
+            value,
+        }));
+        board.run(0.3, None);
+    };
+    let from = board.frames.len();
+    set(&mut board, "FRAME", 1.0);
+    let after_frame = headers(&board, from);
+    assert_eq!(after_frame.len(), 1, "{after_frame:?}");
+    assert_eq!(after_frame[0].vehicle, VehicleId::Bo105);
+    let from = board.frames.len();
+    set(&mut board, "TEST_AXIS", 1.0);
+    let after_axis = headers(&board, from);
+    assert_eq!(after_axis.len(), 1, "{after_axis:?}");
+    assert_eq!(
+        (after_axis[0].vehicle, after_axis[0].test.primary),
+        (VehicleId::Bo105, Axis::Lon)
+    );
+    // Servo 1's lowest pulse above its centre: accepted by the table, refused by the
+    // typed view, so nothing is flown until the centre follows.
+    let from = board.frames.len();
+    set(&mut board, "SERVO1_MIN", 1600.0);
+    assert_eq!(headers(&board, from), []);
+    set(&mut board, "SERVO1_MID", 1700.0);
+    set(&mut board, "SERVO1_MAX", 1900.0);
+    assert!(!headers(&board, from).is_empty());
 }
