@@ -1,9 +1,13 @@
 #!/usr/bin/env python3
 """Instructions the board image's board application executes per tick, counted under QEMU.
 
-Usage (after `cargo fw --features bench-imu --target-dir target/fw-bench`):
+Usage (after `cargo fw --features bench-imu --target-dir target/fw-bench` and
+`cargo run -p sweephold-tests --example default_store -- target/default-store.bin`):
 
-    python3 docs/board_tick_instructions.py target/fw-bench/thumbv7em-none-eabihf/firmware/sweephold-fc
+    python3 docs/board_tick_instructions.py target/fw-bench/thumbv7em-none-eabihf/firmware/sweephold-fc target/default-store.bin
+
+The second file is the parameter store's sectors holding the defaults, preloaded into the
+emulated flash: a board arms only with a valid parameter set stored.
 
 Method: the bench image (its IMU is the flight logic's register-level ICM-42688-P emulator
 at rest, since QEMU has nothing on SPI1) runs in `qemu-system-arm -M netduinoplus2` with
@@ -135,9 +139,9 @@ def count(log, functions, phase, result):
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) != 3:
         sys.exit(__doc__)
-    image = sys.argv[1]
+    image, store = sys.argv[1], sys.argv[2]
     functions = {
         "control_tick": bounds(image, "6Runner12control_tick17h"),
         "imu_tick": bounds(image, "6Runner8imu_tick17h"),
@@ -160,6 +164,7 @@ def main():
         qemu = subprocess.Popen(
             ["taskset", "-c", "0", "qemu-system-arm", "-M", "netduinoplus2", "-nographic",
              "-monitor", "none", "-kernel", image, "-icount", "shift=3,sleep=off",
+             "-device", f"loader,file={store},addr=0x080c0000,force-raw=on",
              "-chardev", f"socket,id=link,host=127.0.0.1,port={link_port},server=off",
              "-chardev", f"socket,id=sbus,host=127.0.0.1,port={sbus_port},server=off",
              "-serial", "chardev:link", "-serial", "chardev:sbus",

@@ -387,10 +387,47 @@ struct Board {
     decoder: Decoder,
     /// Every frame read from the link so far.
     frames: Vec<Frame>,
+    /// Holds the preloaded store file while QEMU runs.
+    _store: Option<Scratch>,
+}
+
+/// The parameter store's sectors (`memory.x`, `firmware/board/src/chip/flash.rs`):
+/// sectors 10 and 11 of the STM32F405, 128 KiB each, from 0x080C_0000 to the end of
+/// its 1 MiB flash; offsets into the flash as the board's driver counts them.
+const STORE_REGION: std::ops::Range<u32> = 0xC_0000..0x10_0000;
+/// Where the flash is mapped.
+const FLASH_BASE: u32 = 0x0800_0000;
+/// The F405 driver's write unit (a 32-bit word) and erase unit (a 128 KiB sector).
+const FLASH_WORD: usize = 4;
+const FLASH_SECTOR: usize = 128 * 1024;
+
+/// The store sectors after the firmware library's own `ParamStore` saved `table` into
+/// them (over a RAM flash with the F405 driver's word and sector sizes).
+fn saved_store(table: &sweephold_firmware::params::ParamTable) -> Vec<u8> {
+    sweephold_firmware::params::ram_flash::saved_region::<FLASH_WORD, FLASH_SECTOR>(
+        table,
+        STORE_REGION,
+    )
+    .expect("the store saves into a RAM flash")
+}
+
+/// The store holding the TREX 700L's defaults: a board that may arm.
+fn default_store() -> Vec<u8> {
+    saved_store(&sweephold_firmware::params::ParamTable::defaults(
+        sweephold_protocol::VehicleId::Trex700l,
+    ))
 }
 
 impl Board {
+    /// The image on a flash whose store sectors are as QEMU leaves them (zero: not a
+    /// valid store).
     fn boot(image: &std::path::Path) -> Board {
+        Board::boot_with_store(image, None)
+    }
+
+    /// The image, with `store` (the bytes of the store's sectors) preloaded into the
+    /// flash by QEMU's generic loader.
+    fn boot_with_store(image: &std::path::Path, store: Option<&[u8]>) -> Board {
         use std::net::TcpListener;
         let listen = || {
             let listener = TcpListener::bind("127.0.0.1:0").expect("a local port");
@@ -401,7 +438,25 @@ impl Board {
         let (sbus_listener, sbus_port) = listen();
         let chardev =
             |id: &str, port: u16| format!("socket,id={id},host=127.0.0.1,port={port},server=off");
-        let qemu = netduinoplus2(image)
+        static BOOTS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let scratch = store.map(|bytes| {
+            let boot = BOOTS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let scratch = Scratch::new(&format!("qemu-store-{boot}"));
+            std::fs::write(scratch.path().join("store.bin"), bytes).unwrap();
+            scratch
+        });
+        let mut qemu = netduinoplus2(image);
+        if let Some(scratch) = &scratch {
+            qemu.args([
+                "-device",
+                &format!(
+                    "loader,file={},addr={:#x},force-raw=on",
+                    scratch.path().join("store.bin").display(),
+                    FLASH_BASE + STORE_REGION.start
+                ),
+            ]);
+        }
+        let qemu = qemu
             .args(["-chardev", &chardev("usart1", link_port)])
             .args(["-chardev", &chardev("usart2", sbus_port)])
             .args(["-serial", "chardev:usart1", "-serial", "chardev:usart2"])
@@ -419,6 +474,7 @@ impl Board {
             sbus,
             decoder: Decoder::new(),
             frames: Vec::new(),
+            _store: scratch,
         }
     }
 
@@ -496,8 +552,17 @@ fn qemu_imu_missing_is_reported_at_boot() {
         );
     };
     assert_eq!(header.protocol, ProtocolVersion::BOARD_APPLICATION);
+    // Then what the parameter store held at boot, then the IMU's absence.
+    assert!(
+        matches!(
+            board.frames.get(1),
+            Some(Frame::Event(Event::ParamStore { tick: 0, .. }))
+        ),
+        "{:?}",
+        board.frames.get(1)
+    );
     assert_eq!(
-        board.frames.get(1),
+        board.frames.get(2),
         Some(&Frame::Event(Event::ImuHealthChange {
             tick: 0,
             health: ImuHealth::Missing
@@ -515,7 +580,7 @@ fn qemu_imu_missing_is_reported_at_boot() {
     assert!(samples
         .iter()
         .all(|s| s.command == Controls::default() && s.phase == Phase::Idle));
-    assert_eq!(board.events().len(), 1, "{:?}", board.events());
+    assert_eq!(board.events().len(), 2, "{:?}", board.events());
 }
 
 /// SBUS and arming: frames fed on the second `-serial` (USART2) reach the board
@@ -611,7 +676,8 @@ fn qemu_arm_by_sbus_then_a_host_sensor_in_is_ignored() {
     else {
         return;
     };
-    let mut board = Board::boot(&image);
+    // A fresh board refuses to arm: a stored set (the defaults) lets it.
+    let mut board = Board::boot_with_store(&image, Some(&default_store()));
     let mut rc = RcInput::NEUTRAL;
     wait_until_calibrated(&mut board, &rc);
     rc.arm = true;

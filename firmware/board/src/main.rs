@@ -1,11 +1,12 @@
-//! `sweephold-fc`: the flight-controller image for an STM32F405 flight controller flying a
-//! TREX 700L (`cargo fw`; by default for a SpeedyBee F405 V4, `--features
+//! `sweephold-fc`: the flight-controller image for an STM32F405 flight controller, one
+//! image for every aircraft: what it flies is its parameter table, stored in the chip's
+//! flash (`cargo fw`; by default for a SpeedyBee F405 V4, `--features
 //! board-matek-f405-te` for a Matek F405-TE).
 //!
 //! Boots on the board and, unchanged, in `qemu-system-arm -M netduinoplus2`. Three rooms:
 //!
 //! - `image/`: the image logic, the same on every board (boot, the control loop of both
-//!   run modes, the frame link, the defmt logger, the build-time flight configuration)
+//!   run modes, the frame link, the defmt logger, the parameters and their store)
 //!   around [`sweephold_firmware::FlightController`] and the board application;
 //! - `chip/`: the STM32F405 drivers on the `stm32f4` peripheral access crate, which take
 //!   the peripherals once (`chip::devices`) and their pins from a board map;

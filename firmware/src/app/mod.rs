@@ -338,6 +338,11 @@ impl BoardApp {
         self.params_valid = valid;
     }
 
+    /// Whether the pre-arm check counts the parameter set as valid.
+    pub fn params_valid(&self) -> bool {
+        self.params_valid
+    }
+
     /// The command applied by the last tick.
     pub fn last_command(&self) -> Controls {
         self.last_command

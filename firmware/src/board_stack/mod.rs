@@ -175,6 +175,8 @@ pub enum StackError {
     Calibration,
     /// The filter bank or the estimator is set for another rate than [`IMU_RATE_HZ`].
     RateMismatch,
+    /// A reconfiguration while the application is armed.
+    Armed,
 }
 
 impl StackError {
@@ -187,6 +189,7 @@ impl StackError {
             StackError::ChannelMap(_) => "receiver channel map invalid",
             StackError::Calibration => "IMU calibration settings invalid",
             StackError::RateMismatch => "filter bank or estimator not set for the 1 kHz IMU rate",
+            StackError::Armed => "reconfiguration refused: armed",
         }
     }
 }
@@ -302,6 +305,55 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
             app,
             config,
         })
+    }
+
+    /// Replace the configuration on the ground (the parameters changed): `Err` and
+    /// nothing changed if `config` is refused or the application is armed. The
+    /// application restarts Disarmed (tick 0, its arm switch to be cycled, the parameter
+    /// flag kept), the filters and the receiver's timeout take the new settings, and a
+    /// changed IMU mounting restarts the gyro calibration (bias and level were measured
+    /// in the old axes). The IMU itself is not re-initialised.
+    pub fn reconfigure(&mut self, config: StackConfig) -> Result<(), StackError> {
+        if !self.app.host_link_allowed() {
+            return Err(StackError::Armed);
+        }
+        let filters = FilterBank::new(config.filters).map_err(StackError::Filters)?;
+        let estimator = Mahony::new(config.estimator).map_err(StackError::Estimator)?;
+        if config.filters.sample_rate_hz != IMU_RATE_HZ
+            || config.estimator.sample_rate_hz != IMU_RATE_HZ
+        {
+            return Err(StackError::RateMismatch);
+        }
+        if !config.calibration.is_valid() {
+            return Err(StackError::Calibration);
+        }
+        config
+            .channel_map
+            .validate()
+            .map_err(StackError::ChannelMap)?;
+        let mut app = BoardApp::new(config.app).map_err(StackError::App)?;
+        app.set_params_valid(self.app.params_valid());
+        let mounting_changed = config.orientation != self.config.orientation
+            || config.calibration != self.config.calibration
+            || config.estimator != self.config.estimator;
+        self.app = app;
+        self.filters = filters;
+        self.receiver = Receiver::new(config.rc_timeout_us);
+        self.monitor = ImuMonitor::new(config.monitor);
+        self.imu.set_orientation(config.orientation);
+        if mounting_changed {
+            self.estimator = estimator;
+            self.mount = Quaternion::IDENTITY;
+            self.calibration = GyroCalibration::new(config.calibration);
+            if matches!(
+                self.boot,
+                BootState::Running(_) | BootState::CalibrationFailed
+            ) {
+                self.boot = BootState::Calibrating;
+            }
+        }
+        self.config = config;
+        Ok(())
     }
 
     /// Initialise the IMU and start the calibration (see the module documentation).
@@ -508,6 +560,12 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
     /// The board application (mode, sequencer, throttle).
     pub fn app(&self) -> &BoardApp {
         &self.app
+    }
+
+    /// Whether a valid parameter set is in use: the application's pre-arm check
+    /// ([`BoardApp::set_params_valid`]).
+    pub fn set_params_valid(&mut self, valid: bool) {
+        self.app.set_params_valid(valid);
     }
 
     /// The IMU's SPI device (on the host: the emulator, to feed it the truth).

@@ -161,6 +161,50 @@ fn boots_calibrates_the_gyro_bias_and_arms_through_the_receiver() {
 }
 
 #[test]
+fn a_reconfiguration_applies_on_the_ground_only() {
+    let mut bench = Bench::new(Imperfections::BENCH);
+    bench.run_ms(1500);
+    assert!(matches!(bench.stack.boot_state(), BootState::Running(_)));
+    bench.stack.set_params_valid(false);
+    // Other gains, same mounting: applied, calibration kept, the parameter flag too.
+    let mut config = *bench.stack.config();
+    config.app.flight.gains.lat.kp *= 2.0;
+    bench.stack.reconfigure(config).expect("disarmed");
+    assert_eq!(*bench.stack.config(), config);
+    assert_eq!(
+        bench.stack.app().config().flight.gains.lat.kp,
+        config.app.flight.gains.lat.kp
+    );
+    assert!(matches!(bench.stack.boot_state(), BootState::Running(_)));
+    assert!(!bench.stack.app().params_valid());
+    bench.stack.set_params_valid(true);
+    // A refused configuration changes nothing.
+    let mut bad = config;
+    bad.channel_map.arm.channel = bad.channel_map.lateral.channel;
+    assert!(bench.stack.reconfigure(bad).is_err());
+    assert_eq!(*bench.stack.config(), config);
+    // Armed: refused.
+    bench.transmitter = Some(pilot(false, 0.0));
+    bench.run_ms(100);
+    bench.transmitter = Some(pilot(true, 0.0));
+    assert_eq!(bench.run_ms(100).mode, Mode::Pilot);
+    let mut armed = config;
+    armed.app.flight.gains.lat.kp *= 2.0;
+    assert!(matches!(
+        bench.stack.reconfigure(armed),
+        Err(StackError::Armed)
+    ));
+    assert_eq!(*bench.stack.config(), config);
+    // Disarmed again, another mounting: the gyro calibration starts over.
+    bench.transmitter = Some(pilot(false, 0.0));
+    assert_eq!(bench.run_ms(100).mode, Mode::Disarmed);
+    let mut mounted = config;
+    mounted.orientation = crate::imu::ImuRotation::Yaw90.orientation();
+    bench.stack.reconfigure(mounted).expect("disarmed");
+    assert_eq!(bench.stack.boot_state(), BootState::Calibrating);
+}
+
+#[test]
 fn arming_is_refused_while_the_gyro_calibrates() {
     let mut bench = Bench::new(Imperfections::BENCH);
     bench.run_ms(200);

@@ -10,8 +10,9 @@
 //! the flag the application's pre-arm check takes
 //! ([`BoardApp::set_params_valid`](crate::app::BoardApp::set_params_valid)): the defaults
 //! fly only on the ground until a valid set is saved. A `Set` changes the table in RAM;
-//! the application flies the set it was built from until the board rebuilds it (the
-//! board integration decides when: at the next boot, or on the ground after a save).
+//! the application flies the set it was built from until the board rebuilds it
+//! ([`ParamLink::take_changed`] tells it to: the image does on its next disarmed
+//! control tick). `Reset` restores the defaults of the airframe `FRAME` names.
 
 use embedded_storage::nor_flash::NorFlash;
 use sweephold_protocol::{
@@ -25,8 +26,9 @@ use crate::params::{ParamId, ParamTable, SetError, COUNT, MAX_NAME_LEN};
 pub struct ParamLink<F: NorFlash> {
     table: ParamTable,
     store: Option<ParamStore<F>>,
-    vehicle: VehicleId,
     status: LoadStatus,
+    /// A Set or Reset changed the table since [`ParamLink::take_changed`] last looked.
+    changed: bool,
 }
 
 /// A load status as it goes on the wire.
@@ -67,8 +69,8 @@ impl<F: NorFlash> ParamLink<F> {
         ParamLink {
             table,
             store,
-            vehicle,
             status,
+            changed: false,
         }
     }
 
@@ -80,6 +82,12 @@ impl<F: NorFlash> ParamLink<F> {
     /// What the store held at boot, or `Loaded` after a successful save.
     pub const fn load_status(&self) -> LoadStatus {
         self.status
+    }
+
+    /// Whether an accepted Set or Reset changed the table since the last call (the
+    /// board rebuilds its configuration from it on the ground).
+    pub fn take_changed(&mut self) -> bool {
+        core::mem::take(&mut self.changed)
     }
 
     /// Whether a valid set is in use: the application refuses to arm otherwise.
@@ -132,7 +140,10 @@ impl<F: NorFlash> ParamLink<F> {
             },
             ParamRequest::Set { name, value } => match lookup(&name) {
                 Some(id) => match self.table.set(id, value) {
-                    Ok(()) => reply(self.value(id)),
+                    Ok(()) => {
+                        self.changed = true;
+                        reply(self.value(id));
+                    }
                     Err(error) => reply(refuse(name, set_refusal(error))),
                 },
                 None => reply(refuse(name, ParamRefusal::UnknownName)),
@@ -142,7 +153,7 @@ impl<F: NorFlash> ParamLink<F> {
                     reply(refuse(ParamName::EMPTY, ParamRefusal::NoStore));
                     return;
                 };
-                match store.save(&self.table, self.vehicle) {
+                match store.save(&self.table) {
                     Ok(()) => {
                         self.status = LoadStatus::Loaded;
                         reply(ParamReply::Done { op });
@@ -156,7 +167,9 @@ impl<F: NorFlash> ParamLink<F> {
                 }
             }
             ParamRequest::Reset => {
-                self.table = ParamTable::defaults(self.vehicle);
+                // The defaults of the airframe the table names (FRAME is kept).
+                self.table = ParamTable::defaults(self.table.frame());
+                self.changed = true;
                 reply(ParamReply::Done { op });
             }
         }

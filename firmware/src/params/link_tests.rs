@@ -268,7 +268,7 @@ fn a_saved_set_boots_next_time_and_allows_arming() {
     assert_eq!(rebooted.load_status(), LoadStatus::Loaded);
     assert!(rebooted.params_valid());
     assert_eq!(*rebooted.table(), saved);
-    let params = saved.params(VEHICLE).unwrap();
+    let params = saved.params().unwrap();
     assert_eq!(params.stack.app.flight.mixer.tail.centre_us, 760);
 }
 
@@ -322,4 +322,40 @@ fn without_a_store_save_is_refused_and_the_defaults_count_as_valid() {
             reason: ParamRefusal::NoStore
         }]
     );
+}
+
+#[test]
+fn accepted_changes_are_flagged_once_and_reset_keeps_the_frame() {
+    let mut link = link(MockFlash::new());
+    assert!(!link.take_changed());
+    // Refused (armed, or out of range): nothing to rebuild.
+    let frame = ParamRequest::Set {
+        name: name("FRAME"),
+        value: 1.0,
+    };
+    link.handle(&frame, false, |_| {});
+    link.handle(
+        &ParamRequest::Set {
+            name: name("FRAME"),
+            value: 3.0,
+        },
+        true,
+        |_| {},
+    );
+    assert!(!link.take_changed());
+    link.handle(&frame, true, |_| {});
+    assert!(link.take_changed());
+    assert!(!link.take_changed());
+    link.handle(
+        &ParamRequest::Set {
+            name: name("SWASH_LEAD"),
+            value: 2.0,
+        },
+        true,
+        |_| {},
+    );
+    link.handle(&ParamRequest::Reset, true, |_| {});
+    assert!(link.take_changed());
+    // Reset: the Bo-105's defaults, FRAME still naming it.
+    assert_eq!(*link.table(), ParamTable::defaults(VehicleId::Bo105));
 }

@@ -17,6 +17,8 @@
 //! * [`store`] — the set in flash, versioned, CRC-checked and wear-levelled.
 //! * [`link`] — the host's parameter requests (protocol 1.5), obeyed only disarmed.
 //! * [`no_flash`] — the flash type of a board that keeps its parameters in RAM only.
+//! * `ram_flash` (host only) — a NOR flash in RAM and the bytes a store region holds
+//!   after a save (the QEMU tests preload a board's store with them).
 //!
 //! Every value is an `f32`, as ArduPilot's parameters travel over MAVLink: whole
 //! numbers up to 2²⁴ are exact, which covers every integer parameter here.
@@ -25,13 +27,18 @@ pub mod link;
 #[cfg(test)]
 pub(crate) mod mock_flash;
 pub mod no_flash;
+#[cfg(any(test, feature = "std"))]
+pub mod ram_flash;
 pub mod store;
 pub mod table;
 #[cfg(test)]
 mod tests;
 pub mod typed;
 
-pub use table::{ParamDef, ParamId, ParamKind, COUNT, DEFS, MAX_NAME_LEN, TABLE_VERSION};
+pub use table::{
+    frame_code, frame_vehicle, ParamDef, ParamId, ParamKind, COUNT, DEFS, MAX_NAME_LEN,
+    TABLE_VERSION,
+};
 pub use typed::{Params, ParamsError};
 
 use sweephold_protocol::VehicleId;
@@ -120,7 +127,7 @@ pub struct ParamTable {
 impl ParamTable {
     /// The defaults: the preset of `vehicle` ([`crate::board_stack::StackConfig`] with
     /// [`crate::app::AppConfig::preset`], test axis lat, the board's frame rates and
-    /// mounting).
+    /// mounting), `FRAME` naming it.
     pub fn defaults(vehicle: VehicleId) -> Self {
         ParamTable {
             values: typed::values_of(&Params::preset(vehicle)),
@@ -168,8 +175,15 @@ impl ParamTable {
         self.set(id, value)
     }
 
-    /// The typed view, if the whole set is consistent.
-    pub fn params(&self, vehicle: VehicleId) -> Result<Params, ParamsError> {
-        Params::from_values(&self.values, vehicle)
+    /// The typed view (on top of the preset `FRAME` names), if the whole set is
+    /// consistent.
+    pub fn params(&self) -> Result<Params, ParamsError> {
+        Params::from_values(&self.values)
+    }
+
+    /// The vehicle whose preset `FRAME` names (TREX 700L for a value the table would
+    /// refuse, which [`ParamTable::set`] never stores).
+    pub fn frame(&self) -> VehicleId {
+        table::frame_vehicle(self.get(ParamId::Frame)).unwrap_or(VehicleId::Trex700l)
     }
 }

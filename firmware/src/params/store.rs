@@ -188,7 +188,7 @@ impl<F: NorFlash> ParamStore<F> {
         };
         match decode(bytes) {
             Ok(values) => match ParamTable::from_values(values) {
-                Ok(table) if table.params(vehicle).is_ok() => Loaded {
+                Ok(table) if table.params().is_ok() => Loaded {
                     table,
                     status: LoadStatus::Loaded,
                 },
@@ -198,10 +198,10 @@ impl<F: NorFlash> ParamStore<F> {
         }
     }
 
-    /// Save `table` (all values at once) for `vehicle`; an inconsistent set is refused
-    /// before anything is written.
-    pub fn save(&mut self, table: &ParamTable, vehicle: VehicleId) -> Result<(), SaveError> {
-        table.params(vehicle).map_err(|_| SaveError::Inconsistent)?;
+    /// Save `table` (all values at once); an inconsistent set is refused before
+    /// anything is written.
+    pub fn save(&mut self, table: &ParamTable) -> Result<(), SaveError> {
+        table.params().map_err(|_| SaveError::Inconsistent)?;
         let record = encode(table);
         embassy_futures::block_on(self.map.store_item(
             &mut self.buffer,

@@ -27,7 +27,7 @@ fn variant(n: u32) -> ParamTable {
 fn flash_after_saves(n: u32) -> MockFlash {
     let mut s = store(MockFlash::new());
     for i in 0..n {
-        s.save(&variant(i), VEHICLE).unwrap();
+        s.save(&variant(i)).unwrap();
     }
     s.into_flash().rebooted()
 }
@@ -44,7 +44,7 @@ fn an_empty_region_gives_the_defaults_and_says_so() {
 fn a_saved_set_is_loaded_after_a_reboot() {
     let table = variant(3);
     let mut s = store(MockFlash::new());
-    s.save(&table, VEHICLE).unwrap();
+    s.save(&table).unwrap();
     let loaded = store(s.into_flash().rebooted()).load(VEHICLE);
     assert_eq!(
         loaded,
@@ -60,7 +60,7 @@ fn an_inconsistent_set_is_refused_before_anything_is_written() {
     let mut table = ParamTable::defaults(VEHICLE);
     table.set_by_name("SERVO1_MIN", 1600.0).unwrap();
     let mut s = store(MockFlash::new());
-    assert_eq!(s.save(&table, VEHICLE), Err(SaveError::Inconsistent));
+    assert_eq!(s.save(&table), Err(SaveError::Inconsistent));
     let flash = s.into_flash();
     assert_eq!(flash.steps, 0);
     assert!(flash.mem.iter().all(|&b| b == 0xFF));
@@ -77,14 +77,14 @@ fn a_power_loss_at_every_step_of_a_save_leaves_the_old_or_the_new_set() {
         let new = variant(1000 + earlier);
         // How many steps a complete save takes from here.
         let mut probe = store(before.rebooted());
-        probe.save(&new, VEHICLE).unwrap();
+        probe.save(&new).unwrap();
         let steps = probe.into_flash().steps;
         assert!(steps > 0);
         for cut in 0..steps {
             let mut flash = before.rebooted();
             flash.cut_at = Some(cut);
             let mut s = store(flash);
-            assert_eq!(s.save(&new, VEHICLE), Err(SaveError::Flash), "cut {cut}");
+            assert_eq!(s.save(&new), Err(SaveError::Flash), "cut {cut}");
             let mut s = store(s.into_flash().rebooted());
             let loaded = s.load(VEHICLE);
             assert_eq!(
@@ -101,7 +101,7 @@ fn a_power_loss_at_every_step_of_a_save_leaves_the_old_or_the_new_set() {
             }
             // The store recovers: the next save goes through and is loaded.
             let next = variant(2000 + cut as u32);
-            s.save(&next, VEHICLE).unwrap();
+            s.save(&next).unwrap();
             assert_eq!(store(s.into_flash().rebooted()).load(VEHICLE).table, next);
             cases += 1;
         }
@@ -115,13 +115,13 @@ fn a_power_loss_at_every_step_of_a_save_leaves_the_old_or_the_new_set() {
 fn a_power_loss_during_the_first_save_gives_the_defaults_flagged_or_the_new_set() {
     let new = variant(7);
     let mut probe = store(MockFlash::new());
-    probe.save(&new, VEHICLE).unwrap();
+    probe.save(&new).unwrap();
     let steps = probe.into_flash().steps;
     for cut in 0..steps {
         let mut flash = MockFlash::new();
         flash.cut_at = Some(cut);
         let mut s = store(flash);
-        assert!(s.save(&new, VEHICLE).is_err());
+        assert!(s.save(&new).is_err());
         let loaded = store(s.into_flash().rebooted()).load(VEHICLE);
         match loaded.status {
             LoadStatus::Loaded => assert_eq!(loaded.table, new),
@@ -137,7 +137,7 @@ fn a_power_loss_during_the_first_save_gives_the_defaults_flagged_or_the_new_set(
 fn a_corrupt_byte_never_loads_a_wrong_set() {
     let table = variant(11);
     let mut s = store(MockFlash::new());
-    s.save(&table, VEHICLE).unwrap();
+    s.save(&table).unwrap();
     let clean = s.into_flash().rebooted();
     let record = encode(&table);
     let record_at = clean
@@ -190,6 +190,13 @@ fn a_record_of_another_version_or_layout_is_not_loaded() {
     let mut other = good.clone();
     other[4..6].copy_from_slice(&(TABLE_VERSION + 1).to_le_bytes());
     check(&with_crc(other), LoadStatus::OtherVersion);
+    // A record of table version 1 (before FRAME was appended): one value fewer,
+    // version 1, CRC consistent. It boots the defaults, flagged.
+    let mut version_1 = good[..RECORD_LEN - 8].to_vec();
+    version_1[4..6].copy_from_slice(&1u16.to_le_bytes());
+    version_1[6..8].copy_from_slice(&((COUNT - 1) as u16).to_le_bytes());
+    version_1.extend_from_slice(&[0; 4]);
+    check(&with_crc(version_1), LoadStatus::OtherVersion);
     // One value fewer, count and CRC consistent: not this table's layout.
     let mut shorter = good[..RECORD_LEN - 8].to_vec();
     shorter[6..8].copy_from_slice(&((COUNT - 1) as u16).to_le_bytes());

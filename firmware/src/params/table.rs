@@ -26,7 +26,7 @@ pub struct ParamDef {
     pub max: f32,
     /// Real, integer or one of a list.
     pub kind: ParamKind,
-    /// What it sets.
+    /// What it sets (empty in the flight-controller image: the `doc_text` macro).
     pub doc: &'static str,
 }
 
@@ -34,11 +34,14 @@ pub struct ParamDef {
 pub const MAX_NAME_LEN: usize = 16;
 
 /// The version of the table's layout, stored with every record: a record of another
-/// version is not loaded (its values could mean other things).
-pub const TABLE_VERSION: u16 = 1;
+/// version is not loaded (its values could mean other things). Version 2 appended
+/// `FRAME`: a version-1 record holds no base preset and boots the defaults.
+pub const TABLE_VERSION: u16 = 2;
 
 /// Swash type codes: H1, 120°, 135°, 140°.
 const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
+/// Base presets, by [`frame_vehicle`] code: TREX 700L, Bo-105.
+const FRAMES: &[f32] = &[0.0, 1.0];
 /// Servo direction: normal or reversed.
 const DIRECTIONS: &[f32] = &[-1.0, 1.0];
 /// ArduPilot's numbers of the 24 axis-aligned rotations and the two aliases.
@@ -50,6 +53,25 @@ const ROTATIONS: &[f32] = &[
 /// included.
 const PULSE_MIN: f32 = 500.0;
 const PULSE_MAX: f32 = 2500.0;
+
+/// A parameter's doc line: the text on the host; empty in the flight-controller image
+/// (`target_os = "none"`), which never shows it and would spend 3.6 KiB of its flash
+/// budget on the 81 lines. The host reads the same table, so `sweephold fc` and the
+/// README check keep the text.
+#[cfg(not(target_os = "none"))]
+macro_rules! doc_text {
+    ($doc:literal) => {
+        $doc
+    };
+}
+
+/// See the host variant.
+#[cfg(target_os = "none")]
+macro_rules! doc_text {
+    ($doc:literal) => {
+        ""
+    };
+}
 
 macro_rules! params {
     ($( $id:ident = $name:literal, $unit:literal, $min:expr, $max:expr, $kind:expr, $doc:literal; )*) => {
@@ -67,7 +89,7 @@ macro_rules! params {
 
         /// The definitions, in table order.
         pub const DEFS: [ParamDef; COUNT] = [
-            $( ParamDef { name: $name, unit: $unit, min: $min, max: $max, kind: $kind, doc: $doc }, )*
+            $( ParamDef { name: $name, unit: $unit, min: $min, max: $max, kind: $kind, doc: doc_text!($doc) }, )*
         ];
 
         impl ParamId {
@@ -77,6 +99,7 @@ macro_rules! params {
     };
 }
 
+use sweephold_protocol::VehicleId;
 use ParamKind::{Integer, OneOf, Real};
 
 params! {
@@ -160,4 +183,25 @@ params! {
     NoiseCutoff = "NOISE_CUTOFF", "rad/s", 0.01, 3200.0, Real, "Off-axis noise low-pass cut-off.";
     TestSeed = "TEST_SEED", "", 0.0, 16_777_215.0, Integer, "Noise seed (up to 2^24 - 1, exact in the f32 value).";
     TestFreeze = "TEST_FREEZE", "", 0.0, 1.0, Integer, "1: freeze the excitation while the hold is engaged in band.";
+    Frame = "FRAME", "", 0.0, 1.0, OneOf(FRAMES), "Base preset for everything the table does not hold: 0 TREX 700L, 1 Bo-105 (simulator).";
+}
+
+/// The vehicle whose preset a `FRAME` value names (ArduPilot's `FRAME_CLASS` idea: one
+/// image, the airframe chosen by a parameter).
+pub const fn frame_vehicle(code: f32) -> Option<VehicleId> {
+    if code == 0.0 {
+        Some(VehicleId::Trex700l)
+    } else if code == 1.0 {
+        Some(VehicleId::Bo105)
+    } else {
+        None
+    }
+}
+
+/// The `FRAME` value of `vehicle`.
+pub const fn frame_code(vehicle: VehicleId) -> f32 {
+    match vehicle {
+        VehicleId::Trex700l => 0.0,
+        VehicleId::Bo105 => 1.0,
+    }
 }

@@ -42,7 +42,7 @@ fn the_defaults_are_the_presets_bit_for_bit() {
         let table = ParamTable::defaults(vehicle);
         // Every default passes its own definition.
         assert_eq!(ParamTable::from_values(*table.values()), Ok(table));
-        let params = table.params(vehicle).unwrap();
+        let params = table.params().unwrap();
         assert_eq!(params, Params::preset(vehicle));
         assert_eq!(
             params.stack,
@@ -63,7 +63,8 @@ fn the_defaults_are_the_presets_bit_for_bit() {
         ("ABORT_RATE_Y", 250.0),
         ("RC_MODE", 8.0),
         ("IMU_ROT", 0.0),
-        ("SERVO_RATE", 50.0),
+        ("SERVO_RATE", 333.0),
+        ("TAIL_RATE", 333.0),
     ] {
         assert_eq!(table.get_by_name(name), Ok(value), "{name}");
     }
@@ -72,7 +73,7 @@ fn the_defaults_are_the_presets_bit_for_bit() {
 #[test]
 fn every_parameter_reaches_the_configuration_and_reads_back() {
     let base = ParamTable::defaults(VehicleId::Trex700l);
-    let base_params = base.params(VehicleId::Trex700l).unwrap();
+    let base_params = base.params().unwrap();
     for id in ParamId::ALL {
         let def = id.def();
         let current = base.get(id);
@@ -93,7 +94,7 @@ fn every_parameter_reaches_the_configuration_and_reads_back() {
             let mut table = base;
             (value != current && table.set(id, value).is_ok())
                 .then_some(table)
-                .and_then(|t| t.params(VehicleId::Trex700l).ok().map(|p| (t, p)))
+                .and_then(|t| t.params().ok().map(|p| (t, p)))
         });
         let (table, params) =
             changed.unwrap_or_else(|| panic!("{}: no other valid value", def.name));
@@ -182,18 +183,19 @@ fn a_set_round_trips_by_name() {
         ("TAIL_MID", 760.0),
         ("TAIL_MIN", 560.0),
         ("TAIL_MAX", 960.0),
-        ("SERVO_RATE", 333.0),
+        ("SERVO_RATE", 200.0),
+        ("TAIL_RATE", 50.0),
         ("IMU_ROT", 27.0),
     ] {
         table.set_by_name(name, value).unwrap();
         assert_eq!(table.get_by_name(name), Ok(value));
     }
-    let params = table.params(VehicleId::Trex700l).unwrap();
+    let params = table.params().unwrap();
     let mixer = params.stack.app.flight.mixer;
     assert_eq!(mixer.geometry.kind(), crate::swash::SwashType::H3_140);
     assert!(mixer.swash[1].reversed && !mixer.swash[0].reversed);
     assert_eq!(mixer.tail.centre_us, 760);
-    assert_eq!(params.swash_frame_hz, 333);
+    assert_eq!((params.swash_frame_hz, params.tail_frame_hz), (200, 50));
     // ArduPilot's PITCH_180_YAW_270 is ROLL_180_YAW_90.
     assert_eq!(params.imu_rotation, crate::imu::ImuRotation::Roll180Yaw90);
     assert_eq!(
@@ -209,7 +211,7 @@ fn an_inconsistent_set_gives_no_configuration() {
         for (name, value) in changes {
             table.set_by_name(name, *value).unwrap();
         }
-        table.params(VehicleId::Trex700l).unwrap_err()
+        table.params().unwrap_err()
     };
     assert_eq!(refused(&[("SERVO1_MIN", 1600.0)]), ParamsError::Mixer);
     assert!(matches!(
@@ -232,7 +234,7 @@ fn an_inconsistent_set_gives_no_configuration() {
     // the 2/rev of a 4000 rpm head is 133 Hz): the filters still design.
     let mut table = ParamTable::defaults(VehicleId::Trex700l);
     table.set_by_name("TAIL_RPM", 20_000.0).unwrap();
-    assert!(table.params(VehicleId::Trex700l).is_ok());
+    assert!(table.params().is_ok());
 }
 
 /// The README's parameter table row of `id`: name, unit, range, kind, TREX 700L and
@@ -286,4 +288,25 @@ fn print_readme_table() {
     for id in ParamId::ALL {
         println!("{}", readme_row(id));
     }
+}
+
+#[test]
+fn frame_names_the_preset_under_the_table() {
+    // FRAME is the last parameter: a table only ever grows at its end.
+    assert_eq!(ParamId::ALL[COUNT - 1], ParamId::Frame);
+    assert_eq!(TABLE_VERSION, 2);
+    for vehicle in VEHICLES {
+        let table = ParamTable::defaults(vehicle);
+        assert_eq!(table.get(ParamId::Frame), frame_code(vehicle));
+        assert_eq!(table.frame(), vehicle);
+        assert_eq!(frame_vehicle(frame_code(vehicle)), Some(vehicle));
+    }
+    assert_eq!(frame_vehicle(0.5), None);
+    // FRAME 1 on the TREX 700L values: the Bo-105 preset under the same values.
+    let mut table = ParamTable::defaults(VehicleId::Trex700l);
+    table.set_by_name("FRAME", 1.0).unwrap();
+    let params = table.params().unwrap();
+    assert_eq!(params.stack.app.flight.vehicle, VehicleId::Bo105);
+    assert_eq!(typed::values_of(&params), *table.values());
+    assert_eq!(table.set_by_name("FRAME", 2.0), Err(SetError::OutOfRange));
 }

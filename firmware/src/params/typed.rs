@@ -9,7 +9,7 @@
 
 use sweephold_protocol::{Axis, ExcitationMode, InputKind, VehicleId};
 
-use super::table::{ParamId, COUNT};
+use super::table::{frame_code, frame_vehicle, ParamId, COUNT};
 use crate::app::{AppConfig, AppConfigError};
 use crate::board_stack::StackConfig;
 use crate::config::ConfigError;
@@ -55,8 +55,18 @@ const TAIL_SERVO_IDS: [ParamId; 5] = [
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
-/// The board's swash and tail servo frame rate before parameters existed \[Hz\].
-pub const DEFAULT_FRAME_HZ: u16 = 50;
+/// The default swash servo frame rate \[Hz\]: 333, the fastest the table allows. A
+/// flybarless head is flown with digital servos, which take 333 Hz frames; at the 50 Hz
+/// of analog servos, three of every four 200 Hz control ticks' commands never reached a
+/// servo and the hold it applied was not the logged one. An analog servo needs
+/// `SERVO_RATE` 50 (it may overheat at 333).
+pub const DEFAULT_FRAME_HZ: u16 = 333;
+
+/// The default tail servo frame rate \[Hz\]: 333 too. The yaw loop is the fastest of
+/// the helicopter and its servo the one a lost command costs most; flybarless tail
+/// servos are digital (narrow-band 760 µs ones take 333 Hz and more, wide-band digital
+/// ones 333 Hz). An analog tail servo needs `TAIL_RATE` 50.
+pub const DEFAULT_TAIL_FRAME_HZ: u16 = 333;
 
 /// Everything the parameters set, typed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,25 +120,27 @@ impl ParamsError {
 
 impl Params {
     /// The preset of `vehicle`: [`AppConfig::preset`] on the lateral axis in the board's
-    /// standard stack, no IMU rotation, 50 Hz servo frames.
+    /// standard stack, no IMU rotation, 333 Hz servo frames ([`DEFAULT_FRAME_HZ`],
+    /// [`DEFAULT_TAIL_FRAME_HZ`]).
     pub const fn preset(vehicle: VehicleId) -> Self {
         Params {
             stack: StackConfig::with_app(AppConfig::preset(vehicle, Axis::Lat)),
             imu_rotation: ImuRotation::None,
             swash_frame_hz: DEFAULT_FRAME_HZ,
-            tail_frame_hz: DEFAULT_FRAME_HZ,
+            tail_frame_hz: DEFAULT_TAIL_FRAME_HZ,
         }
     }
 
-    /// The configuration `values` describe on top of the preset of `vehicle`, checked
-    /// as a whole.
-    pub fn from_values(values: &[f32; COUNT], vehicle: VehicleId) -> Result<Self, ParamsError> {
+    /// The configuration `values` describe on top of the preset their `FRAME` names,
+    /// checked as a whole.
+    pub fn from_values(values: &[f32; COUNT]) -> Result<Self, ParamsError> {
         for (id, value) in ParamId::ALL.iter().zip(values) {
             id.def()
                 .check(*value)
                 .map_err(|_| ParamsError::Value(*id))?;
         }
         let v = |id: ParamId| values.get(id.index()).copied().unwrap_or(0.0);
+        let vehicle = frame_vehicle(v(ParamId::Frame)).ok_or(ParamsError::Value(ParamId::Frame))?;
         let mut params = Params::preset(vehicle);
         let stack = &mut params.stack;
 
@@ -451,5 +463,6 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
         ParamId::TestFreeze,
         if test.freeze_in_band { 1.0 } else { 0.0 },
     );
+    put(ParamId::Frame, frame_code(flight.vehicle));
     values
 }

@@ -124,11 +124,17 @@ pub struct ClockGates {
 }
 
 /// Bring up the clock tree (see the module documentation) with the board's `crystal` and
-/// report what it is. Takes the RCC and the flash interface (wait states) for good; the
-/// RCC comes back as the [`ClockGates`] the drivers' set-up uses.
-pub fn init(rcc: pac::RCC, flash: pac::FLASH, crystal: Crystal) -> (Clocks, ClockGates) {
+/// report what it is. Takes the RCC for good and the flash interface for its wait
+/// states; the RCC comes back as the [`ClockGates`] the drivers' set-up uses, the flash
+/// interface for the parameter store's driver (`chip::flash`, which uses only KEYR, CR
+/// and SR; the wait states in ACR stay as set here).
+pub fn init(
+    rcc: pac::RCC,
+    flash: pac::FLASH,
+    crystal: Crystal,
+) -> (Clocks, ClockGates, pac::FLASH) {
     let clocks = configure(&rcc, &flash, crystal);
-    (clocks, ClockGates { rcc })
+    (clocks, ClockGates { rcc }, flash)
 }
 
 fn configure(rcc: &pac::RCC, flash: &pac::FLASH, crystal: Crystal) -> Clocks {

@@ -8,6 +8,7 @@ use stm32f4::stm32f405 as pac;
 use crate::chip::boot::Boot;
 use crate::chip::clocks;
 use crate::chip::dividers;
+use crate::chip::flash::{F405Flash, Registers};
 use crate::chip::gpio::Gpio;
 use crate::chip::imu_device::{self, ImuDevice};
 use crate::chip::logport;
@@ -36,6 +37,8 @@ pub struct Devices {
     pub imu: ImuDevice,
     /// The independent watchdog (not started).
     pub watchdog: Watchdog,
+    /// The flash, for the parameter store.
+    pub flash: F405Flash<Registers>,
     /// The loop tick's timer, started by the loop once its flight logic is ready.
     pub tim5: pac::TIM5,
 }
@@ -47,7 +50,7 @@ pub fn bring_up(map: &BoardMap) -> Devices {
     let (Some(p), Some(core)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {
         defmt::panic!("peripherals taken twice")
     };
-    let (clocks, gates) = clocks::init(p.RCC, p.FLASH, map.crystal);
+    let (clocks, gates, flash) = clocks::init(p.RCC, p.FLASH, map.crystal);
     defmt::info!("clocks {}", clocks);
     let Some(gpio) = cortex_m::singleton!(: Gpio = Gpio::new(p.GPIOA, p.GPIOB, p.GPIOC)) else {
         defmt::panic!("GPIO taken twice")
@@ -98,6 +101,7 @@ pub fn bring_up(map: &BoardMap) -> Devices {
         sbus,
         imu,
         watchdog: Watchdog::new(p.IWDG),
+        flash: F405Flash::new(Registers::new(flash)),
         tim5: p.TIM5,
     }
 }

@@ -121,6 +121,30 @@ mod tests {
         }
     }
 
+    /// Servo frames from 50 to 333 Hz (the table's `SERVO_RATE`/`TAIL_RATE` range) on
+    /// every timer clock the image runs at (APB1 and APB2 timers on the PLL, HSI, QEMU's
+    /// emulated clock): the counter ticks exactly 1 MHz (1 µs resolution), and the frame
+    /// holds the longest pulse plus a gap, so a 760 µs tail centre (and its 560–960 µs
+    /// travel) is a compare value of 760 inside a 3003 µs frame at 333 Hz.
+    #[test]
+    fn servo_frames_up_to_333_hz_hold_a_760_us_tail_centre() {
+        use crate::chip::pins::{MAX_FRAME_HZ, MAX_PULSE_US, MIN_PULSE_US};
+        for timer_hz in [84_000_000, 168_000_000, 16_000_000, 1_000_000_000] {
+            for frame_hz in [50, 200, 250, 333] {
+                let (prescaler, reload) = servo_dividers(timer_hz, frame_hz).unwrap();
+                assert_eq!(timer_hz / (u32::from(prescaler) + 1), SERVO_COUNTER_HZ);
+                assert_eq!(timer_hz % (u32::from(prescaler) + 1), 0);
+                let period_us = u32::from(reload) + 1;
+                assert_eq!(period_us, SERVO_COUNTER_HZ / frame_hz);
+                assert!(period_us >= u32::from(MAX_PULSE_US) + 100, "{frame_hz} Hz");
+                assert!(MIN_PULSE_US <= 560 && 760 < period_us);
+            }
+            let (_, reload) = servo_dividers(timer_hz, 333).unwrap();
+            assert_eq!(reload, 3002);
+        }
+        const { assert!(MAX_FRAME_HZ >= 333) };
+    }
+
     #[test]
     fn tick_reload_rejects_impossible_rates() {
         assert_eq!(tick_reload(16_000_000, 0), Err(DividerError::ZeroRate));

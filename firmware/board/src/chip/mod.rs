@@ -23,6 +23,8 @@ pub mod delay;
 pub mod devices;
 #[cfg(any(target_os = "none", test))]
 pub mod dividers;
+#[cfg(any(target_os = "none", test))]
+pub mod flash;
 #[cfg(target_os = "none")]
 pub mod gpio;
 #[cfg(target_os = "none")]

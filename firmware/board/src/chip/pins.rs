@@ -164,8 +164,10 @@ pub struct BoardMap {
     pub swd: [Pin; 2],
 }
 
-/// Shortest pulse ever put on a pin [µs].
-pub const MIN_PULSE_US: u16 = 900;
+/// Shortest pulse ever put on a pin [µs]: the parameter table's shortest servo pulse,
+/// so a 760 µs tail servo's range (about 560–960 µs) reaches the pin; each servo's own
+/// `*_MIN`/`*_MAX` limit it in the mixer before this last clamp.
+pub const MIN_PULSE_US: u16 = 500;
 /// Longest pulse ever put on a pin [µs].
 pub const MAX_PULSE_US: u16 = 2100;
 /// Highest frame rate whose period still holds the longest pulse plus a 100 µs gap [Hz].

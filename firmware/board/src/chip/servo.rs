@@ -161,6 +161,40 @@ pub struct Servos<P: SetDutyCycle> {
     channels: [P; 4],
 }
 
+impl Servos<ServoChannel> {
+    /// Frames at `swash_hz` on the swash servos' timers and `tail_hz` on the tail's (the
+    /// parameters `SERVO_RATE`, `TAIL_RATE`); the ESC's timer keeps its rate. The board
+    /// maps give the tail and the ESC timers of their own (`boards` tests), so each rate
+    /// reaches its outputs only. The new reload is preloaded (ARPE): it starts with the
+    /// next frame, never cutting one short. Every control tick writes every compare
+    /// register, so at 333 Hz (3 ms frames, 5 ms ticks) each command reaches its servo.
+    // One body serves the 32-bit TIM2 (u32 fields) and the 16-bit timers (u16 fields).
+    #[allow(clippy::useless_conversion)]
+    pub fn set_frame_rates(
+        &mut self,
+        clocks: &Clocks,
+        swash_hz: u32,
+        tail_hz: u32,
+    ) -> Result<(), DividerError> {
+        let rates = [swash_hz, swash_hz, swash_hz, tail_hz];
+        let mut periods = [0u16; 4];
+        // Every divider first: a rate refused leaves every timer as it was.
+        for ((channel, rate), period) in self.channels.iter().zip(rates).zip(&mut periods) {
+            let (_, timer_hz) = clock_of(channel.output.timer, clocks);
+            let (_, reload) = dividers::servo_dividers(timer_hz, rate)?;
+            *period = reload.saturating_add(1);
+        }
+        for (channel, period) in self.channels.iter_mut().zip(periods) {
+            let reload = period.saturating_sub(1);
+            with_timer!(channel.timers, channel.output.timer, |tim| tim
+                .arr()
+                .write(|w| w.arr().set(reload.into())));
+            channel.period_us = period;
+        }
+        Ok(())
+    }
+}
+
 impl<P: SetDutyCycle> Servos<P> {
     /// Put the pulses `pulse_us` (clamped to [`MIN_PULSE_US`, `MAX_PULSE_US`]) on the
     /// outputs. The duty value of a channel counting µs is the pulse width itself.

@@ -36,9 +36,14 @@
 //! chosen on the ground, never a takeover in flight. The first such frame of each armed
 //! period is reported with an Event (`HostLinkIgnored`), every one is counted.
 //!
-//! **Parameters** (protocol 1.5): ParamRequest frames are answered through
+//! **Parameters** (protocol 1.5): the board application (and the in-the-loop flight
+//! logic's first configuration) is built from the typed view of the table the store held
+//! at boot, its servo timers run at the table's frame rates, and the store's status goes
+//! out as an Event after the boot Header. ParamRequest frames are answered through
 //! [`crate::image::params`] in the board application while it is disarmed (refused as
-//! armed otherwise, and in the loop); a List is answered one reply per control tick.
+//! armed otherwise, and in the loop); a List is answered one reply per control tick. A
+//! Set or Reset is applied on the next disarmed control tick (`Runner::apply_params`);
+//! a Save stretches the watchdog around the flash erase.
 //!
 //! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the in-the-loop
 //! configuration at run time. The image builds the preset of the frame's vehicle for
@@ -51,14 +56,15 @@
 use embedded_hal::pwm::SetDutyCycle;
 use sweephold_firmware::app::Mode as AppMode;
 use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_HZ};
+use sweephold_firmware::params::Params;
 use sweephold_firmware::FlightController;
 use sweephold_protocol::{
     ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, Header, HostFrame,
-    LinkConfig, SensorIn,
+    LinkConfig, ParamRequest, SensorIn,
 };
 
 use crate::boards::BOARD;
-use crate::chip::clocks::ClockSource;
+use crate::chip::clocks::{ClockSource, Clocks};
 use crate::chip::delay::BusyDelay;
 use crate::chip::devices::{self, Devices};
 use crate::chip::dividers;
@@ -70,7 +76,7 @@ use crate::chip::servo::{self, ServoChannel, Servos, ESC_CUT_US};
 use crate::chip::ticker::Ticker;
 use crate::chip::usart::{self, UsartTx};
 use crate::chip::watchdog::Watchdog;
-use crate::image::config::{image_config, link_config, stack_config};
+use crate::image::config::{fallback_params, link_config};
 use crate::image::link::{self, FrameScratch, Inbound, Telemetry};
 use crate::image::log;
 use crate::image::params::HostParams;
@@ -156,6 +162,8 @@ pub struct Runner {
     watchdog: Watchdog,
     /// The parameter table the host's ParamRequest frames read and set.
     params: HostParams,
+    /// The clock tree (the servo timers' dividers).
+    clocks: Clocks,
 }
 
 impl Runner {
@@ -197,6 +205,7 @@ impl Runner {
     /// `docs/board_tick_instructions.py`.
     #[inline(never)]
     fn control_tick(&mut self) {
+        self.apply_params();
         let mut received = [0u8; sbus_uart::RX_CAPACITY];
         let count = self.sbus.take(&mut received);
         let tick = self.stack.app().flight_controller().tick();
@@ -222,6 +231,63 @@ impl Runner {
         }
         if out.refused.is_some() {
             defmt::warn!("request refused in mode {=str}", out.mode.name());
+        }
+    }
+
+    /// On the ground, the parameters as the host left them: the pre-arm flag (a save
+    /// makes the set valid), and a table changed by a Set or Reset rebuilt into the
+    /// board application (restarted Disarmed on it, its Header sent, the failsafe
+    /// pulses its mixer's). Armed, nothing changes: a change waits for the ground (the
+    /// link refuses them armed anyway). A set the typed view or the stack refuses (a
+    /// push half-way through, servo limits crossing their centre for a moment) keeps
+    /// the running configuration until a later change makes it whole.
+    fn apply_params(&mut self) {
+        if !self.stack.app().host_link_allowed() {
+            return;
+        }
+        self.stack.set_params_valid(self.params.valid());
+        if !self.params.take_changed() {
+            return;
+        }
+        let applied = self
+            .params
+            .params()
+            .map_err(|error| error.message())
+            .and_then(|params| {
+                self.stack
+                    .reconfigure(params.stack)
+                    .map_err(|error| error.message())?;
+                self.apply_frame_rates(&params);
+                Ok(())
+            });
+        match applied {
+            Ok(()) => {
+                let neutral = sweephold_firmware::mix(
+                    &self.stack.config().app.flight.mixer,
+                    &Controls::default(),
+                );
+                servo::set_failsafe(neutral);
+                defmt::info!("parameters applied");
+                self.send_header(self.stack.app().header());
+            }
+            Err(message) => defmt::warn!("parameters not applied yet: {=str}", message),
+        }
+    }
+
+    /// The servo frame rates of `params` on the output timers (a rate the dividers
+    /// refuse, never expected for 50–333 Hz, keeps the running ones and is logged).
+    fn apply_frame_rates(&mut self, params: &Params) {
+        let (swash_hz, tail_hz) = (
+            u32::from(params.swash_frame_hz),
+            u32::from(params.tail_frame_hz),
+        );
+        match self.servos.set_frame_rates(&self.clocks, swash_hz, tail_hz) {
+            Ok(()) => defmt::info!(
+                "servo frames: swash {=u32} Hz, tail {=u32} Hz",
+                swash_hz,
+                tail_hz
+            ),
+            Err(error) => defmt::warn!("servo frame rates refused: {}", error),
         }
     }
 
@@ -418,8 +484,17 @@ impl Runner {
             Ok(Frame::Configure(request)) => self.configure(&request),
             Ok(Frame::ParamRequest(request)) => {
                 let disarmed = self.params_allowed();
+                // A save may erase a flash sector: the loop stalls up to 2 s (disarmed
+                // only; the link refuses a save armed before touching the flash).
+                let saving = disarmed && matches!(request, ParamRequest::Save);
+                if saving {
+                    self.watchdog.stretch_for_flash();
+                }
                 self.params
                     .on_request(&request, disarmed, &mut self.tx, &mut self.scratch);
+                if saving {
+                    self.watchdog.restore_after_save();
+                }
             }
             Ok(_) => self.stats.ignored_frames = self.stats.ignored_frames.wrapping_add(1),
             // The decoder has resynchronised on the next delimiter already.
@@ -439,18 +514,32 @@ pub fn run() -> ! {
         sbus,
         imu,
         watchdog,
+        flash,
         tim5,
     } = devices::bring_up(&BOARD);
     let clocks = boot.clocks;
 
-    let fc = match FlightController::new(image_config()) {
+    let params = HostParams::boot(flash);
+    defmt::info!(
+        "parameter store: {}",
+        sweephold_firmware::params::link::store_status(params.status())
+    );
+    let flown = params.params().unwrap_or_else(|error| {
+        defmt::error!("parameter set refused: {=str}", error.message());
+        fallback_params()
+    });
+    let fc = match FlightController::new(flown.stack.app.flight) {
         Ok(fc) => fc,
         Err(error) => defmt::panic!("flight configuration refused: {=str}", error.message()),
     };
-    let mut stack = match Stack::new(imu, BusyDelay::new(clocks.hclk_hz), stack_config()) {
+    let mut stack = match Stack::new(imu, BusyDelay::new(clocks.hclk_hz), flown.stack) {
         Ok(stack) => stack,
         Err(error) => defmt::panic!("board configuration refused: {=str}", error.message()),
     };
+    stack.set_params_valid(params.valid());
+    if !params.valid() {
+        defmt::warn!("no valid parameter set stored: defaults, arming refused until a save");
+    }
     // From now on a panic or fault puts the servos where the mixer puts centred sticks:
     // the board application's disarmed output.
     let neutral = sweephold_firmware::mix(&fc.config().mixer, &Controls::default());
@@ -489,9 +578,13 @@ pub fn run() -> ! {
         host_ignored_reported: false,
         scratch: [0; sweephold_protocol::MAX_FRAME_LEN],
         watchdog,
-        params: HostParams::new(image_config().vehicle),
+        params,
+        clocks,
     };
+    runner.apply_frame_rates(&flown);
     runner.announce();
+    let event = runner.params.store_event(0);
+    link::send(&mut runner.tx, &mut runner.scratch, &Frame::Event(event));
 
     let ticker = match Ticker::start(tim5, &mut boot, TIMER_HZ) {
         Ok(ticker) => ticker,

@@ -31,9 +31,9 @@
 
 use crate::chip::pins::{pin, BoardMap, Crystal, ImuPins, Output, OutputTimer, Port, TimerRate};
 
-/// Frame rate of the swash servos (TIM2) [Hz].
+/// Frame rate of the swash servos (TIM2) at boot [Hz], until `SERVO_RATE` is applied.
 pub const SWASH_FRAME_HZ: u32 = 50;
-/// Frame rate of the tail servo (TIM8) [Hz].
+/// Frame rate of the tail servo (TIM8) at boot [Hz], until `TAIL_RATE` is applied.
 pub const TAIL_FRAME_HZ: u32 = 50;
 /// Frame rate of the ESC's throttle pulse (TIM1) [Hz].
 pub const ESC_FRAME_HZ: u32 = 50;

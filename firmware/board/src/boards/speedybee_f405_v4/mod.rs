@@ -29,11 +29,11 @@
 //!
 //! **Frame rates** are per timer, so per group of outputs sharing one: the swash servos
 //! (TIM4 and TIM3), the tail servo (TIM8) and the ESC (TIM2) each have their own
-//! ([`SWASH_FRAME_HZ`], [`TAIL_FRAME_HZ`], [`ESC_FRAME_HZ`]). A frame rate is usable
-//! when its period is longer than the longest pulse (`MAX_FRAME_HZ`, checked when the
-//! image is built). Every servo pulse is clamped to 900–2100 µs (the standard 1520 µs
-//! centre convention); servos of the narrow-band 760 µs-centre convention (some tail
-//! servos) are not supported by this range.
+//! ([`SWASH_FRAME_HZ`], [`TAIL_FRAME_HZ`], [`ESC_FRAME_HZ`]: the rates at boot; the
+//! swash and tail timers then take the parameters `SERVO_RATE` and `TAIL_RATE`). A frame
+//! rate is usable when its period is longer than the longest pulse (`MAX_FRAME_HZ`,
+//! checked when the image is built). Every servo pulse is clamped to 500–2100 µs, which
+//! holds the standard 1520 µs centre convention and the narrow-band 760 µs one.
 //!
 //! Under QEMU (`-M netduinoplus2`, the same chip): USART1 is the machine's first
 //! `-serial`, USART2 the second; TIM2..TIM5 and USART1..6 are emulated, TIM8 is not
@@ -41,11 +41,10 @@
 
 use crate::chip::pins::{pin, BoardMap, Crystal, ImuPins, Output, OutputTimer, Port, TimerRate};
 
-/// Frame rate of the swash servos (TIM4 and TIM3) [Hz]. 50 Hz is safe for every servo;
-/// digital 700-class cyclic servos take up to 333 Hz (a 3003 µs frame).
+/// Frame rate of the swash servos (TIM4 and TIM3) at boot [Hz], until the parameter
+/// table's `SERVO_RATE` is applied. 50 Hz is safe for every servo.
 pub const SWASH_FRAME_HZ: u32 = 50;
-/// Frame rate of the tail servo (TIM8) [Hz]. Digital tail servos of the standard
-/// convention take up to 333 Hz.
+/// Frame rate of the tail servo (TIM8) at boot [Hz], until `TAIL_RATE` is applied.
 pub const TAIL_FRAME_HZ: u32 = 50;
 /// Frame rate of the ESC's throttle pulse (TIM2) [Hz]: every PWM ESC reads 50 Hz.
 pub const ESC_FRAME_HZ: u32 = 50;
