@@ -129,6 +129,18 @@ impl SignedAxis {
         }
     }
 
+    /// This axis with its sign multiplied by `sign` (+1 keeps it, −1 reverses it).
+    const fn signed(self, sign: i8) -> SignedAxis {
+        match (self.index(), self.sign() * sign) {
+            (0, 1) => SignedAxis::PosX,
+            (0, _) => SignedAxis::NegX,
+            (1, 1) => SignedAxis::PosY,
+            (1, _) => SignedAxis::NegY,
+            (_, 1) => SignedAxis::PosZ,
+            _ => SignedAxis::NegZ,
+        }
+    }
+
     /// The signed component of `v` this axis selects.
     fn pick(self, v: [f32; 3]) -> f32 {
         let [x, y, z] = v;
@@ -200,6 +212,25 @@ impl Orientation {
     /// The signed chip axis read by each body axis.
     pub const fn axes(&self) -> [SignedAxis; 3] {
         self.axes
+    }
+
+    /// `self` after `inner`: the map from `inner`'s input axes to `self`'s output axes
+    /// (`to_body` of the result equals `self.to_body(inner.to_body(v))`). The image uses
+    /// it to put the aircraft's mounting of the board (`IMU_ROT`) after the board's own
+    /// mounting of its chip. A product of proper rotations is proper.
+    pub fn after(self, inner: Orientation) -> Orientation {
+        let [x, y, z] = inner.axes;
+        let through_inner = |outer: SignedAxis| {
+            let read = match outer.index() {
+                0 => x,
+                1 => y,
+                _ => z,
+            };
+            read.signed(outer.sign())
+        };
+        Orientation {
+            axes: self.axes.map(through_inner),
+        }
     }
 
     /// Chip-axis vector to body axes.

@@ -297,3 +297,22 @@ fn a_reading_that_is_not_gravity_is_refused() {
         Err(LevelError::NotFinite)
     );
 }
+
+#[test]
+fn a_mounting_after_another_rotates_as_the_two_in_turn() {
+    // Every pair of the 24 mountings, on a vector with three distinct components.
+    let v = [0.3, -1.7, 2.9];
+    for outer in ImuRotation::ALL {
+        for inner in ImuRotation::ALL {
+            let composed = outer.orientation().after(inner.orientation());
+            let in_turn = outer.orientation().to_body(inner.orientation().to_body(v));
+            assert_eq!(composed.to_body(v), in_turn, "{outer:?} after {inner:?}");
+            // And it is still a proper rotation the driver accepts.
+            assert_eq!(Orientation::new(composed.axes()), Some(composed));
+        }
+    }
+    assert_eq!(
+        Orientation::IDENTITY.after(Orientation::TOP_UP_X_FORWARD),
+        Orientation::TOP_UP_X_FORWARD
+    );
+}

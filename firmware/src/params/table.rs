@@ -146,7 +146,7 @@ params! {
     RcMid = "RC_MID", "", 0.0, 2047.0, Integer, "Raw SBUS value at centre.";
     RcMax = "RC_MAX", "", 0.0, 2047.0, Integer, "Raw SBUS value at full positive travel.";
     RcTimeout = "RC_TIMEOUT", "ms", 20.0, 1000.0, Integer, "Receiver link lost after this long without an intact frame.";
-    ImuRot = "IMU_ROT", "", 0.0, 37.0, OneOf(ROTATIONS), "IMU mounting, ArduPilot's ROTATION_* number (axis-aligned only).";
+    ImuRot = "IMU_ROT", "", 0.0, 37.0, OneOf(ROTATIONS), "The board's mounting in the aircraft, ArduPilot's ROTATION_* number (axis-aligned only).";
     HeadRpm = "HEAD_RPM", "rpm", 600.0, 4000.0, Real, "Main rotor speed: places the 1/rev and 2/rev notches.";
     TailRpm = "TAIL_RPM", "rpm", 1200.0, 20000.0, Real, "Tail rotor speed: places the tail notch.";
     HoldLatP = "HOLD_LAT_P", "1/rad", 0.0, 20.0, Real, "Attitude hold, roll: stick per rad of attitude error.";

@@ -156,3 +156,54 @@ fn no_output_sits_on_the_imu_spi() {
         }
     }
 }
+
+/// Betaflight's `alignSensors` (`src/main/sensors/boardalignment.c`), the cases the
+/// boards' targets name: the chip's (x, y, z) to the board's (forward, left, up).
+fn betaflight_align(align: &str, [x, y, z]: [f32; 3]) -> [f32; 3] {
+    match align {
+        "CW90_DEG" => [y, -x, z],
+        "CW270_DEG_FLIP" => [-y, -x, -z],
+        other => panic!("alignment {other} not transcribed"),
+    }
+}
+
+/// ArduPilot's `Vector3::rotate` for `ROTATION_PITCH_180_YAW_270`: the chip's (x, y, z)
+/// to the board's (forward, right, down).
+fn ardupilot_pitch_180_yaw_270([x, y, z]: [f32; 3]) -> [f32; 3] {
+    [y, x, -z]
+}
+
+#[test]
+fn each_board_carries_its_imu_as_its_published_definitions_say() {
+    // Betaflight's frame is (forward, left, up): (forward, right, down) negates the last two.
+    let from_betaflight = |align: &str, chip: [f32; 3]| {
+        let [f, l, u] = betaflight_align(align, chip);
+        [f, -l, -u]
+    };
+    let published: [(&str, &str); 2] = [
+        ("SpeedyBee F405 V4", "CW90_DEG"),
+        ("Matek F405-TE", "CW270_DEG_FLIP"),
+    ];
+    assert_eq!(
+        published.len(),
+        ALL.len(),
+        "every board has its definition here"
+    );
+    let chip = [0.3, -1.7, 2.9];
+    for board in ALL {
+        let (_, align) = published
+            .iter()
+            .find(|(name, _)| *name == board.name)
+            .expect("board listed");
+        let body = board.imu_mounting.orientation().to_body(chip);
+        assert_eq!(body, from_betaflight(align, chip), "{}", board.name);
+    }
+    // The SpeedyBee F405 V4's ArduPilot hwdef says the same as its Betaflight target.
+    assert_eq!(
+        speedybee_f405_v4::BOARD
+            .imu_mounting
+            .orientation()
+            .to_body(chip),
+        ardupilot_pitch_180_yaw_270(chip)
+    );
+}

@@ -88,7 +88,7 @@ pub fn bring_up(map: &BoardMap) -> Devices {
         Ok(sbus) => sbus,
         Err(error) => defmt::panic!("USART2 (SBUS): {}", error),
     };
-    let imu = match imu_device::init(p.SPI1, map.imu, &boot) {
+    let imu = match imu_device::init(p.SPI1, map, &boot) {
         Ok(imu) => imu,
         Err(error) => defmt::panic!("SPI1 (IMU): {}", error),
     };

@@ -8,19 +8,19 @@ use stm32f4::stm32f405 as pac;
 
 use crate::chip::boot::Boot;
 use crate::chip::dividers::DividerError;
-use crate::chip::pins::ImuPins;
+use crate::chip::pins::BoardMap;
 
 #[cfg(not(feature = "bench-imu"))]
 mod device {
-    use super::{pac, Boot, DividerError, ImuPins};
+    use super::{pac, BoardMap, Boot, DividerError};
     use crate::chip::imu_spi::{self, ImuSpi};
 
     /// The chip on SPI1.
     pub type ImuDevice = ImuSpi;
 
-    /// Configure SPI1.
-    pub fn init(spi1: pac::SPI1, pins: ImuPins, boot: &Boot) -> Result<ImuDevice, DividerError> {
-        let (spi, hz) = imu_spi::init(spi1, pins, boot)?;
+    /// Configure SPI1 on `map`'s IMU pins.
+    pub fn init(spi1: pac::SPI1, map: &BoardMap, boot: &Boot) -> Result<ImuDevice, DividerError> {
+        let (spi, hz) = imu_spi::init(spi1, map.imu, boot)?;
         defmt::info!("IMU: ICM-42688-P on SPI1 at {=u32} Hz", hz);
         Ok(spi)
     }
@@ -31,7 +31,7 @@ mod device {
 
 #[cfg(feature = "bench-imu")]
 mod device {
-    use super::{pac, Boot, DividerError, ImuPins};
+    use super::{pac, BoardMap, Boot, DividerError};
     use crate::chip::imu_spi;
     use sweephold_firmware::imu::emulator::{Icm42688Emulator, Imperfections};
     use sweephold_firmware::imu::GRAVITY_M_S2;
@@ -39,11 +39,15 @@ mod device {
     /// The emulated chip.
     pub type ImuDevice = Icm42688Emulator;
 
-    /// An emulated chip at rest, level, with a bench board's bias and noise. SPI1 is
-    /// set up as on the board image (chip select released), then left alone.
-    pub fn init(spi1: pac::SPI1, pins: ImuPins, boot: &Boot) -> Result<ImuDevice, DividerError> {
-        imu_spi::init(spi1, pins, boot)?;
+    /// An emulated chip at rest, level, with a bench board's bias and noise, carried as
+    /// `map`'s own chip is. SPI1 is set up as on the board image (chip select released),
+    /// then left alone.
+    pub fn init(spi1: pac::SPI1, map: &BoardMap, boot: &Boot) -> Result<ImuDevice, DividerError> {
+        imu_spi::init(spi1, map.imu, boot)?;
         let mut device = Icm42688Emulator::new(Imperfections::BENCH);
+        // The emulated chip sits on the board as the board's own chip does, so the image
+        // reads it through the same mounting.
+        device.set_mounting(map.imu_mounting.orientation());
         device.set_truth([0.0; 3], [0.0, 0.0, -GRAVITY_M_S2]);
         defmt::warn!("IMU: BENCH IMAGE, emulated ICM-42688-P at rest (never fly this image)");
         Ok(device)

@@ -13,6 +13,8 @@
 // drivers that read the rest are not built.
 #![allow(dead_code)]
 
+use sweephold_firmware::imu::ImuRotation;
+
 /// A GPIO port of the pins a board map may use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Port {
@@ -158,6 +160,11 @@ pub struct BoardMap {
     pub log_tx: Pin,
     /// The IMU on SPI1.
     pub imu: ImuPins,
+    /// How the board carries its IMU chip: the rotation from the chip's axes to the
+    /// board's (x towards the board's forward arrow, y right, z down through its bottom
+    /// face), from the board's published definitions. The parameter `IMU_ROT` is the
+    /// aircraft's mounting of the board, applied after this one.
+    pub imu_mounting: ImuRotation,
     /// Status LED (GPIO output), when the board has one off the SWD pins.
     pub led: Option<Pin>,
     /// The SWD pins: never reconfigured by the image.

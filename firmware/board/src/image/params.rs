@@ -28,6 +28,7 @@ use sweephold_protocol::{
     Event, Frame, ParamName, ParamOp, ParamRefusal, ParamReply, ParamRequest,
 };
 
+use crate::boards::BOARD;
 use crate::chip::flash::{F405Flash, Registers, STORE_REGION};
 use crate::chip::usart::UsartTx;
 use crate::image::config::DEFAULT_FRAME;
@@ -64,9 +65,18 @@ impl HostParams {
         self.link.load_status()
     }
 
-    /// The typed view of the table.
+    /// The typed view of the table, its IMU mounting put after the board's own mounting
+    /// of the chip ([`BoardMap::imu_mounting`](crate::chip::pins::BoardMap)): `IMU_ROT`
+    /// is how the aircraft carries the board, as ArduPilot's `AHRS_ORIENTATION` and
+    /// Betaflight's board alignment are, while the chip's place on the board comes with
+    /// the board (its published definitions).
     pub fn params(&self) -> Result<Params, ParamsError> {
-        self.link.table().params()
+        let mut params = self.link.table().params()?;
+        params.stack.orientation = params
+            .imu_rotation
+            .orientation()
+            .after(BOARD.imu_mounting.orientation());
+        Ok(params)
     }
 
     /// Whether a valid set is in use (the pre-arm check's flag).

@@ -30,6 +30,7 @@
 //! registers are written as on the board.
 
 use crate::chip::pins::{pin, BoardMap, Crystal, ImuPins, Output, OutputTimer, Port, TimerRate};
+use sweephold_firmware::imu::ImuRotation;
 
 /// Frame rate of the swash servos (TIM2) at boot [Hz], until `SERVO_RATE` is applied.
 pub const SWASH_FRAME_HZ: u32 = 50;
@@ -97,6 +98,9 @@ pub const BOARD: BoardMap = BoardMap {
         cs: pin(Port::C, 14, 0),
         int: pin(Port::C, 15, 0),
     },
+    // The chip top face down: body = (−y, x, z), Betaflight's `GYRO_1_ALIGN
+    // CW270_DEG_FLIP` (docs/decisions/2026-11-26-imu-mounting-defaults.md).
+    imu_mounting: ImuRotation::Yaw90,
     led: None,
     swd: [pin(Port::A, 13, 0), pin(Port::A, 14, 0)],
 };

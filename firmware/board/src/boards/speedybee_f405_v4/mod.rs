@@ -40,6 +40,7 @@
 //! (its writes go nowhere), which leaves the emulated runs unchanged.
 
 use crate::chip::pins::{pin, BoardMap, Crystal, ImuPins, Output, OutputTimer, Port, TimerRate};
+use sweephold_firmware::imu::ImuRotation;
 
 /// Frame rate of the swash servos (TIM4 and TIM3) at boot [Hz], until the parameter
 /// table's `SERVO_RATE` is applied. 50 Hz is safe for every servo.
@@ -113,6 +114,10 @@ pub const BOARD: BoardMap = BoardMap {
         cs: pin(Port::A, 4, 0),
         int: pin(Port::C, 4, 0),
     },
+    // The chip top face up, turned 90° clockwise seen from above: body = (y, x, −z),
+    // Betaflight's `GYRO_1_ALIGN CW90_DEG` and ArduPilot's `ROTATION_PITCH_180_YAW_270`
+    // alike (docs/decisions/2026-11-26-imu-mounting-defaults.md).
+    imu_mounting: ImuRotation::Roll180Yaw90,
     led: Some(pin(Port::C, 13, 0)),
     swd: [pin(Port::A, 13, 0), pin(Port::A, 14, 0)],
 };
