@@ -42,7 +42,7 @@ impl Default for AnalysisOptions {
 }
 
 /// A figure with its spread over the drawn models.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Figure {
     /// On the identified model (null: not defined, e.g. no crossing in the grid).
     pub value: Option<f64>,
