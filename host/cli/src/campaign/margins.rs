@@ -28,7 +28,13 @@ impl Campaign<'_> {
         if self.args.quick {
             args.samples = QUICK_SAMPLES;
         }
-        let analysis = analyse(&args)?;
+        // Reported, not fatal (as the truth stage's modes): a model the analysis cannot
+        // take (singular at a frequency of the grid) still has its fit and report; the
+        // report then says margins.json is absent.
+        let analysis = match analyse(&args) {
+            Ok(analysis) => analysis,
+            Err(error) => return Ok(((), format!("not computed: {error:#}"))),
+        };
         write_json(&self.dir().join(files::MARGINS), &analysis.result)?;
         write_json(
             &self.dir().join(files::MARGINS_LOOPS),
@@ -73,4 +79,57 @@ fn headline(result: &control::MarginsDocument) -> String {
         "least PM {pm}, least GM {gm}; ADS-33 levels T/O {}",
         levels.join(", ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{CampaignArgs, CampaignLink, CampaignTrimBalance, TrimPointsArg};
+    use super::*;
+    use crate::artifacts::stage::Stage;
+    use crate::fly::AmplitudeArg;
+    use crate::vehicle::Vehicle;
+
+    /// The stage writes both files for a model it can take, and leaves them out with its
+    /// reason, without failing the campaign, for one it cannot.
+    #[test]
+    fn the_stage_writes_the_figures_or_says_why_not() {
+        let dir = std::env::temp_dir().join(format!("sweephold-margins-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let args = CampaignArgs {
+            vehicle: Vehicle::shipped("trex700l"),
+            out: dir.join("campaign"),
+            seed: 1,
+            quick: true,
+            trim_points: TrimPointsArg::On,
+            trim_balance: CampaignTrimBalance::Default,
+            amplitude: AmplitudeArg::Fixed,
+            fc: CampaignLink::InProcess,
+            quiet: true,
+        };
+        let mut run = Campaign::new(&args);
+        run.stage(Stage::Setup, Campaign::set_up).unwrap();
+        let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../control/tests/fixtures/trex700l-quick-seed1-model9.json");
+        std::fs::copy(model, run.dir().join(files::MODEL_9DOF)).unwrap();
+        let ((), line) = run.margins().unwrap();
+        assert!(line.contains("ADS-33 levels"), "{line}");
+        let written: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.dir().join(files::MARGINS)).unwrap())
+                .unwrap();
+        assert_eq!(written["samples"], QUICK_SAMPLES);
+        let loops: crate::margins::ExportedLoops = serde_json::from_str(
+            &std::fs::read_to_string(run.dir().join(files::MARGINS_LOOPS)).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(loops.loops.len(), 6);
+        assert!(loops.loops.iter().all(|l| l.omega.len() == PLOTTED_POINTS));
+
+        std::fs::remove_file(run.dir().join(files::MARGINS)).unwrap();
+        std::fs::write(run.dir().join(files::MODEL_9DOF), "{\"version\": 1}").unwrap();
+        let ((), line) = run.margins().unwrap();
+        assert!(line.starts_with("not computed: "), "{line}");
+        assert!(!run.dir().join(files::MARGINS).exists());
+        drop(run);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -29,7 +29,8 @@ pub fn loops_section(inputs: &ReportInputs) -> String {
             TITLE,
             &note(
                 "No margins.json in this folder (a campaign from before the margins stage, \
-or one that stopped before it): `sweephold margins model9.json` computes the figures.",
+one that stopped before it, or one whose model the analysis could not take: its margins \
+line says why): `sweephold margins model9.json` computes the figures.",
             ),
         );
     };
