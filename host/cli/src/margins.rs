@@ -12,7 +12,7 @@ use clap::Args;
 use control::analysis::{self, AnalysisOptions, Figure, MarginsDocument};
 use control::law::BoardLaw;
 use control::Plant;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use sweephold_firmware::app::AppConfig;
 use sweephold_firmware::board_stack::StackConfig;
 use sweephold_protocol::Axis;
@@ -86,15 +86,25 @@ fn positive_hz(text: &str) -> Result<f64, String> {
     }
 }
 
-/// Run `sweephold margins`.
-pub fn run(args: &MarginsArgs) -> anyhow::Result<()> {
+/// One model analysed under the board's law: what `sweephold margins` prints and writes.
+pub struct MarginsAnalysis {
+    /// The model read.
+    pub document: ModelDocument,
+    /// The vehicle whose law flies the loops.
+    pub vehicle: Vehicle,
+    /// The law (its servos still those of the preset: the analysis adds the vehicle's).
+    pub law: BoardLaw,
+    /// The vehicle's servo, added where the model has none.
+    pub vehicle_servo: Option<Actuator>,
+    /// How the analysis ran.
+    pub options: AnalysisOptions,
+    /// The figures (`margins.json`).
+    pub result: MarginsDocument,
+}
+
+/// Read the model of `args` and analyse it (no output written).
+pub fn analyse(args: &MarginsArgs) -> anyhow::Result<MarginsAnalysis> {
     check_input_file("model", &args.model)?;
-    let outputs: Vec<(&str, &std::path::Path)> =
-        [("--out", &args.out), ("--export-loops", &args.export_loops)]
-            .into_iter()
-            .filter_map(|(name, path)| path.as_deref().map(|p| (name, p)))
-            .collect();
-    refuse_inputs_as_outputs(&[args.model.as_path()], &outputs)?;
     let text = fs::read_to_string(&args.model)
         .with_context(|| format!("cannot read {}", args.model.display()))?;
     let document: ModelDocument = serde_json::from_str(&text)
@@ -129,21 +139,54 @@ pub fn run(args: &MarginsArgs) -> anyhow::Result<()> {
     if let Err(why) = &structure {
         result.notes.push(format!("no spread: {why}"));
     }
+    Ok(MarginsAnalysis {
+        document,
+        vehicle,
+        law,
+        vehicle_servo,
+        options,
+        result,
+    })
+}
+
+impl MarginsAnalysis {
+    /// The nominal model's broken loops, sensitivities and stick responses on the
+    /// analysis grid, or on `points` log-spaced frequencies of the same band.
+    pub fn sampled(&self, points: Option<usize>) -> anyhow::Result<ExportedLoops> {
+        let options = AnalysisOptions {
+            grid_points: points.unwrap_or(self.options.grid_points),
+            ..self.options
+        };
+        exported_loops(&self.document, &self.law, self.vehicle_servo, &options)
+    }
+}
+
+/// Run `sweephold margins`.
+pub fn run(args: &MarginsArgs) -> anyhow::Result<()> {
+    let outputs: Vec<(&str, &std::path::Path)> =
+        [("--out", &args.out), ("--export-loops", &args.export_loops)]
+            .into_iter()
+            .filter_map(|(name, path)| path.as_deref().map(|p| (name, p)))
+            .collect();
+    check_input_file("model", &args.model)?;
+    refuse_inputs_as_outputs(&[args.model.as_path()], &outputs)?;
+    let analysis = analyse(args)?;
     if let Some(path) = &args.export_loops {
-        write_json(
-            path,
-            &exported_loops(&document, &law, vehicle_servo, &options)?,
-        )?;
+        write_json(path, &analysis.sampled(None)?)?;
     }
     if let Some(path) = &args.out {
-        write_json(path, &result)?;
+        write_json(path, &analysis.result)?;
     }
     if args.json {
-        let mut text = serde_json::to_string_pretty(&result)?;
+        let mut text = serde_json::to_string_pretty(&analysis.result)?;
         text.push('\n');
         crate::output::print(&text)
     } else {
-        crate::output::print(&table(&result, vehicle.name(), &args.model))
+        crate::output::print(&table(
+            &analysis.result,
+            analysis.vehicle.name(),
+            &args.model,
+        ))
     }
 }
 
@@ -176,21 +219,29 @@ fn structure_of(document: &ModelDocument, vehicle: &Vehicle) -> Result<ModelStru
 }
 
 /// One sampled response of the export.
-#[derive(Serialize)]
-struct ExportedResponse {
-    name: String,
-    omega: Vec<f64>,
-    re: Vec<f64>,
-    im: Vec<f64>,
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExportedResponse {
+    /// The loop's or stick's name.
+    pub name: String,
+    /// Frequencies [rad/s].
+    pub omega: Vec<f64>,
+    /// Real parts.
+    pub re: Vec<f64>,
+    /// Imaginary parts.
+    pub im: Vec<f64>,
 }
 
-/// The nominal model's broken loops and sensitivities on the analysis grid.
-#[derive(Serialize)]
-struct ExportedLoops {
-    structure: String,
-    loops: Vec<ExportedResponse>,
-    sensitivities: Vec<ExportedResponse>,
-    sticks: Vec<ExportedResponse>,
+/// The nominal model's broken loops, sensitivities and stick responses, sampled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExportedLoops {
+    /// The model's structure name.
+    pub structure: String,
+    /// The six broken loops.
+    pub loops: Vec<ExportedResponse>,
+    /// Their sensitivities 1/(1 + L).
+    pub sensitivities: Vec<ExportedResponse>,
+    /// The five stick-to-attitude responses.
+    pub sticks: Vec<ExportedResponse>,
 }
 
 fn exported_loops(

@@ -307,6 +307,39 @@ fn quick_campaign_report_and_errors() {
     let again = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert_eq!(structure(&again), sections);
 
+    // The loops section: a Bode plot per broken loop and a chart per axis, from
+    // margins.json and margins-loops.json. A folder without them (a campaign from before
+    // the margins stage) still makes a report, whose section says they are absent.
+    assert_eq!(sections.iter().find(|(s, _)| s == "loops").unwrap().1, 9);
+    let margins: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("margins.json")).unwrap()).unwrap();
+    assert_eq!(margins["loops"].as_array().unwrap().len(), 6);
+    assert_eq!(margins["samples"], 40);
+    let older = dir.join("older");
+    std::fs::create_dir_all(&older).unwrap();
+    for file in [
+        "summary.json",
+        "frf.json",
+        "model9.json",
+        "truth-model9.json",
+        "verify.json",
+    ] {
+        std::fs::copy(out.join(file), older.join(file)).unwrap();
+    }
+    let output = sweephold(&["report", older.to_str().unwrap()]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let older_html = std::fs::read_to_string(older.join("report.html")).unwrap();
+    let older_sections = structure(&older_html);
+    assert_eq!(
+        older_sections.iter().find(|(s, _)| s == "loops").unwrap().1,
+        0
+    );
+    assert!(older_html.contains("No margins.json in this folder"));
+
     // Ctrl-C mid-way: the campaign stops at its next safe point, names the stage, keeps its
     // files with the error in DIR.failed, and leaves the previous campaign as it was.
     let report_before = std::fs::read(out.join("report.html")).unwrap();

@@ -6,7 +6,7 @@ use sysid::fit::model::Actuator;
 use sysid::fit::{Model, ModelDocument, ModelStructure};
 use sysid::random::SplitMix64;
 
-use crate::handling::{self, Bandwidth, LevelBoundary, ResponseType, TaskClass};
+use crate::handling::{self, Bandwidth, ChartBoundary, ResponseType, TaskClass};
 use crate::law::{BoardLaw, LoopMode};
 use crate::loops::{self, Configuration, LoopResponses};
 use crate::margins::{self, Margins};
@@ -14,7 +14,7 @@ use crate::plant::Plant;
 use crate::uncertainty::ParameterSampler;
 
 /// Layout version of `margins.json`.
-pub const MARGINS_DOCUMENT_VERSION: u32 = 1;
+pub const MARGINS_DOCUMENT_VERSION: u32 = 2;
 
 /// How the analysis runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,7 +42,7 @@ impl Default for AnalysisOptions {
 }
 
 /// A figure with its spread over the drawn models.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Figure {
     /// On the identified model (null: not defined, e.g. no crossing in the grid).
     pub value: Option<f64>,
@@ -102,8 +102,8 @@ pub struct HandlingFigures {
     pub level_tracking: Option<u8>,
     /// Level for all other MTEs (hover and low speed).
     pub level_other: Option<u8>,
-    /// The boundaries used (tracking, other).
-    pub boundaries: [LevelBoundary; 2],
+    /// The charts' boundaries used (tracking, other).
+    pub boundaries: [ChartBoundary; 2],
 }
 
 /// What the analysis assumed.

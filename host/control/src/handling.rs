@@ -17,11 +17,16 @@
 //! stick leaves open (the Bo-105's roll rate stick turns by 180° through 0.3–0.5 rad/s),
 //! and put the response's phase a whole turn off.
 //!
-//! The levels are the boundaries of ADS-33E-PRF's small-amplitude attitude charts for
-//! hover and low speed (section 3.3, Figures 3.3.2.1 (pitch and roll) and 3.3.5.1
-//! (yaw)), simplified here to rectangles: Level 1 when ω_BW ≥ ω₁ and τ_p ≤ τ₁, Level 2
-//! when ω_BW ≥ ω₂ and τ_p ≤ τ₂, Level 3 otherwise. The numbers and their status are in
-//! docs/method.md.
+//! The levels are read from ADS-33E-PRF's small-amplitude attitude charts for hover and
+//! low speed (paragraphs 3.3.2.1, pitch and roll, and 3.3.5.1, yaw; one chart for target
+//! acquisition and tracking, one for all other MTEs). Each chart's Level 1/2 and Level 2/3
+//! boundaries are polylines on the (ω_BW, τ_p) plane, from the τ_p = 0 axis to the
+//! chart's right edge, and each level's region is the polygon they close with that axis
+//! and edge ([`ChartBoundary`]): a point is classified by which polygon holds it, so a
+//! sloped segment is classified as drawn. The corner points used are the ones recalled in
+//! docs/method.md (no citable source of the charts' coordinates was found): their
+//! boundaries are a vertical then a horizontal segment, kept until the specification's
+//! corners replace them.
 
 use crate::loops::Sampled;
 use crate::margins::bode;
@@ -48,35 +53,70 @@ pub enum TaskClass {
     Other,
 }
 
-/// One chart's simplified boundaries.
+/// Where the charts' regions are closed on the right [rad/s]: beyond every chart's last
+/// tick (the charts end at a few rad/s; a larger bandwidth is classified as at this edge).
+pub const CHART_RIGHT_EDGE_RAD_S: f64 = 100.0;
+
+/// One chart's two boundaries, as polylines of (ω_BW [rad/s], τ_p \[s\]) corners from
+/// the τ_p = 0 axis up and right to [`CHART_RIGHT_EDGE_RAD_S`]. A level's region lies
+/// below and right of its boundary.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct LevelBoundary {
-    /// Least bandwidth for Level 1 [rad/s].
-    pub level1_bandwidth_rad_s: f64,
-    /// Largest phase delay for Level 1 \[s\].
-    pub level1_phase_delay_s: f64,
-    /// Least bandwidth for Level 2 [rad/s].
-    pub level2_bandwidth_rad_s: f64,
-    /// Largest phase delay for Level 2 \[s\].
-    pub level2_phase_delay_s: f64,
+pub struct ChartBoundary {
+    /// The task class of the chart.
+    pub task: TaskClass,
+    /// The Level 1/2 boundary.
+    pub level1: &'static [[f64; 2]],
+    /// The Level 2/3 boundary.
+    pub level2: &'static [[f64; 2]],
 }
 
-/// The boundaries used, per axis (roll, pitch, yaw) and task class (docs/method.md).
-pub const fn boundary(axis: usize, class: TaskClass) -> LevelBoundary {
-    let (w1, t1, w2, t2) = match (axis, class) {
-        (0, TaskClass::Tracking) => (2.5, 0.12, 1.5, 0.20),
-        (1, TaskClass::Tracking) => (2.0, 0.14, 1.0, 0.24),
-        (_, TaskClass::Tracking) => (3.5, 0.13, 2.0, 0.22),
-        (0, TaskClass::Other) => (2.0, 0.15, 1.0, 0.25),
-        (1, TaskClass::Other) => (1.0, 0.20, 0.5, 0.30),
-        (_, TaskClass::Other) => (2.0, 0.15, 1.0, 0.25),
+/// A boundary of a vertical segment at ω from τ_p = 0 to τ, then a horizontal one to the
+/// right edge: the shape of every chart as recalled (docs/method.md).
+macro_rules! corner {
+    ($w:expr, $t:expr) => {
+        &[[$w, 0.0], [$w, $t], [CHART_RIGHT_EDGE_RAD_S, $t]]
     };
-    LevelBoundary {
-        level1_bandwidth_rad_s: w1,
-        level1_phase_delay_s: t1,
-        level2_bandwidth_rad_s: w2,
-        level2_phase_delay_s: t2,
+}
+
+/// The boundaries of every chart, per axis (0 roll, 1 pitch, 2 yaw) and task class; the
+/// numbers and their status are in docs/method.md.
+pub const fn boundary(axis: usize, class: TaskClass) -> ChartBoundary {
+    let (level1, level2): (&'static [[f64; 2]], &'static [[f64; 2]]) = match (axis, class) {
+        (0, TaskClass::Tracking) => (corner!(2.5, 0.12), corner!(1.5, 0.20)),
+        (1, TaskClass::Tracking) => (corner!(2.0, 0.14), corner!(1.0, 0.24)),
+        (_, TaskClass::Tracking) => (corner!(3.5, 0.13), corner!(2.0, 0.22)),
+        (0, TaskClass::Other) => (corner!(2.0, 0.15), corner!(1.0, 0.25)),
+        (1, TaskClass::Other) => (corner!(1.0, 0.20), corner!(0.5, 0.30)),
+        (_, TaskClass::Other) => (corner!(2.0, 0.15), corner!(1.0, 0.25)),
+    };
+    ChartBoundary {
+        task: class,
+        level1,
+        level2,
     }
+}
+
+/// Whether (ω, τ) lies inside the region below and right of `boundary`: the polygon of
+/// its corners closed along the right edge and the τ_p = 0 axis (even-odd ray casting).
+pub fn inside_boundary(boundary: &[[f64; 2]], omega: f64, tau: f64) -> bool {
+    let (Some(first), Some(last)) = (boundary.first(), boundary.last()) else {
+        return false;
+    };
+    let mut polygon = boundary.to_vec();
+    polygon.push([last[0], 0.0]);
+    if first[1] != 0.0 {
+        polygon.push([first[0], 0.0]);
+    }
+    let mut inside = false;
+    let mut j = polygon.len() - 1;
+    for i in 0..polygon.len() {
+        let ([xi, yi], [xj, yj]) = (polygon[i], polygon[j]);
+        if (yi > tau) != (yj > tau) && omega < xi + (tau - yi) * (xj - xi) / (yj - yi) {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
 }
 
 /// Bandwidth and phase delay of one attitude response.
@@ -150,19 +190,98 @@ pub fn bandwidth(response: &Sampled, kind: ResponseType) -> Bandwidth {
     }
 }
 
-/// The level (1, 2, 3) of `figures` against `limits`; `None` without a bandwidth.
-pub fn level(figures: &Bandwidth, limits: &LevelBoundary) -> Option<u8> {
+/// The level (1, 2, 3) of `figures` on `chart`; `None` without a bandwidth.
+pub fn level(figures: &Bandwidth, chart: &ChartBoundary) -> Option<u8> {
     let bw = figures.bandwidth_rad_s?;
+    Some(chart_level(chart, bw, figures.phase_delay_s))
+}
+
+/// The level (1, 2, 3) of the point (`bandwidth`, `phase_delay`) on `chart`.
+pub fn chart_level(chart: &ChartBoundary, bandwidth: f64, phase_delay: Option<f64>) -> u8 {
     // A phase delay beyond the grid is taken as none (the attitude never lags 180°
-    // twice over inside the band), which favours the response: say so in the table.
-    let delay = figures.phase_delay_s.unwrap_or(0.0);
-    Some(
-        if bw >= limits.level1_bandwidth_rad_s && delay <= limits.level1_phase_delay_s {
-            1
-        } else if bw >= limits.level2_bandwidth_rad_s && delay <= limits.level2_phase_delay_s {
-            2
-        } else {
-            3
-        },
-    )
+    // twice over inside the band), which favours the response: say so in the table. A
+    // negative one (phase above −180° at 2ω_180) is none too: the charts start at 0.
+    let delay = phase_delay.unwrap_or(0.0).max(0.0);
+    // Just inside the right edge, so that a larger bandwidth reads as the edge does.
+    let omega = bandwidth.min(CHART_RIGHT_EDGE_RAD_S * (1.0 - 1e-9));
+    if inside_boundary(chart.level1, omega, delay) {
+        1
+    } else if inside_boundary(chart.level2, omega, delay) {
+        2
+    } else {
+        3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const AXES: [&str; 3] = ["roll", "pitch", "yaw"];
+
+    fn charts() -> Vec<(String, ChartBoundary)> {
+        let mut charts = Vec::new();
+        for (axis, name) in AXES.iter().enumerate() {
+            for class in [TaskClass::Tracking, TaskClass::Other] {
+                charts.push((format!("{name} {class:?}"), boundary(axis, class)));
+            }
+        }
+        charts
+    }
+
+    /// Points a little to either side of the middle of every drawn segment of both
+    /// boundaries: inside the Level 1 boundary is Level 1, just outside it Level 2; inside
+    /// the Level 2 boundary (and outside Level 1's) Level 2, just outside it Level 3.
+    #[test]
+    fn points_either_side_of_every_segment_fall_in_the_levels_it_separates() {
+        let step = 1e-3;
+        for (name, chart) in charts() {
+            for (boundary, inner, outer) in [(chart.level1, 1, 2), (chart.level2, 2, 3)] {
+                assert!(boundary.len() >= 2, "{name}");
+                for segment in boundary.windows(2) {
+                    let ([x0, y0], [x1, y1]) = (segment[0], segment[1]);
+                    let (mx, my) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+                    // The normal pointing right/down of the segment, going up and right:
+                    // (dy, −dx) normalised on the chart's axes scaled to similar sizes.
+                    let (dx, dy) = ((x1 - x0) / 10.0, y1 - y0);
+                    let norm = dx.hypot(dy);
+                    let (nx, ny) = (dy / norm * 10.0 * step, -dx / norm * step);
+                    let level_at = |x: f64, y: f64| chart_level(&chart, x, Some(y));
+                    assert_eq!(
+                        level_at(mx + nx, my + ny),
+                        inner,
+                        "{name}: inside the segment {segment:?}"
+                    );
+                    assert_eq!(
+                        level_at(mx - nx, my - ny),
+                        outer,
+                        "{name}: outside the segment {segment:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_level_1_region_lies_inside_the_level_2_region() {
+        for (name, chart) in charts() {
+            for [w, t] in chart.level1 {
+                // Each Level 1 corner, nudged into its own region, is inside Level 2's.
+                let (w, t) = ((w * 1.001).min(CHART_RIGHT_EDGE_RAD_S * 0.999), t * 0.999);
+                assert!(inside_boundary(chart.level2, w, t), "{name}: {w} {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn far_points_and_missing_delays_are_classified() {
+        let chart = boundary(0, TaskClass::Tracking);
+        assert_eq!(chart_level(&chart, 0.1, Some(0.01)), 3);
+        assert_eq!(chart_level(&chart, 500.0, Some(0.01)), 1);
+        assert_eq!(chart_level(&chart, 500.0, Some(0.5)), 3);
+        assert_eq!(chart_level(&chart, 10.0, None), 1);
+        assert_eq!(chart_level(&chart, 10.0, Some(-0.01)), 1);
+        let none = Bandwidth::default();
+        assert_eq!(level(&none, &chart), None);
+    }
 }

@@ -17,6 +17,11 @@ pub const MODEL_9DOF: &str = "model9.json";
 pub const TRUTH_MODEL_9DOF: &str = "truth-model9.json";
 /// Verification time histories and scores.
 pub const VERIFY: &str = "verify.json";
+/// Loop margins and handling qualities of the 9-DOF fit (`sweephold margins --out`).
+pub const MARGINS: &str = "margins.json";
+/// The 9-DOF fit's broken loops, sensitivities and stick responses, sampled for the
+/// report's plots (`sweephold margins --export-loops` on a coarser grid).
+pub const MARGINS_LOOPS: &str = "margins-loops.json";
 /// Folder of the held-out doublets.
 pub const VERIFICATION_FOLDER: &str = "verify-doublet";
 

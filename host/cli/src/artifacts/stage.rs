@@ -28,13 +28,15 @@ pub enum Stage {
     Truth,
     /// Time-domain verification on the held-out doublets.
     Verify,
+    /// Loop margins and handling qualities of the 9-DOF fit under the board's law.
+    Margins,
     /// `report.html`.
     Report,
 }
 
 impl Stage {
     /// Every stage, in the order a campaign runs them.
-    pub const ALL: [Stage; 12] = [
+    pub const ALL: [Stage; 13] = [
         Stage::Setup,
         Stage::FlyCah,
         Stage::FlyStandard,
@@ -46,6 +48,7 @@ impl Stage {
         Stage::Fit9Dof,
         Stage::Truth,
         Stage::Verify,
+        Stage::Margins,
         Stage::Report,
     ];
 
@@ -63,6 +66,7 @@ impl Stage {
             Stage::Fit9Dof => "fit_9dof",
             Stage::Truth => "truth",
             Stage::Verify => "verify",
+            Stage::Margins => "margins",
             Stage::Report => "report",
         }
     }
@@ -81,6 +85,7 @@ impl Stage {
             Stage::Fit9Dof => "9-DOF hybrid fit with reduction",
             Stage::Truth => "scoring against the simulator's truth",
             Stage::Verify => "verification on the doublets",
+            Stage::Margins => "loop margins and handling qualities of the 9-DOF fit",
             Stage::Report => "report.html",
         }
     }

@@ -13,6 +13,7 @@
 pub mod error;
 pub mod fits;
 pub mod flights;
+pub mod margins;
 pub mod progress;
 pub mod responses;
 pub mod scoring;
@@ -52,8 +53,9 @@ pub const QUICK_T_REC_S: f64 = 20.0;
 #[command(
     after_help = "Writes into DIR: fly-cah/, fly-standard/, fly-noise/ (the sweep \
 dumps and fly's summary.json per mode), verify-doublet/ (held-out doublets), frf.json, \
-model6.json, model9.json, truth-model9.json, verify.json, summary.json (layout in \
-docs/formats.md) and report.html. The campaign is built in DIR.partial and replaces DIR only \
+model6.json, model9.json, truth-model9.json, verify.json, margins.json and \
+margins-loops.json (loop margins and handling qualities of model9.json), summary.json \
+(layout in docs/formats.md) and report.html. The campaign is built in DIR.partial and replaces DIR only \
 when it completes. A failing stage, or SIGINT (Ctrl-C) or SIGTERM (the campaign stops \
 after the current stage, or within a second in a flight; a second signal quits at once, \
 removing DIR.partial), stops it with the stage's name and exit status 1: DIR keeps the previous complete campaign, and \
@@ -386,6 +388,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
     })?;
     run.stage(Stage::Truth, |run| run.score(&nine))?;
     run.stage(Stage::Verify, |run| run.verify(&nine.model, &doublets))?;
+    run.stage(Stage::Margins, Campaign::margins)?;
     run.report(sweep, frf.lateral_coherence, [standard, noise])
 }
 

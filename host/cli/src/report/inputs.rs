@@ -1,5 +1,6 @@
 //! Everything the report draws, read from the campaign folder: `summary.json`, `frf.json`,
-//! `model9.json`, `truth-model9.json`, `verify.json`, and what it draws from the dumps (the
+//! `model9.json`, `truth-model9.json`, `verify.json`, `margins.json` and
+//! `margins-loops.json`, and what it draws from the dumps (the
 //! sweep time history and the cross-control coherence curves): handed over by the
 //! campaign, or decoded from the dumps when the report is made from the folder alone.
 
@@ -17,6 +18,8 @@ use crate::artifacts::flown::{lateral_coherence, FlownRecords, ModeCoherence, LA
 use crate::artifacts::summary::CampaignSummary;
 use crate::artifacts::truth_model::TruthModelDocument;
 use crate::artifacts::verification::VerifyDocument;
+use crate::margins::ExportedLoops;
+use crate::report::margins_file::MarginsFile;
 
 /// Why the report cannot be made.
 #[derive(Debug)]
@@ -117,6 +120,10 @@ pub struct ReportInputs {
     pub truth_model: Option<TruthModelDocument>,
     /// `verify.json`.
     pub verify: Option<VerifyDocument>,
+    /// `margins.json` (absent in campaigns from before the margins stage).
+    pub margins: Option<MarginsFile>,
+    /// `margins-loops.json`.
+    pub margins_loops: Option<ExportedLoops>,
     /// The sweep time history and the cross-control coherence curves.
     pub flown: FlownRecords,
 }
@@ -198,6 +205,11 @@ impl ReportInputs {
             }
         }
         let verify = read_optional(&dir.join(files::VERIFY))?;
+        let margins: Option<MarginsFile> = read_optional(&dir.join(files::MARGINS))?;
+        if let Some(Err(why)) = margins.as_ref().map(MarginsFile::check) {
+            return Err(corrupt(&dir.join(files::MARGINS), why));
+        }
+        let margins_loops = read_optional(&dir.join(files::MARGINS_LOOPS))?;
         let flown = match flown {
             Some(flown) => flown,
             None => decode_flown(dir, &summary)?,
@@ -209,6 +221,8 @@ impl ReportInputs {
             model,
             truth_model,
             verify,
+            margins,
+            margins_loops,
             flown,
         })
     }

@@ -8,6 +8,7 @@
 pub mod curves;
 pub mod html;
 pub mod inputs;
+pub mod margins_file;
 pub mod sections;
 
 use std::path::{Path, PathBuf};
@@ -123,5 +124,6 @@ with the simulator's truth.",
     body += &sections::modes::modes_section(inputs);
     body += &sections::costs::cost_section(inputs);
     body += &sections::verification::verification_section(inputs);
+    body += &sections::loops::loops_section(inputs);
     html::page(&title, &body)
 }

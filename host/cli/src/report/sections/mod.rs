@@ -3,11 +3,13 @@
 //! [`sweep`]), cross-control coherence (Fig. 3/7, [`coherence`]), Bode plots data vs model
 //! vs truth (Fig. 10, [`bode`]), the parameter table (Table 3, [`parameters`]), the modes
 //! of the identified model beside the truth's ([`modes`]), the cost table ([`costs`]), and
-//! the verification time histories ([`verification`]).
+//! the verification time histories ([`verification`]), and the board's loops on the
+//! identified model: Bode plots with margins, the ADS-33 charts ([`loops`]).
 
 pub mod bode;
 pub mod coherence;
 pub mod costs;
+pub mod loops;
 pub mod modes;
 pub mod parameters;
 pub mod summary;
@@ -20,7 +22,13 @@ use super::inputs::ReportInputs;
 use crate::artifacts::summary::ModeSummary;
 
 /// Section ids of the plot sections, in page order (each holds at least one `<svg>`).
-pub const PLOT_SECTIONS: [&str; 4] = ["sweep-input", "cross-coherence", "bode", "verification"];
+pub const PLOT_SECTIONS: [&str; 5] = [
+    "sweep-input",
+    "cross-coherence",
+    "bode",
+    "verification",
+    "loops",
+];
 
 /// Parameters the fit issue requires within 10 % of the truth (τ_f, L_β1s, M_β1c, Z_col,
 /// N_ped and the four flapping control derivatives).

@@ -27,6 +27,8 @@ pub fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
         model: None,
         truth_model: None,
         verify: None,
+        margins: None,
+        margins_loops: None,
         flown: Default::default(),
     }
 }

@@ -1,0 +1,135 @@
+//! The margins stage: `sweephold margins` on the campaign's `model9.json` with the
+//! campaign's vehicle — `margins.json` (the figures and their spreads) and
+//! `margins-loops.json` (the nominal loops sampled for the report's Bode plots).
+
+use std::ffi::OsString;
+
+use super::{verb_args, Campaign};
+use crate::artifacts::files;
+use crate::margins::{analyse, MarginsArgs};
+use crate::output::write_json;
+
+/// Models drawn for the spreads with `--quick` (the verb's default, 200, without it).
+pub const QUICK_SAMPLES: usize = 40;
+
+/// Frequencies of the loops sampled for the report's plots: the Bode plots need a few
+/// hundred points, not the analysis grid's 2400 (the figures come from margins.json).
+pub const PLOTTED_POINTS: usize = 400;
+
+impl Campaign<'_> {
+    /// The margins stage: the figures of `model9.json` under the vehicle's board law.
+    pub(super) fn margins(&mut self) -> anyhow::Result<((), String)> {
+        let model = self.dir().join(files::MODEL_9DOF);
+        let argv: Vec<OsString> = vec![model.into()];
+        // The verb's defaults (the shipped board's law, seed 1), with the campaign's
+        // vehicle and, for a quick campaign, fewer draws.
+        let mut args: MarginsArgs = verb_args("margins", argv)?;
+        args.vehicle = Some(self.args.vehicle.clone());
+        if self.args.quick {
+            args.samples = QUICK_SAMPLES;
+        }
+        // Reported, not fatal (as the truth stage's modes): a model the analysis cannot
+        // take (singular at a frequency of the grid) still has its fit and report; the
+        // report then says margins.json is absent.
+        let analysis = match analyse(&args) {
+            Ok(analysis) => analysis,
+            Err(error) => return Ok(((), format!("not computed: {error:#}"))),
+        };
+        write_json(&self.dir().join(files::MARGINS), &analysis.result)?;
+        write_json(
+            &self.dir().join(files::MARGINS_LOOPS),
+            &analysis.sampled(Some(PLOTTED_POINTS))?,
+        )?;
+        Ok(((), headline(&analysis.result)))
+    }
+}
+
+/// The stage's progress line: the least phase and gain margins over the loops, and the
+/// ADS-33 levels (tracking/other) per stick.
+fn headline(result: &control::MarginsDocument) -> String {
+    let least = |pick: &dyn Fn(&control::analysis::LoopFigures) -> Option<f64>| {
+        result
+            .loops
+            .iter()
+            .filter_map(|l| pick(l).map(|v| (v, l.name)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    };
+    let pm = least(&|l| l.min_phase_margin_deg.value)
+        .map_or("-".to_string(), |(v, name)| format!("{v:.1} deg ({name})"));
+    let gm = least(&|l| l.gain_margin_db.value)
+        .map_or("-".to_string(), |(v, name)| format!("{v:.1} dB ({name})"));
+    let level = |l: Option<u8>| l.map_or("-".to_string(), |l| l.to_string());
+    let levels: Vec<String> = result
+        .handling
+        .iter()
+        .map(|h| {
+            format!(
+                "{} {} {}/{}",
+                h.axis,
+                match h.mode {
+                    control::law::LoopMode::Rate => "rate",
+                    control::law::LoopMode::Level => "level",
+                },
+                level(h.level_tracking),
+                level(h.level_other)
+            )
+        })
+        .collect();
+    format!(
+        "least PM {pm}, least GM {gm}; ADS-33 levels T/O {}",
+        levels.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{CampaignArgs, CampaignLink, CampaignTrimBalance, TrimPointsArg};
+    use super::*;
+    use crate::artifacts::stage::Stage;
+    use crate::fly::AmplitudeArg;
+    use crate::vehicle::Vehicle;
+
+    /// The stage writes both files for a model it can take, and leaves them out with its
+    /// reason, without failing the campaign, for one it cannot.
+    #[test]
+    fn the_stage_writes_the_figures_or_says_why_not() {
+        let dir = std::env::temp_dir().join(format!("sweephold-margins-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let args = CampaignArgs {
+            vehicle: Vehicle::shipped("trex700l"),
+            out: dir.join("campaign"),
+            seed: 1,
+            quick: true,
+            trim_points: TrimPointsArg::On,
+            trim_balance: CampaignTrimBalance::Default,
+            amplitude: AmplitudeArg::Fixed,
+            fc: CampaignLink::InProcess,
+            quiet: true,
+        };
+        let mut run = Campaign::new(&args);
+        run.stage(Stage::Setup, Campaign::set_up).unwrap();
+        let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../control/tests/fixtures/trex700l-quick-seed1-model9.json");
+        std::fs::copy(model, run.dir().join(files::MODEL_9DOF)).unwrap();
+        let ((), line) = run.margins().unwrap();
+        assert!(line.contains("ADS-33 levels"), "{line}");
+        let written: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.dir().join(files::MARGINS)).unwrap())
+                .unwrap();
+        assert_eq!(written["samples"], QUICK_SAMPLES);
+        let loops: crate::margins::ExportedLoops = serde_json::from_str(
+            &std::fs::read_to_string(run.dir().join(files::MARGINS_LOOPS)).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(loops.loops.len(), 6);
+        assert!(loops.loops.iter().all(|l| l.omega.len() == PLOTTED_POINTS));
+
+        std::fs::remove_file(run.dir().join(files::MARGINS)).unwrap();
+        std::fs::write(run.dir().join(files::MODEL_9DOF), "{\"version\": 1}").unwrap();
+        let ((), line) = run.margins().unwrap();
+        assert!(line.starts_with("not computed: "), "{line}");
+        assert!(!run.dir().join(files::MARGINS).exists());
+        drop(run);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

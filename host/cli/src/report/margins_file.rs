@@ -1,0 +1,116 @@
+//! What the report reads of the campaign's `margins.json` and `margins-loops.json`
+//! (docs/formats.md): the loops' and sticks' figures, the charts' boundaries, and the
+//! nominal loops sampled for the Bode plots.
+//!
+//! Read through these narrow types rather than `control::MarginsDocument`, whose names
+//! are `&'static str` constants of the analysis and cannot be read back.
+
+use control::analysis::{Figure, MARGINS_DOCUMENT_VERSION};
+use serde::Deserialize;
+
+/// One loop broken at its actuator input.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct LoopRow {
+    /// `roll_rate`, …, `heading`.
+    pub name: String,
+    /// `lat`, `lon`, `ped`.
+    pub broken_at: String,
+    /// `rate` or `level`.
+    pub mode: String,
+    /// The highest gain crossover [rad/s].
+    pub crossover_rad_s: Figure,
+    /// Its phase margin \[deg\].
+    pub phase_margin_deg: Figure,
+    /// The least phase margin over the crossovers \[deg\].
+    pub min_phase_margin_deg: Figure,
+    /// Gain margin \[dB\].
+    pub gain_margin_db: Figure,
+    /// Its phase crossover [rad/s].
+    pub phase_crossover_rad_s: Figure,
+    /// Disturbance-rejection bandwidth [rad/s].
+    pub drb_rad_s: Figure,
+    /// Every gain crossover: [ω_c, PM].
+    pub all_crossovers: Vec<[f64; 2]>,
+}
+
+/// One chart's boundaries.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct ChartRow {
+    /// `tracking` or `other`.
+    pub task: String,
+    /// Level 1/2 boundary corners [ω, τ_p].
+    pub level1: Vec<[f64; 2]>,
+    /// Level 2/3 boundary corners.
+    pub level2: Vec<[f64; 2]>,
+}
+
+/// ADS-33 figures of one stick.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct HandlingRow {
+    /// `roll`, `pitch`, `yaw`.
+    pub axis: String,
+    /// `rate` or `level`.
+    pub mode: String,
+    /// ω_BW [rad/s].
+    pub bandwidth_rad_s: Figure,
+    /// τ_p \[s\].
+    pub phase_delay_s: Figure,
+    /// Level, target acquisition and tracking.
+    pub level_tracking: Option<u8>,
+    /// Level, all other MTEs.
+    pub level_other: Option<u8>,
+    /// The two charts (tracking, other).
+    pub boundaries: Vec<ChartRow>,
+}
+
+/// The law the figures assume.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct LawRow {
+    /// Control tick \[s\].
+    pub tick_s: f64,
+    /// Whether the IMU filter bank is in the loop.
+    pub filter_bank: bool,
+    /// Computation delay \[s\].
+    pub compute_delay_s: f64,
+    /// Servo frame rate \[Hz\].
+    pub servo_frame_hz: Option<f64>,
+}
+
+/// `margins.json`, the parts the report shows.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct MarginsFile {
+    /// Layout version: [`MARGINS_DOCUMENT_VERSION`] is read.
+    pub version: u32,
+    /// The model's structure.
+    pub structure: String,
+    /// The law.
+    pub law: LawRow,
+    /// Draws for the spreads.
+    pub samples: usize,
+    /// Their seed.
+    pub seed: u64,
+    /// Free parameters drawn.
+    pub drawn_parameters: usize,
+    /// Draws left out.
+    pub failed_draws: usize,
+    /// Why there is no spread.
+    pub notes: Vec<String>,
+    /// The six loops.
+    pub loops: Vec<LoopRow>,
+    /// The five sticks.
+    pub handling: Vec<HandlingRow>,
+}
+
+impl MarginsFile {
+    /// Why the file cannot be shown, when its layout is not the one read here.
+    pub fn check(&self) -> Result<(), String> {
+        if self.version == MARGINS_DOCUMENT_VERSION {
+            Ok(())
+        } else {
+            Err(format!(
+                "layout version {} (this report reads {MARGINS_DOCUMENT_VERSION})",
+                self.version
+            ))
+        }
+    }
+}
