@@ -301,6 +301,35 @@ fn scalars(plant: &Plant, law: &BoardLaw, grid: &[f64]) -> Result<Scalars, Strin
     })
 }
 
+/// `work` applied to every item, on up to as many threads as the machine has cores, the
+/// results in the items' order.
+fn in_parallel<T: Send, R: Send>(items: Vec<T>, work: impl Fn(T) -> R + Sync) -> Vec<R> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if threads < 2 || items.len() < 2 {
+        return items.into_iter().map(work).collect();
+    }
+    let chunk = items.len().div_ceil(threads);
+    let mut chunks: Vec<Vec<T>> = Vec::new();
+    let mut items = items.into_iter().peekable();
+    while items.peek().is_some() {
+        chunks.push(items.by_ref().take(chunk).collect());
+    }
+    let work = &work;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = chunks
+            .into_iter()
+            .map(|chunk| scope.spawn(move || chunk.into_iter().map(work).collect::<Vec<R>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|handle| match handle.join() {
+                Ok(results) => results,
+                Err(panic) => std::panic::resume_unwind(panic),
+            })
+            .collect()
+    })
+}
+
 /// The analysis grid of `law` under `options`.
 pub fn grid(law: &BoardLaw, options: &AnalysisOptions) -> Vec<f64> {
     let nyquist = std::f64::consts::PI / law.tick_s;
@@ -332,12 +361,19 @@ pub fn analyse(
         Some(Err(why)) => notes.push(format!("no spread: {why}")),
         Some(Ok(sampler)) if options.samples > 0 => {
             drawn_parameters = sampler.free_count();
+            // The models are drawn in sequence from one generator, then analysed on every
+            // core, each draw's figures kept in its place: the same seed gives the same
+            // figures whatever the number of cores.
             let mut random = SplitMix64::new(options.seed);
-            for _ in 0..options.samples {
-                let figures = sampler
-                    .draw(&mut random)
+            let models: Vec<_> = (0..options.samples)
+                .map(|_| sampler.draw(&mut random))
+                .collect();
+            let analysed = in_parallel(models, |drawn| {
+                drawn
                     .and_then(Plant::new)
-                    .and_then(|plant| scalars(&plant, &law, &grid));
+                    .and_then(|plant| scalars(&plant, &law, &grid))
+            });
+            for figures in analysed {
                 match figures {
                     Ok(figures) => draws.push(figures),
                     Err(_) => failed += 1,
