@@ -9,6 +9,7 @@ pub mod link_qemu;
 pub mod link_serial;
 pub mod plan;
 pub mod record;
+pub mod servo_plant;
 pub mod summary;
 
 use std::collections::BTreeMap;
@@ -594,6 +595,8 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
         vibration: args.vibration != Some(VibrationArg::None),
         rc_loss_at_s: args.rc_loss_at_s,
         imu_fault: args.imu_fault,
+        swash: args.vehicle.aircraft().swash,
+        setup: link_board_sim::BoardSetup::FromAircraft,
     })
 }
 
