@@ -2,12 +2,15 @@
 """The identification bars of a vehicle's default campaign over a range of seeds.
 
     cargo build --release -p sweephold
-    python3 docs/bars.py [--vehicle NAME|FILE] [--seeds 1-10] [--out DIR] [--reuse] [-- CAMPAIGN ARGS]
+    python3 docs/bars.py [--vehicle NAME|FILE] [--seeds 1-10] [--out DIR] [--reuse] [--excursions] [-- CAMPAIGN ARGS]
 
 Flies `sweephold campaign --vehicle V --seed N --out DIR/V-N` for each seed (unless
 --reuse finds a completed campaign there) and prints one Markdown row per seed and a count
 row, read from each campaign's summary.json and model6.json. Arguments after `--` are passed
-to every campaign (e.g. `-- --trim-balance joint`).
+to every campaign (e.g. `-- --trim-balance joint`, or `-- --fc board-sim:FLASH` for a
+board booted from a saved parameter set). `--excursions` adds a second table: per seed the
+records that aborted (and why) and the largest |φ|, |θ| from trim over the records, from each
+fly stage's `fly-*/summary.json` (`aborted`, `abort_reason`, `max_from_trim_deg`).
 
 - key: the nine key parameters (tau_f Lb1s Mb1c Zcol Nped Mf_lat Mf_lon Lf_lat Lf_lon)
   within 10 % of the truth;
@@ -107,12 +110,31 @@ def row(seed, summary, six):
     return "| " + " | ".join(cells) + " |", passes
 
 
+def excursions(folder):
+    """(aborted records with reasons, records, max |phi| and |theta| from trim) of a campaign."""
+    aborted, records, phi, theta = [], 0, 0.0, 0.0
+    for stage in sorted(os.listdir(folder)) if os.path.isdir(folder) else []:
+        path = os.path.join(folder, stage, "summary.json")
+        if not (stage.startswith("fly-") and os.path.isfile(path)):
+            continue
+        with open(path) as f:
+            for run in json.load(f).get("runs", []):
+                records += 1
+                if run.get("aborted"):
+                    aborted.append(f"{stage}/{run['file']} {run.get('abort_reason')}")
+                trim = run.get("max_from_trim_deg") or {}
+                phi = max(phi, trim.get("phi") or 0.0)
+                theta = max(theta, trim.get("theta") or 0.0)
+    return aborted, records, phi, theta
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--vehicle", default="bo105", help="a shipped aircraft (bo105, trex700l, fbl700) or an aircraft file")
     parser.add_argument("--seeds", default="1-10", help="e.g. 1-10")
     parser.add_argument("--out", default="out/bars")
     parser.add_argument("--reuse", action="store_true", help="keep completed campaigns in OUT")
+    parser.add_argument("--excursions", action="store_true", help="also print aborts and max |phi|, |theta| from trim per seed")
     parser.add_argument("extra", nargs="*", help="after --: arguments for every campaign")
     args = parser.parse_args()
     if not os.path.isfile(BINARY):
@@ -121,9 +143,11 @@ def main():
     print(f"{args.vehicle}, {setup}, seeds {args.seeds}\n")
     print("| seed | key ≤10 % | hover ≤25 %, origin poles | speed derivatives vs truth | worst rate-pair J vs truth | truth J_ave | TIC p, q, r | 6-DOF confirmed | flagged free | s |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    counts, n = {}, 0
+    counts, n, folders = {}, 0, []
     for seed in seeds(args.seeds):
-        summary, six = campaign(args.vehicle, seed, os.path.join(args.out, f"{os.path.splitext(os.path.basename(args.vehicle))[0]}-{seed}"), args.reuse, args.extra)
+        folder = os.path.join(args.out, f"{os.path.splitext(os.path.basename(args.vehicle))[0]}-{seed}")
+        folders.append((seed, folder))
+        summary, six = campaign(args.vehicle, seed, folder, args.reuse, args.extra)
         if summary is None:
             print(f"| {seed} | no summary.json |")
             continue
@@ -133,6 +157,12 @@ def main():
         for name, ok in (passes or {}).items():
             counts[name] = counts.get(name, 0) + bool(ok)
     print("\nseeds meeting each bar, of", n, ": " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if args.excursions:
+        print("\n| seed | records | aborted | max |φ| / |θ| from trim |")
+        print("|---|---|---|---|")
+        for seed, folder in folders:
+            aborted, records, phi, theta = excursions(folder)
+            print(f"| {seed} | {records} | {'; '.join(aborted) or 'none'} | {phi:.1f} / {theta:.1f}° |")
 
 
 if __name__ == "__main__":

@@ -35,8 +35,10 @@ pub const MAX_NAME_LEN: usize = 16;
 
 /// The version of the table's layout, stored with every record: a record of another
 /// version is not loaded (its values could mean other things). Version 2 appended
-/// `FRAME`: a version-1 record holds no base preset and boots the defaults.
-pub const TABLE_VERSION: u16 = 2;
+/// `FRAME`, version 3 the excitation scales, slew limits and the holds' reference,
+/// integrator limits, time constants and directions: a record of an older version holds
+/// no base preset or none of those and boots the defaults.
+pub const TABLE_VERSION: u16 = 3;
 
 /// Swash type codes: H1, 120°, 135°, 140°.
 const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
@@ -184,6 +186,27 @@ params! {
     TestSeed = "TEST_SEED", "", 0.0, 16_777_215.0, Integer, "Noise seed (up to 2^24 - 1, exact in the f32 value).";
     TestFreeze = "TEST_FREEZE", "", 0.0, 1.0, Integer, "1: freeze the excitation while the hold is engaged in band.";
     Frame = "FRAME", "", 0.0, 1.0, OneOf(FRAMES), "Base preset for everything the table does not hold: 0 TREX 700L, 1 Bo-105 (simulator).";
+    ExcScaleLat = "EXC_SCALE_LAT", "", 0.001, 1.0, Real, "Excitation scale of lat: fraction of the test's amplitude and noise.";
+    ExcScaleLon = "EXC_SCALE_LON", "", 0.001, 1.0, Real, "Excitation scale of lon: fraction of the test's amplitude and noise.";
+    ExcScalePed = "EXC_SCALE_PED", "", 0.001, 1.0, Real, "Excitation scale of ped: fraction of the test's amplitude and noise.";
+    ExcScaleCol = "EXC_SCALE_COL", "", 0.001, 1.0, Real, "Excitation scale of col: fraction of the test's amplitude and noise.";
+    SlewLat = "SLEW_LAT", "1/s", 0.0, 1000.0, Real, "Excitation phases' lat command slew limit (stick per s); 0: none.";
+    SlewLon = "SLEW_LON", "1/s", 0.0, 1000.0, Real, "Excitation phases' lon command slew limit (stick per s); 0: none.";
+    SlewPed = "SLEW_PED", "1/s", 0.0, 1000.0, Real, "Excitation phases' ped command slew limit (stick per s); 0: none.";
+    SlewCol = "SLEW_COL", "1/s", 0.0, 1000.0, Real, "Excitation phases' col command slew limit (stick per s); 0: none.";
+    HoldRef = "HOLD_REF", "", 0.0, 1.0, Integer, "Hold thresholds on roll and pitch from: 0 level, 1 the captured trim.";
+    HoldLatIlim = "HOLD_LAT_ILIM", "", 0.0, 1.0, Real, "Attitude hold, roll: integrator limit, fraction of stick.";
+    HoldLatBump = "HOLD_LAT_TBUMP", "s", 0.0, 10.0, Real, "Attitude hold, roll: bumpless hand-over time constant.";
+    HoldLatFade = "HOLD_LAT_TFADE", "s", 0.0, 10.0, Real, "Attitude hold, roll: output fade time constant after a release.";
+    HoldLatRev = "HOLD_LAT_REV", "", 0.0, 1.0, Integer, "Attitude hold, roll: 1 if a positive command gives a negative moment.";
+    HoldLonIlim = "HOLD_LON_ILIM", "", 0.0, 1.0, Real, "Attitude hold, pitch: integrator limit, fraction of stick.";
+    HoldLonBump = "HOLD_LON_TBUMP", "s", 0.0, 10.0, Real, "Attitude hold, pitch: bumpless hand-over time constant.";
+    HoldLonFade = "HOLD_LON_TFADE", "s", 0.0, 10.0, Real, "Attitude hold, pitch: output fade time constant after a release.";
+    HoldLonRev = "HOLD_LON_REV", "", 0.0, 1.0, Integer, "Attitude hold, pitch: 1 if a positive command gives a negative moment.";
+    HoldPedIlim = "HOLD_PED_ILIM", "", 0.0, 1.0, Real, "Heading hold: integrator limit, fraction of stick.";
+    HoldPedBump = "HOLD_PED_TBUMP", "s", 0.0, 10.0, Real, "Heading hold: bumpless hand-over time constant.";
+    HoldPedFade = "HOLD_PED_TFADE", "s", 0.0, 10.0, Real, "Heading hold: output fade time constant after a release.";
+    HoldPedRev = "HOLD_PED_REV", "", 0.0, 1.0, Integer, "Heading hold: 1 if a positive command gives a negative moment.";
 }
 
 /// The vehicle whose preset a `FRAME` value names (ArduPilot's `FRAME_CLASS` idea: one

@@ -12,7 +12,7 @@ use sweephold_protocol::{Axis, ExcitationMode, InputKind, VehicleId};
 use super::table::{frame_code, frame_vehicle, ParamId, COUNT};
 use crate::app::{AppConfig, AppConfigError};
 use crate::board_stack::StackConfig;
-use crate::config::ConfigError;
+use crate::config::{ConfigError, HoldReference};
 use crate::filters::{FilterBank, FilterBankConfig, FilterError};
 use crate::imu::ImuRotation;
 use crate::mixer::ServoConfig;
@@ -51,6 +51,45 @@ const TAIL_SERVO_IDS: [ParamId; 5] = [
     ParamId::TailMin,
     ParamId::TailMax,
     ParamId::TailThrow,
+];
+
+/// Each held axis' (lat, lon, ped) integrator limit, bumpless and fade time constants and
+/// direction.
+const HOLD_MORE_IDS: [[ParamId; 4]; 3] = [
+    [
+        ParamId::HoldLatIlim,
+        ParamId::HoldLatBump,
+        ParamId::HoldLatFade,
+        ParamId::HoldLatRev,
+    ],
+    [
+        ParamId::HoldLonIlim,
+        ParamId::HoldLonBump,
+        ParamId::HoldLonFade,
+        ParamId::HoldLonRev,
+    ],
+    [
+        ParamId::HoldPedIlim,
+        ParamId::HoldPedBump,
+        ParamId::HoldPedFade,
+        ParamId::HoldPedRev,
+    ],
+];
+
+/// The excitation scale of lat, lon, ped, col.
+const EXC_SCALE_IDS: [ParamId; 4] = [
+    ParamId::ExcScaleLat,
+    ParamId::ExcScaleLon,
+    ParamId::ExcScalePed,
+    ParamId::ExcScaleCol,
+];
+
+/// The excitation phases' command slew limits of lat, lon, ped, col.
+const SLEW_IDS: [ParamId; 4] = [
+    ParamId::SlewLat,
+    ParamId::SlewLon,
+    ParamId::SlewPed,
+    ParamId::SlewCol,
 ];
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
@@ -240,14 +279,30 @@ impl Params {
                 ],
             ),
         ];
-        for (axis, [p, i, d, limit]) in gains {
+        for ((axis, [p, i, d, limit]), [ilim, bump, fade, rev]) in
+            gains.into_iter().zip(HOLD_MORE_IDS)
+        {
             axis.kp = v(p);
             axis.ki = v(i);
             axis.kd = v(d);
             axis.output_limit = v(limit);
-            // The integrator may not exceed the output limit (AxisGains::is_valid).
-            axis.integrator_limit = axis.integrator_limit.min(axis.output_limit);
+            // Not above the output limit: the flight configuration's check refuses that.
+            axis.integrator_limit = v(ilim);
+            axis.bumpless_time_s = v(bump);
+            axis.release_time_s = v(fade);
+            axis.reversed = v(rev) != 0.0;
         }
+        flight.hold_reference = if v(ParamId::HoldRef) == 0.0 {
+            HoldReference::Level
+        } else {
+            HoldReference::Trim
+        };
+        flight.excitation_scale.per_axis = EXC_SCALE_IDS.map(v);
+        // 0 stands for no limit (an infinite value cannot be a parameter).
+        flight.slew.per_s = SLEW_IDS.map(|id| match v(id) {
+            0.0 => f32::INFINITY,
+            rate => rate,
+        });
         let test = &mut flight.test;
         test.hold_engage_rad = v(ParamId::HoldEngage) * DEG;
         test.hold_release_rad = v(ParamId::HoldRelease) * DEG;
@@ -425,11 +480,32 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
             ],
         ),
     ];
-    for (axis, [p, i, d, limit]) in gains {
+    for ((axis, [p, i, d, limit]), [ilim, bump, fade, rev]) in gains.into_iter().zip(HOLD_MORE_IDS)
+    {
         put(p, axis.kp);
         put(i, axis.ki);
         put(d, axis.kd);
         put(limit, axis.output_limit);
+        put(ilim, axis.integrator_limit);
+        put(bump, axis.bumpless_time_s);
+        put(fade, axis.release_time_s);
+        put(rev, if axis.reversed { 1.0 } else { 0.0 });
+    }
+    put(
+        ParamId::HoldRef,
+        match flight.hold_reference {
+            HoldReference::Level => 0.0,
+            HoldReference::Trim => 1.0,
+        },
+    );
+    for (id, scale) in EXC_SCALE_IDS
+        .into_iter()
+        .zip(flight.excitation_scale.per_axis)
+    {
+        put(id, scale);
+    }
+    for (id, rate) in SLEW_IDS.into_iter().zip(flight.slew.per_s) {
+        put(id, if rate.is_finite() { rate } else { 0.0 });
     }
     let test = &flight.test;
     put(ParamId::HoldEngage, test.hold_engage_rad / DEG);

@@ -257,6 +257,10 @@ pub(crate) fn aircraft(
         )?,
     };
 
+    let swash = match &file.swash {
+        Some(table) => crate::swash::read(&r, table)?,
+        None => crate::Swash::default(),
+    };
     let flight_controller = flight_controller::read(&r, &file.flight_controller)?;
     let identification = identification(&r, &file.identification)?;
 
@@ -272,6 +276,7 @@ pub(crate) fn aircraft(
         tailplane: r.surface(&file.tailplane, "tailplane")?,
         controls,
         servos,
+        swash,
         flight_controller,
         identification,
     })

@@ -16,9 +16,10 @@ use crate::schema::{self, Value, Values};
 use crate::AircraftError;
 
 /// The firmware presets a flight controller can fly: an aircraft names the one its
-/// controller's settings default to. A board image is built with one preset and takes no
-/// parameters yet: the command line flies a file's own settings in-process and on the
-/// simulated board, and its links to a real or emulated board refuse them.
+/// controller's settings default to. A board image is built with one preset: the command
+/// line flies a file's own settings in-process and on the simulated board (`fc params push`
+/// sets them on a board that takes parameters), and `fly` over its links to a board image
+/// refuses them.
 pub const FIRMWARE_PRESETS: [&str; 2] = ["bo105", "trex700l"];
 
 /// What the flight controller flies. Each `Option` is `None` when the file leaves the

@@ -22,11 +22,13 @@ mod flight_controller;
 pub mod quantity;
 mod reader;
 mod schema;
+mod swash;
 
 use std::path::{Path, PathBuf};
 
 pub use flight_controller::{FlightController, HoldGains, HoldReference, FIRMWARE_PRESETS};
 pub use quantity::{Dimension, Quantity};
+pub use swash::{ServoOutput, Swash, SwashKind};
 
 /// A helicopter as its aircraft file describes it. Values in SI units, body axes x
 /// forward, y right, z down, positions from the centre of gravity (CG).
@@ -54,6 +56,8 @@ pub struct Aircraft {
     pub controls: Controls,
     /// The swashplate and tail servos.
     pub servos: Servos,
+    /// The servo geometry (`[swash]`; the presets' 120° plate when the file has none).
+    pub swash: Swash,
     /// What the flight controller flies.
     pub flight_controller: FlightController,
     /// How the campaign identifies it.

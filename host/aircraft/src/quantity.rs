@@ -57,6 +57,10 @@ pub enum Dimension {
     Time,
     /// 1/s (a rate of a dimensionless quantity, e.g. stick fraction per second).
     PerTime,
+    /// A servo pulse width, kept in µs (the servo world's unit, exact for whole µs).
+    PulseWidth,
+    /// Hz (a frame rate).
+    Frequency,
     /// A bare number.
     Dimensionless,
 }
@@ -81,6 +85,8 @@ impl Dimension {
             Dimension::TimePerAngle => &[("s/rad", Si)],
             Dimension::Time => &[("s", Si), ("ms", Per(1e3))],
             Dimension::PerTime => &[("/s", Si), ("1/s", Si)],
+            Dimension::PulseWidth => &[("us", Si), ("µs", Si)],
+            Dimension::Frequency => &[("Hz", Si)],
             Dimension::Dimensionless => &[],
         }
     }

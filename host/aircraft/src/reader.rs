@@ -62,6 +62,8 @@ fn si_unit(dimension: Dimension) -> &'static str {
         Dimension::TimePerAngle => "s/rad",
         Dimension::Time => "s",
         Dimension::PerTime => "/s",
+        Dimension::PulseWidth => "us",
+        Dimension::Frequency => "Hz",
         Dimension::Dimensionless => "",
     }
 }

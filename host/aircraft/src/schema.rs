@@ -44,6 +44,7 @@ pub(crate) struct File {
     pub tailplane: Surface,
     pub controls: Controls,
     pub servos: Servos,
+    pub swash: Option<Swash>,
     pub flight_controller: FlightController,
     pub identification: Identification,
 }
@@ -187,4 +188,29 @@ pub(crate) struct Servos {
     pub damping: Value,
     pub rate_limit: Value,
     pub transport_delay: Value,
+}
+
+/// The `[swash]` table: the servo geometry the aircraft is built with.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Swash {
+    #[serde(rename = "type")]
+    pub kind: Value,
+    pub phase: Option<Value>,
+    pub lead: Option<Value>,
+    pub servos: Option<Spanned<Vec<ServoOutput>>>,
+    pub tail: Option<ServoOutput>,
+    pub frame_rate: Option<Value>,
+    pub tail_frame_rate: Option<Value>,
+}
+
+/// One servo output of the `[swash]` table.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ServoOutput {
+    pub reversed: Option<bool>,
+    pub centre: Option<Value>,
+    pub throw: Option<Value>,
+    pub min: Option<Value>,
+    pub max: Option<Value>,
 }

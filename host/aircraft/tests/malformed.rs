@@ -455,3 +455,182 @@ fn flight_controller_settings_read_in_si_and_default_to_none() {
     assert!(!shipped.states_settings());
     assert_eq!(shipped.preset, "trex700l");
 }
+
+const FBL700: &str = aircraft::SHIPPED[2].1;
+
+/// (what is wrong, text of the FBL700 file's `[swash]` table replaced, replacement,
+/// fragment the message must hold)
+const SWASH_CASES: &[(&str, &str, &str, &str)] = &[
+    (
+        "unknown plate angle",
+        "type = 140",
+        "type = 130",
+        "swash.type: `130`: expected 120, 135, 140 or \"H1\"",
+    ),
+    (
+        "plate type misspelt",
+        "type = 140",
+        "type = \"h1\"",
+        "swash.type: `\"h1\"`: expected 120, 135, 140 or \"H1\"",
+    ),
+    (
+        "phase beyond 180 deg",
+        "phase = \"0 deg\"",
+        "phase = \"190 deg\"",
+        "swash.phase: 3.316",
+    ),
+    (
+        "phase without unit",
+        "phase = \"0 deg\"",
+        "phase = 0",
+        "swash.phase: `0` has no unit",
+    ),
+    (
+        "lead servo 4",
+        "lead = 1",
+        "lead = 4",
+        "swash.lead: 4 must be between 1 and 3",
+    ),
+    (
+        "lead servo not whole",
+        "lead = 1",
+        "lead = 1.5",
+        "swash.lead: 1.5 is not a whole number",
+    ),
+    (
+        "two swash servos",
+        "  { centre = \"1520 us\", throw = \"400 us\", min = \"1100 us\", max = \"1940 us\" },\n]",
+        "]",
+        "swash.servos: expected 3 servos (outputs 1, 2, 3), found 2",
+    ),
+    (
+        "centre in ms",
+        "tail = { centre = \"760 us\"",
+        "tail = { centre = \"0.76 ms\"",
+        "swash.tail.centre: `0.76 ms`: unit `ms` is not one of us, µs",
+    ),
+    (
+        "centre beyond the pulse range",
+        "tail = { centre = \"760 us\"",
+        "tail = { centre = \"3000 us\"",
+        "swash.tail.centre: 3000 must be between 500 and 2500 us",
+    ),
+    (
+        "centre not a whole µs",
+        "tail = { centre = \"760 us\"",
+        "tail = { centre = \"760.5 us\"",
+        "swash.tail.centre: 760.5 is not a whole number",
+    ),
+    (
+        "zero throw",
+        "tail = { centre = \"760 us\", throw = \"200 us\"",
+        "tail = { centre = \"760 us\", throw = \"0 us\"",
+        "swash.tail.throw: 0 must be positive and at most 1000 us",
+    ),
+    (
+        "760 us tail with the standard limits",
+        ", min = \"550 us\", max = \"970 us\" }",
+        " }",
+        "swash.tail: min 1100 µs, centre 760 µs, max 1940 µs: the limits must surround",
+    ),
+    (
+        "limits reversed",
+        "min = \"550 us\", max = \"970 us\"",
+        "min = \"970 us\", max = \"550 us\"",
+        "swash.tail: min 970 µs, centre 760 µs, max 550 µs",
+    ),
+    (
+        "frame rate above 333 Hz",
+        "frame_rate = \"333 Hz\"\ntail",
+        "frame_rate = \"400 Hz\"\ntail",
+        "swash.frame_rate: 400 must be between 50 and 333 Hz",
+    ),
+    (
+        "frame rate with an uncertainty",
+        "tail_frame_rate = \"333 Hz\"",
+        "tail_frame_rate = \"333 ± 1 Hz\"",
+        "swash.tail_frame_rate: the servo geometry is set, not measured",
+    ),
+    (
+        "direction as a number",
+        "{ reversed = true,",
+        "{ reversed = -1,",
+        "invalid type: integer `-1`, expected a boolean",
+    ),
+    (
+        "unknown servo key",
+        "{ reversed = true,",
+        "{ reverse = true,",
+        "unknown field `reverse`",
+    ),
+];
+
+#[test]
+fn every_malformed_swash_table_is_refused_on_one_line() {
+    for (what, old, new, expected) in SWASH_CASES {
+        assert!(FBL700.contains(old), "{what}: `{old}` not in fbl700.toml");
+        let text = FBL700.replacen(old, new, 1);
+        let error = aircraft::parse(&text, "variant.toml")
+            .err()
+            .unwrap_or_else(|| panic!("{what}: accepted"))
+            .to_string();
+        assert!(
+            error.contains(expected),
+            "{what}: `{error}` lacks `{expected}`"
+        );
+        assert!(!error.contains('\n'), "{what}: more than one line: {error}");
+        assert!(error.starts_with("variant.toml:"), "{what}: {error}");
+    }
+}
+
+#[test]
+fn the_swash_table_reads_and_defaults_to_the_presets_geometry() {
+    let fbl = aircraft::shipped("fbl700").unwrap().swash;
+    assert_eq!(fbl.kind, aircraft::SwashKind::H3_140);
+    assert_eq!(fbl.kind.code(), 140);
+    assert_eq!((fbl.phase, fbl.lead), (0.0, 1));
+    let reversed: Vec<bool> = fbl.servos.iter().map(|s| s.reversed).collect();
+    assert_eq!(reversed, [false, true, false]);
+    assert_eq!(
+        fbl.tail,
+        aircraft::ServoOutput {
+            reversed: false,
+            centre_us: 760.0,
+            throw_us: 200.0,
+            min_us: 550.0,
+            max_us: 970.0
+        }
+    );
+    assert_eq!(
+        (fbl.frame_rate, fbl.tail_frame_rate),
+        (Some(333.0), Some(333.0))
+    );
+    for name in ["bo105", "trex700l"] {
+        let swash = aircraft::shipped(name).unwrap().swash;
+        assert_eq!(swash, aircraft::Swash::default(), "{name}");
+    }
+    let default = aircraft::Swash::default();
+    assert_eq!(default.kind, aircraft::SwashKind::H3_120);
+    assert_eq!(default.servos, [aircraft::ServoOutput::STANDARD; 3]);
+    // A servo left partly unstated takes the standard servo's other fields; H1 and a
+    // phase angle read.
+    let text = FBL700
+        .replacen("type = 140", "type = \"H1\"", 1)
+        .replacen("phase = \"0 deg\"", "phase = \"-30 deg\"", 1)
+        .replacen(
+            "{ reversed = true, centre = \"1520 us\", throw = \"400 us\", min = \"1100 us\", max = \"1940 us\" }",
+            "{ reversed = true, centre = \"1500 µs\" }",
+            1,
+        );
+    let read = aircraft::parse(&text, "variant.toml").unwrap().swash;
+    assert_eq!(read.kind, aircraft::SwashKind::H1);
+    assert_eq!(read.phase, -30.0 * (std::f64::consts::PI / 180.0));
+    assert_eq!(
+        read.servos[1],
+        aircraft::ServoOutput {
+            reversed: true,
+            centre_us: 1500.0,
+            ..aircraft::ServoOutput::STANDARD
+        }
+    );
+}

@@ -187,7 +187,7 @@ impl Campaign<'_> {
     fn fly(&self, args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
         match self.args.fc {
             CampaignLink::InProcess => fly::fly(args, &|| Box::new(InProcessLink::new())),
-            CampaignLink::BoardSim => fly::fly_board_sim(args),
+            CampaignLink::BoardSim(_) => fly::fly_board_sim(args),
         }
     }
 }
@@ -330,13 +330,13 @@ mod tests {
         );
         assert!(sweeps.pilot_override_at_s.is_none() && sweeps.elf.is_none());
         let board = CampaignArgs {
-            fc: CampaignLink::BoardSim,
+            fc: CampaignLink::BoardSim(None),
             ..args.clone()
         };
         let on_the_board = Campaign::new(&board)
             .fly_args(ModeArg::Cah, InputArg::Sweep, 7, "fly-cah")
             .unwrap();
-        assert_eq!(on_the_board.fc, crate::fly::FcArg::BoardSim);
+        assert_eq!(on_the_board.fc, crate::fly::FcArg::BoardSim(None));
         // The board-sim link's own flags keep fly's defaults (vibration on, no faults).
         assert!(on_the_board.vibration.is_none() && on_the_board.imu_fault.is_none());
         let doublets = run

@@ -100,7 +100,11 @@ pub struct CampaignArgs {
     /// emulated ICM-42688-P and SBUS receiver, as `fly --fc board-sim`). The board
     /// measures no air data (u, v, w), so with `board-sim` the fits leave out the pairs of
     /// those outputs and the verification scores the outputs the board measures.
-    #[arg(long, value_enum, default_value_t = CampaignLink::InProcess, value_name = "LINK")]
+    /// `board-sim:FLASH`: the board boots the parameter set saved in FLASH (`sweephold fc
+    /// params push FILE --fc board-sim:FLASH`, then `save`; refused if FLASH holds none)
+    /// and flies the aircraft --vehicle describes; the campaign chooses only each
+    /// record's test (axis, input, mode, seed, band, length, amplitude).
+    #[arg(long, default_value = "in-process", value_name = "LINK", value_parser = CampaignLink::parse)]
     pub fc: CampaignLink,
     /// No progress on stderr.
     #[arg(short, long)]
@@ -192,26 +196,43 @@ fn headline(summary: &CampaignSummary) -> String {
 }
 
 /// `campaign --fc`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum CampaignLink {
     /// The firmware's flight logic in process on the simulator's exact states.
     InProcess,
-    /// The board application on the emulated IMU and receiver (`fly --fc board-sim`).
-    BoardSim,
+    /// The board application on the emulated IMU and receiver (`fly --fc board-sim`),
+    /// set up from the aircraft file or booted from a flash file (`board-sim:FLASH`).
+    BoardSim(Option<std::path::PathBuf>),
 }
 
 impl CampaignLink {
+    /// Parse `in-process`, `board-sim` or `board-sim:FLASH`.
+    pub fn parse(text: &str) -> Result<CampaignLink, String> {
+        match text {
+            "in-process" => Ok(CampaignLink::InProcess),
+            "board-sim" => Ok(CampaignLink::BoardSim(None)),
+            _ => match text.strip_prefix("board-sim:") {
+                Some(flash) if !flash.is_empty() => Ok(CampaignLink::BoardSim(Some(flash.into()))),
+                _ => Err(format!(
+                    "unknown flight controller `{text}` (expected in-process, board-sim or \
+                     board-sim:FLASH)"
+                )),
+            },
+        }
+    }
+
     /// The name `--fc` and `summary.json` know it by.
-    pub const fn name(self) -> &'static str {
+    pub fn name(&self) -> String {
         match self {
-            CampaignLink::InProcess => "in-process",
-            CampaignLink::BoardSim => "board-sim",
+            CampaignLink::InProcess => "in-process".to_string(),
+            CampaignLink::BoardSim(None) => "board-sim".to_string(),
+            CampaignLink::BoardSim(Some(flash)) => format!("board-sim:{}", flash.display()),
         }
     }
 
     /// Whether the records carry air data (u, v, w): only the simulator's exact states
     /// do; the board measures rates, attitude and specific force.
-    pub const fn measures_air_data(self) -> bool {
+    pub const fn measures_air_data(&self) -> bool {
         matches!(self, CampaignLink::InProcess)
     }
 }

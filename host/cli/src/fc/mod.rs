@@ -2,11 +2,14 @@
 //! sets, saves and resets the board's parameters (protocol 1.5's parameter frames),
 //! pulls them into a params file, pushes such a file (all or nothing) and compares one
 //! with the board, over `--fc qemu-usart` (the board image in QEMU, its USART1 on a
-//! socket) or `--fc serial:PATH[@BAUD]` (a board on a serial port).
+//! socket), `--fc serial:PATH[@BAUD]` (a board on a serial port) or `--fc
+//! board-sim:FLASH` (the simulated board, its parameter sectors in a file: [`board_sim`]).
 //!
 //! Its parts: [`client`] (the frames), [`params_file`] (the file format) and [`push`]
 //! (checking a file against the board, then writing it all or nothing).
 
+pub mod aircraft_params;
+pub mod board_sim;
 pub mod client;
 pub mod params_file;
 pub mod push;
@@ -44,7 +47,12 @@ pub enum FcCommand {
     after_help = "Parameters change only while the board is disarmed (every request is \
 refused while armed) and only in its RAM until `save`. `push` reads the board's list first, \
 refuses unknown names and out-of-range values before writing anything, sets only the values \
-that differ, and puts the old values back if a set fails mid-way."
+that differ, and puts the old values back if a set fails mid-way. `push` takes a params file \
+or an aircraft file (its [flight_controller] and [swash] tables as parameters). With --fc \
+board-sim:FLASH every command is a power cycle of the simulated board: `set`, `push` and \
+`reset` without `save` in the same board's life are lost when the command ends, as on a \
+board switched off; `save` writes FLASH, so change and save in one command with --save \
+(e.g. `fc params push fbl700.toml --save --fc board-sim:F`)."
 )]
 pub struct ParamsArgs {
     /// What to do.
@@ -52,7 +60,9 @@ pub struct ParamsArgs {
     pub action: ParamsAction,
     /// The flight controller: `qemu-usart` (the board image in qemu-system-arm, frames
     /// over its USART1; its parameters live as long as that QEMU, i.e. this command) or
-    /// `serial:PATH[@BAUD]` (a board on a serial port, default 460800 Bd).
+    /// `serial:PATH[@BAUD]` (a board on a serial port, default 460800 Bd) or
+    /// `board-sim:FLASH` (the simulated board; FLASH, a file holding its parameter
+    /// sectors, created erased if absent; one power cycle per command).
     #[arg(long, value_name = "FC", global = true, value_parser = parse_fc)]
     pub fc: Option<FcLink>,
     /// Board image for `--fc qemu-usart` [default: $SWEEPHOLD_FC_ELF, else
@@ -60,6 +70,11 @@ pub struct ParamsArgs {
     /// was built in, else of the current folder].
     #[arg(long, value_name = "PATH", global = true)]
     pub elf: Option<PathBuf>,
+    /// After `set`, `push` or `reset`: save the set to the board's flash in the same
+    /// connection (a board whose RAM does not outlive the command — QEMU, board-sim —
+    /// keeps a change only so).
+    #[arg(long, global = true)]
+    pub save: bool,
 }
 
 /// What `fc params` does.
@@ -89,9 +104,10 @@ pub enum ParamsAction {
         /// The params file to write (replaced atomically).
         file: PathBuf,
     },
-    /// Set the board's RAM to a params file's values, all or nothing.
+    /// Set the board's RAM to a params file's values, or to an aircraft file's (its
+    /// [flight_controller] and [swash] tables), all or nothing.
     Push {
-        /// The params file to read.
+        /// The params file or aircraft file to read.
         file: PathBuf,
     },
     /// Show where the board and a params file differ.
@@ -108,6 +124,8 @@ pub enum FcLink {
     QemuUsart,
     /// A board on a serial port.
     Serial(SerialPort),
+    /// The simulated board, its parameter sectors in a file.
+    BoardSim(PathBuf),
 }
 
 impl FcLink {
@@ -115,6 +133,7 @@ impl FcLink {
         match self {
             FcLink::QemuUsart => "qemu-usart".to_string(),
             FcLink::Serial(port) => format!("serial:{port}"),
+            FcLink::BoardSim(path) => format!("board-sim:{}", path.display()),
         }
     }
 }
@@ -124,12 +143,19 @@ pub fn parse_fc(text: &str) -> Result<FcLink, String> {
     if text == "qemu-usart" {
         return Ok(FcLink::QemuUsart);
     }
+    if let Some(path) = text.strip_prefix("board-sim:") {
+        if path.is_empty() {
+            return Err("board-sim:FLASH needs the path of the flash file".to_string());
+        }
+        return Ok(FcLink::BoardSim(PathBuf::from(path)));
+    }
     match text.strip_prefix("serial:") {
         Some(port) => SerialPort::parse(port)
             .map(FcLink::Serial)
             .map_err(|e| e.to_string()),
         None => Err(format!(
-            "unknown flight controller `{text}` (expected qemu-usart or serial:PATH[@BAUD])"
+            "unknown flight controller `{text}` (expected qemu-usart, serial:PATH[@BAUD] or \
+             board-sim:FLASH)"
         )),
     }
 }
@@ -140,6 +166,8 @@ pub enum FcWire {
     Qemu(QemuProcess),
     /// A serial port.
     Serial(SerialWire),
+    /// The simulated board.
+    BoardSim(Box<board_sim::BoardSimWire>),
 }
 
 impl ByteWire for FcWire {
@@ -147,6 +175,7 @@ impl ByteWire for FcWire {
         match self {
             FcWire::Qemu(wire) => wire.send(bytes),
             FcWire::Serial(wire) => wire.send(bytes),
+            FcWire::BoardSim(wire) => wire.send(bytes),
         }
     }
 
@@ -154,6 +183,7 @@ impl ByteWire for FcWire {
         match self {
             FcWire::Qemu(wire) => wire.recv(buf, timeout),
             FcWire::Serial(wire) => wire.recv(buf, timeout),
+            FcWire::BoardSim(wire) => wire.recv(buf, timeout),
         }
     }
 
@@ -161,6 +191,7 @@ impl ByteWire for FcWire {
         match self {
             FcWire::Qemu(wire) => wire.failure(what),
             FcWire::Serial(wire) => wire.failure(what),
+            FcWire::BoardSim(wire) => wire.failure(what),
         }
     }
 }
@@ -174,7 +205,7 @@ pub fn run(args: &FcArgs) -> anyhow::Result<()> {
 
 fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
     let Some(fc) = &args.fc else {
-        bail!("--fc is required (qemu-usart or serial:PATH[@BAUD])");
+        bail!("--fc is required (qemu-usart, serial:PATH[@BAUD] or board-sim:FLASH)");
     };
     // Inputs are read, and outputs checked, before the board is reached.
     let file_values = match &args.action {
@@ -184,6 +215,14 @@ fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
     if let ParamsAction::Pull { file } = &args.action {
         output::refuse_inputs_as_outputs(&[], &[("FILE", file)])?;
     }
+    if args.save
+        && !matches!(
+            args.action,
+            ParamsAction::Set { .. } | ParamsAction::Push { .. } | ParamsAction::Reset
+        )
+    {
+        bail!("--save goes with set, push or reset");
+    }
     let (mut client, source) = connect(fc, args.elf.as_deref())?;
     match &args.action {
         ParamsAction::List => output::print(&listing(&client.list()?)),
@@ -191,6 +230,7 @@ fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
         ParamsAction::Set { name, value } => {
             local_check(name, *value)?;
             let held = client.set(name, *value)?;
+            save_if_asked(&mut client, args.save)?;
             output::print(&format!("{name} = {held}\n"))
         }
         ParamsAction::Save => {
@@ -199,7 +239,12 @@ fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
         }
         ParamsAction::Reset => {
             client.reset()?;
-            output::print("defaults in RAM (not saved)\n")
+            save_if_asked(&mut client, args.save)?;
+            output::print(if args.save {
+                "defaults saved\n"
+            } else {
+                "defaults in RAM (not saved)\n"
+            })
         }
         ParamsAction::Pull { file } => {
             let values = client.list()?;
@@ -214,8 +259,14 @@ fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
         ParamsAction::Push { .. } => {
             let values = file_values.unwrap_or_default();
             let pushed = push::push(&mut client, &values)?;
+            save_if_asked(&mut client, args.save)?;
+            let kept = if args.save {
+                "saved"
+            } else {
+                "in RAM: `sweephold fc params save` to keep them"
+            };
             output::print(&format!(
-                "{} changed, {} already held (in RAM: `sweephold fc params save` to keep them)\n",
+                "{} changed, {} already held ({kept})\n",
                 pushed.changed, pushed.unchanged
             ))
         }
@@ -224,6 +275,16 @@ fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {
             output::print(&diff(&board, &file_values.unwrap_or_default()))
         }
     }
+}
+
+/// `--save`: save what the command set.
+fn save_if_asked(client: &mut ParamClient<FcWire>, save: bool) -> anyhow::Result<()> {
+    if save {
+        client
+            .save()
+            .map_err(|e| anyhow::anyhow!("the values were set but not saved: {e}"))?;
+    }
+    Ok(())
 }
 
 /// A value the host's copy of the firmware's table refuses is refused here, with the
@@ -249,6 +310,15 @@ fn read_params_file(path: &Path) -> anyhow::Result<Vec<BoardValue>> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         anyhow::anyhow!("cannot read {}: {}", path.display(), output::io_reason(&e))
     })?;
+    // An aircraft file has a [flight_controller] table; a params file never does.
+    let is_aircraft = text
+        .parse::<toml::Table>()
+        .is_ok_and(|table| table.contains_key("flight_controller"));
+    if is_aircraft {
+        let given = path.to_string_lossy();
+        let vehicle = crate::vehicle::Vehicle::parse(&given).map_err(|e| anyhow::anyhow!(e))?;
+        return aircraft_params::values(&vehicle);
+    }
     params_file::parse(&text, &path.display().to_string())
 }
 
@@ -269,6 +339,15 @@ fn connect(fc: &FcLink, elf: Option<&Path>) -> anyhow::Result<(ParamClient<FcWir
             let source = Source {
                 fc: fc.name(),
                 image: Some(image.display().to_string()),
+            };
+            Ok((ParamClient::new(channel), source))
+        }
+        FcLink::BoardSim(path) => {
+            let wire = board_sim::BoardSimWire::boot(path)?;
+            let channel = FrameChannel::new(FcWire::BoardSim(Box::new(wire)));
+            let source = Source {
+                fc: fc.name(),
+                image: None,
             };
             Ok((ParamClient::new(channel), source))
         }

@@ -26,6 +26,13 @@ pub trait FlightControllerLink {
         telemetry: &mut Vec<u8>,
     ) -> anyhow::Result<ActuatorOut>;
 
+    /// The controls the simulated rotor gets for the reply `out` of the last exchange:
+    /// the command, or for a link that flies the servo pulses (`board-sim`) what the
+    /// aircraft's servos make of them.
+    fn controls_flown(&self, out: &ActuatorOut) -> [f64; 4] {
+        out.command.to_array().map(f64::from)
+    }
+
     /// The board application's mode after the last tick (`pilot`, `rc_failsafe`, …), for
     /// a link that runs one (`board-sim`). Default: none.
     fn board_mode(&self) -> Option<&'static str> {

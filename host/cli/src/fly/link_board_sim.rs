@@ -12,7 +12,20 @@
 //! 3. the simulated transmitter sends an SBUS frame every 7 ms (high-speed mode); the
 //!    frames complete by the tick go into the tick's byte stream;
 //! 4. `control_tick` runs the application; its command and servo pulses are the reply,
-//!    and the sequencer's telemetry goes into the dump as with the in-process link.
+//!    and the sequencer's telemetry goes into the dump as with the in-process link;
+//! 5. the servo pulses reach the simulated rotor through the aircraft's servo geometry
+//!    (its `[swash]` table), each servo taking a new pulse only when one of its frames
+//!    starts ([`servo_plant`](super::servo_plant)): the simulator flies what the servos
+//!    do, not the command.
+//!
+//! # The board's setup
+//!
+//! With `--fc board-sim` the board is set up from the aircraft file in memory: the
+//! record's configuration (the preset with the file's `[flight_controller]` settings),
+//! its mixer and servo frame rates those of the file's `[swash]` table, as `fc params
+//! push` would set them. With `--fc board-sim:FLASH` it boots the set saved in FLASH
+//! ([`BoardSetup::Stored`]) and only the record's test (axis, input, mode, seed, band,
+//! length, amplitude) and rate are the campaign's.
 //!
 //! # The simulated pilot and transmitter
 //!
@@ -73,6 +86,7 @@ use sweephold_firmware::{Config, FrameSink};
 use sweephold_protocol::{ActuatorOut, Controls, SensorIn};
 
 use super::link::FlightControllerLink;
+use super::servo_plant::{self, FrameHold, ServoGeometry};
 
 /// The transmitter's frame period \[µs\] (SBUS high-speed mode).
 pub const FRAME_PERIOD_US: u32 = 7_000;
@@ -186,6 +200,20 @@ pub struct BoardSimSettings {
     pub rc_loss_at_s: Option<f64>,
     /// IMU fault to inject.
     pub imu_fault: Option<ImuFaultPlan>,
+    /// The aircraft's servo geometry: the board's pulses reach the rotor through it.
+    pub swash: aircraft::Swash,
+    /// How the board is set up.
+    pub setup: BoardSetup,
+}
+
+/// Where the board's configuration comes from.
+#[derive(Clone, Debug)]
+pub enum BoardSetup {
+    /// The aircraft file in memory: the record's configuration, the mixer and frame
+    /// rates of its `[swash]` table.
+    FromAircraft,
+    /// A parameter set saved on the board (`--fc board-sim:FLASH`).
+    Stored(Box<sweephold_firmware::params::Params>),
 }
 
 /// A delay that returns at once: the emulator's time moves only with `advance`.
@@ -227,6 +255,14 @@ struct Board {
     trim_sticks: [f32; 4],
     /// The transmitter sends frames.
     transmitting: bool,
+    /// Board time since power-on \[µs\] (not wrapping).
+    elapsed_us: u64,
+    /// The pulses the servos hold between their frames.
+    servos: FrameHold,
+    /// The aircraft's servo geometry.
+    geometry: ServoGeometry,
+    /// What the rotor gets over the current tick (lat, lon, ped, col).
+    flown: [f64; 4],
 }
 
 impl Board {
@@ -253,6 +289,10 @@ impl Board {
         let out = self.stack.control_tick(self.now_us, &self.wire, sink);
         self.wire.clear();
         self.last = Some(out);
+        self.elapsed_us += u64::from(self.samples_per_tick * IMU_PERIOD_US);
+        let tick_us = u64::from(self.samples_per_tick * IMU_PERIOD_US);
+        let held = self.servos.tick(self.elapsed_us, tick_us, out.servo_us);
+        self.flown = self.geometry.controls(held);
         out
     }
 
@@ -301,13 +341,23 @@ impl BoardSimLink {
                 "--fc board-sim needs a rate that divides the IMU's 1000 Hz, not {rate} Hz"
             );
         }
-        let primary = config.test.primary;
-        let preset = AppConfig::preset(config.vehicle, primary);
-        let app = AppConfig {
-            flight: *config,
-            ..preset
+        let (stack_config, [swash_hz, tail_hz]) = match &settings.setup {
+            BoardSetup::FromAircraft => {
+                let preset = AppConfig::preset(config.vehicle, config.test.primary);
+                let mut flight = *config;
+                flight.mixer = servo_plant::board_mixer(&settings.swash);
+                let app = AppConfig { flight, ..preset };
+                (
+                    StackConfig::with_app(app),
+                    servo_plant::board_frame_rates(&settings.swash),
+                )
+            }
+            BoardSetup::Stored(params) => (
+                stored_with_record(params, config)?,
+                [params.swash_frame_hz, params.tail_frame_hz],
+            ),
         };
-        let stack_config = StackConfig::with_app(app);
+        let app = stack_config.app;
         let seed = 0xB0A2_D51A_u64 ^ u64::from(config.test.seed).rotate_left(23);
         let (rotor_stopped, rotor_running) = if settings.vibration {
             (
@@ -355,6 +405,10 @@ impl BoardSimLink {
             ],
             trim_sticks: trim.controls.map(|c| c as f32),
             transmitting: true,
+            elapsed_us: 0,
+            servos: FrameHold::new(swash_hz, tail_hz, [0; 4]),
+            geometry: ServoGeometry::new(&settings.swash),
+            flown: [0.0; 4],
         };
         let ticks_in = |seconds: f64| (seconds * f64::from(rate)).ceil() as u64;
         let col = board.trim_sticks[3];
@@ -445,8 +499,8 @@ impl BoardSimLink {
                 [reading.p, reading.q, reading.r].map(|v| v as f32),
                 [reading.ax, reading.ay, reading.az].map(|v| v as f32),
             );
-            let out = board.tick(&rc, &mut Discard);
-            reading = sim.step(board.dt, out.command.to_array().map(f64::from));
+            board.tick(&rc, &mut Discard);
+            reading = sim.step(board.dt, board.flown);
             let mut state = sim.state();
             for i in [
                 rotorsim::model::U,
@@ -521,12 +575,45 @@ impl FlightControllerLink for BoardSimLink {
         })
     }
 
+    fn controls_flown(&self, out: &ActuatorOut) -> [f64; 4] {
+        self.board
+            .as_ref()
+            .map_or(out.command.to_array().map(f64::from), |board| board.flown)
+    }
+
     fn board_mode(&self) -> Option<&'static str> {
         self.board
             .as_ref()
             .and_then(|board| board.last)
             .map(|out| out.mode.name())
     }
+}
+
+/// The stored set with the record's test and rate: what the campaign chooses per record.
+fn stored_with_record(
+    params: &sweephold_firmware::params::Params,
+    config: &Config,
+) -> anyhow::Result<StackConfig> {
+    let mut stack = params.stack;
+    let flight = &mut stack.app.flight;
+    flight.rate_hz = config.rate_hz;
+    let (mine, record) = (&mut flight.test, &config.test);
+    mine.primary = record.primary;
+    mine.input = record.input;
+    mine.mode = record.mode;
+    mine.seed = record.seed;
+    mine.sweep.omega_min = record.sweep.omega_min;
+    mine.sweep.omega_max = record.sweep.omega_max;
+    mine.sweep.t_rec_s = record.sweep.t_rec_s;
+    mine.sweep.amplitude = record.sweep.amplitude;
+    mine.pulse.amplitude = record.pulse.amplitude;
+    flight.test.warnings = flight.validate().map_err(|e| {
+        anyhow::anyhow!(
+            "the board's stored set refuses this record's test: {}",
+            e.message()
+        )
+    })?;
+    Ok(stack)
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! `sweephold fly`: the paper's test campaign, flown on the host with the flight
 //! controller in the loop and the nonlinear simulator as the aircraft.
 
+pub mod board_flash;
 pub mod defmt_log;
 pub mod frame_channel;
 pub mod link;
@@ -9,6 +10,7 @@ pub mod link_qemu;
 pub mod link_serial;
 pub mod plan;
 pub mod record;
+pub mod servo_plant;
 pub mod summary;
 
 use std::collections::BTreeMap;
@@ -199,8 +201,11 @@ pub struct FlyArgs {
     /// USART: slow, no log), `serial:PATH[@BAUD]` (a real board on a serial port,
     /// default 460800 Bd; records flown one at a time) or `board-sim` (the board
     /// application's sensor-to-servo stack on an emulated IMU and SBUS receiver, booted,
-    /// armed and hovering before each record; see --vibration, --rc-loss, --imu-fault,
-    /// --fly-on).
+    /// armed and hovering before each record, its servo pulses flown through the
+    /// aircraft's [swash] geometry; see --vibration, --rc-loss, --imu-fault, --fly-on).
+    /// `board-sim` is set up from the aircraft file; `board-sim:FLASH` boots the
+    /// parameter set saved in FLASH (`sweephold fc params … --fc board-sim:FLASH`; never
+    /// written here) and takes only each record's test and rate from the command line.
     #[arg(long, value_name = "FC", default_value = "in-process", value_parser = parse_fc)]
     pub fc: FcArg,
     /// Board image for `--fc qemu` (a 32-bit ARM ELF, checked before QEMU starts) [default:
@@ -259,20 +264,25 @@ pub enum FcArg {
     /// A real board on a serial port (`serial:PATH[@BAUD]`).
     Serial(link_serial::SerialPort),
     /// The board application (the firmware's `BoardStack`) in-process on an emulated IMU
-    /// and an SBUS byte stream.
-    BoardSim,
+    /// and an SBUS byte stream; set up from the aircraft file, or booted from the
+    /// parameter set saved in a flash file (`board-sim:FLASH`).
+    BoardSim(Option<PathBuf>),
 }
 
 /// Parse `--fc`: `in-process`, `qemu`, `qemu-usart`, `serial:PATH[@BAUD]` or `board-sim`.
 pub fn parse_fc(text: &str) -> Result<FcArg, FcArgError> {
     match text {
         "in-process" => Ok(FcArg::InProcess),
-        "board-sim" => Ok(FcArg::BoardSim),
+        "board-sim" => Ok(FcArg::BoardSim(None)),
         "qemu" => Ok(FcArg::Qemu),
         "qemu-usart" => Ok(FcArg::QemuUsart),
-        _ => match text.strip_prefix("serial:") {
-            Some(port) => Ok(FcArg::Serial(link_serial::SerialPort::parse(port)?)),
-            None => Err(FcArgError::Unknown(text.to_string())),
+        _ => match (
+            text.strip_prefix("serial:"),
+            text.strip_prefix("board-sim:"),
+        ) {
+            (Some(port), _) => Ok(FcArg::Serial(link_serial::SerialPort::parse(port)?)),
+            (_, Some(flash)) if !flash.is_empty() => Ok(FcArg::BoardSim(Some(flash.into()))),
+            _ => Err(FcArgError::Unknown(text.to_string())),
         },
     }
 }
@@ -283,7 +293,7 @@ pub enum FcArgError {
     /// None of the kinds.
     #[error(
         "unknown flight controller `{0}` (expected in-process, qemu, qemu-usart, \
-         serial:PATH[@BAUD] or board-sim)"
+         serial:PATH[@BAUD], board-sim or board-sim:FLASH)"
     )]
     Unknown(String),
     /// `serial:` with a value that names no port.
@@ -387,7 +397,7 @@ impl FlyArgs {
                 self.t_rec_s
             );
         }
-        if self.fc != FcArg::BoardSim {
+        if !matches!(self.fc, FcArg::BoardSim(_)) {
             let board_only = [
                 ("--vibration", self.vibration.is_some()),
                 ("--rc-loss", self.rc_loss_at_s.is_some()),
@@ -570,7 +580,7 @@ fn fly_on_link(args: &FlyArgs, image: Option<&std::path::Path>) -> anyhow::Resul
             &|| Box::new(link_serial::SerialLink::new(port.clone())),
             1,
         ),
-        FcArg::BoardSim => fly_board_sim(args),
+        FcArg::BoardSim(_) => fly_board_sim(args),
     }
 }
 
@@ -594,6 +604,13 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
         vibration: args.vibration != Some(VibrationArg::None),
         rc_loss_at_s: args.rc_loss_at_s,
         imu_fault: args.imu_fault,
+        swash: args.vehicle.aircraft().swash,
+        setup: match &args.fc {
+            FcArg::BoardSim(Some(flash)) => link_board_sim::BoardSetup::Stored(Box::new(
+                board_flash::load_params(flash, args.vehicle.preset())?,
+            )),
+            _ => link_board_sim::BoardSetup::FromAircraft,
+        },
     })
 }
 
@@ -615,6 +632,9 @@ fn sim_options(args: &FlyArgs) -> rotorsim::SimOptions {
 /// anything is flown or written.
 pub fn validate(args: &FlyArgs) -> anyhow::Result<()> {
     args.check()?;
+    if let FcArg::BoardSim(Some(flash)) = &args.fc {
+        board_flash::load_params(flash, args.vehicle.preset())?;
+    }
     let plans = args.plans();
     for plan in &plans {
         let config = record_config(&args.vehicle, plan, args.rate_hz);
@@ -814,7 +834,7 @@ fn finish_record(
         max_from_trim_deg: flown.max_from_trim_deg,
         hold_fraction: flown.hold_fraction,
         cross_coherence,
-        estimator: (args.fc == FcArg::BoardSim).then_some(summary::EstimatorSummary {
+        estimator: matches!(args.fc, FcArg::BoardSim(_)).then_some(summary::EstimatorSummary {
             max_error_deg: flown.attitude_error_deg,
         }),
         after: flown.after,

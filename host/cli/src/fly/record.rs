@@ -291,8 +291,7 @@ pub fn fly_record(
                 errors.add(sample, truth);
             }
         }
-        let command = out.command.to_array().map(f64::from);
-        reading = sim.step(dt, command);
+        reading = sim.step(dt, link.controls_flown(&out));
         truth = sim.state().attitude();
         ticks += 1;
         if ticks % 200 == 0 {

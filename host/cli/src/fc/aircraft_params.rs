@@ -1,0 +1,157 @@
+//! `fc params push AIRCRAFT.toml`: an aircraft file as board parameters. The board a
+//! file describes is its firmware preset with the file's `[flight_controller]` settings
+//! (the configuration `fly` and `campaign` build from it) and the mixer and servo frame
+//! rates of its `[swash]` table; its values are the parameter table's
+//! ([`typed::values_of`](sweephold_firmware::params::typed::values_of)).
+//!
+//! Pushed are the parameters the file determines — swash type, phase and lead servo,
+//! every servo's direction, centre, limits and throw, the frame rates, the mixer's
+//! scales and ring, the hold's gains, limits, time constants, directions, reference and
+//! thresholds, the abort limits, the pulse width, the excitation scale and the command
+//! slew — each the file's value or, where the file states none, its preset's. Not pushed:
+//! the board's installation (receiver map and ranges, IMU mounting), the head and tail
+//! rotor speeds of the notches (the presets' filter bank, as `fly` flies it) and the test
+//! (chosen per record).
+
+use sweephold_firmware::params::{typed, ParamId, ParamTable, Params};
+use sweephold_protocol::Axis;
+
+use super::client::BoardValue;
+use crate::fly::servo_plant;
+use crate::vehicle::Vehicle;
+
+/// The parameters an aircraft file does not set.
+const NOT_FROM_THE_AIRCRAFT: [&str; 8] = [
+    "RC_",
+    "IMU_ROT",
+    "HEAD_RPM",
+    "TAIL_RPM",
+    "TEST_",
+    "SWP_",
+    "PULSE_AMP",
+    "NOISE_",
+];
+
+/// Whether `id` is one the aircraft file determines.
+fn from_the_aircraft(id: ParamId) -> bool {
+    let name = id.def().name;
+    !NOT_FROM_THE_AIRCRAFT
+        .iter()
+        .any(|prefix| name.starts_with(prefix))
+}
+
+/// The typed parameters of a board set up for `vehicle`.
+pub fn params(vehicle: &Vehicle) -> anyhow::Result<Params> {
+    let swash = &vehicle.aircraft().swash;
+    let mut flight = vehicle.firmware_config(Axis::Lat);
+    flight.mixer = servo_plant::board_mixer(swash);
+    let mut params = Params::preset(flight.vehicle);
+    params.stack.app.flight = flight;
+    [params.swash_frame_hz, params.tail_frame_hz] = servo_plant::board_frame_rates(swash);
+    // The table's own check: every value in range and the set consistent.
+    let values = typed::values_of(&params);
+    let table = ParamTable::from_values(values).map_err(|(id, error)| {
+        anyhow::anyhow!(
+            "aircraft `{}`: {} = {} cannot be a parameter: {}",
+            vehicle.name(),
+            id.def().name,
+            values[id.index()],
+            error.message()
+        )
+    })?;
+    table.params().map_err(|e| {
+        anyhow::anyhow!(
+            "aircraft `{}` makes no consistent parameter set: {}",
+            vehicle.name(),
+            e.message()
+        )
+    })
+}
+
+/// The values `push` writes for `vehicle`, in table order.
+pub fn values(vehicle: &Vehicle) -> anyhow::Result<Vec<BoardValue>> {
+    let values = typed::values_of(&params(vehicle)?);
+    Ok(ParamId::ALL
+        .iter()
+        .filter(|id| from_the_aircraft(**id))
+        .map(|id| BoardValue {
+            name: id.def().name.to_string(),
+            value: values[id.index()],
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fbl700_file_maps_onto_its_servo_geometry_and_settings() {
+        let vehicle = Vehicle::shipped("fbl700");
+        let values = values(&vehicle).unwrap();
+        let get = |name: &str| {
+            values
+                .iter()
+                .find(|v| v.name == name)
+                .unwrap_or_else(|| panic!("{name} not pushed"))
+                .value
+        };
+        assert_eq!(get("SWASH_TYPE"), 140.0);
+        assert_eq!(get("SWASH_LEAD"), 1.0);
+        assert_eq!(
+            [get("SERVO1_DIR"), get("SERVO2_DIR"), get("SERVO3_DIR")],
+            [1.0, -1.0, 1.0]
+        );
+        assert_eq!(
+            [
+                get("TAIL_MID"),
+                get("TAIL_MIN"),
+                get("TAIL_MAX"),
+                get("TAIL_THROW")
+            ],
+            [760.0, 550.0, 970.0, 200.0]
+        );
+        assert_eq!([get("SERVO_RATE"), get("TAIL_RATE")], [333.0, 333.0]);
+        assert_eq!(
+            [
+                get("EXC_SCALE_LAT"),
+                get("EXC_SCALE_LON"),
+                get("EXC_SCALE_PED"),
+                get("EXC_SCALE_COL")
+            ],
+            [0.7, 0.7, 0.2, 1.0]
+        );
+        assert_eq!(
+            [get("HOLD_LAT_P"), get("HOLD_LON_D"), get("HOLD_PED_I")],
+            [2.12, 0.22, 0.045]
+        );
+        for name in [
+            "RC_LAT",
+            "IMU_ROT",
+            "HEAD_RPM",
+            "TEST_AXIS",
+            "SWP_AMP",
+            "NOISE_RMS",
+        ] {
+            assert!(values.iter().all(|v| v.name != name), "{name} pushed");
+        }
+        // The typed set flies the configuration `fly` builds from the file.
+        let params = params(&vehicle).unwrap();
+        let mut expected = vehicle.firmware_config(Axis::Lat);
+        expected.mixer = servo_plant::board_mixer(&vehicle.aircraft().swash);
+        assert_eq!(params.stack.app.flight, expected);
+    }
+
+    #[test]
+    fn the_presets_files_push_the_presets_mixer() {
+        for name in ["bo105", "trex700l"] {
+            let vehicle = Vehicle::shipped(name);
+            let params = params(&vehicle).unwrap();
+            assert_eq!(
+                params.stack.app.flight.mixer,
+                sweephold_firmware::mixer::MixerConfig::trex700l(),
+                "{name}"
+            );
+        }
+    }
+}
