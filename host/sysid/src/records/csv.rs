@@ -37,8 +37,8 @@ pub mod units;
 
 use std::path::Path;
 
-use super::records::{remove_line, rms, Channel, Record};
-use super::FrfError;
+use super::record::{remove_line, rms, Channel, Record};
+use super::RecordError;
 use timing::{median, uniform_samples};
 use units::{deg_per_s_note, detected_time_unit, TimeUnit, Unit};
 
@@ -52,7 +52,7 @@ pub struct CsvColumns {
     /// Outputs as (channel name, column).
     pub outputs: Vec<(String, String)>,
     /// References as (input name, column): the excitation injected into that input (the
-    /// sweep), for [`ResponseEstimator::SweepReference`](super::ResponseEstimator::SweepReference).
+    /// sweep), for [`ResponseEstimator::SweepReference`](crate::frf::ResponseEstimator::SweepReference).
     pub references: Vec<(String, String)>,
     /// The swept input (a channel name, `frf --swept`); it overrides the file's primary
     /// column. `None`: the primary column names it, else the input with the largest RMS
@@ -118,8 +118,8 @@ fn field(raw: &str) -> &str {
     raw.trim().trim_matches('"').trim()
 }
 
-fn read(path: &Path) -> Result<String, FrfError> {
-    std::fs::read_to_string(path).map_err(|error| FrfError::Io {
+fn read(path: &Path) -> Result<String, RecordError> {
+    std::fs::read_to_string(path).map_err(|error| RecordError::Io {
         path: path.to_path_buf(),
         error,
     })
@@ -127,7 +127,7 @@ fn read(path: &Path) -> Result<String, FrfError> {
 
 /// Load a record from a CSV file; a file that long gaps split into several records is
 /// refused (read it with [`load_csv_records`]).
-pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, FrfError> {
+pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, RecordError> {
     let path = path.as_ref();
     parse_csv(&read(path)?, &path.display().to_string(), columns)
 }
@@ -136,17 +136,17 @@ pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, 
 pub fn load_csv_records(
     path: impl AsRef<Path>,
     columns: &CsvColumns,
-) -> Result<Vec<Record>, FrfError> {
+) -> Result<Vec<Record>, RecordError> {
     let path = path.as_ref();
     parse_csv_records(&read(path)?, &path.display().to_string(), columns)
 }
 
 /// Parse CSV text into one record; `source` names it in messages. A file that long gaps
 /// split into several records is refused (read it with [`parse_csv_records`]).
-pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Record, FrfError> {
+pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Record, RecordError> {
     let mut records = parse_csv_records(text, source, columns)?;
     if records.len() > 1 {
-        return Err(FrfError::Csv {
+        return Err(RecordError::Csv {
             path: source.into(),
             line: 0,
             message: format!(
@@ -179,8 +179,8 @@ pub fn parse_csv_records(
     text: &str,
     source: &str,
     columns: &CsvColumns,
-) -> Result<Vec<Record>, FrfError> {
-    let error = |line: usize, message: String| FrfError::Csv {
+) -> Result<Vec<Record>, RecordError> {
+    let error = |line: usize, message: String| RecordError::Csv {
         path: source.into(),
         line,
         message,
@@ -374,8 +374,8 @@ fn header(first: &str) -> (Option<Vec<&str>>, usize) {
 }
 
 /// Read the rows of `text`: the kept rows' times and channel values.
-fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Rows, FrfError> {
-    let error = |line: usize, message: String| FrfError::Csv {
+fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Rows, RecordError> {
+    let error = |line: usize, message: String| RecordError::Csv {
         path: source.into(),
         line,
         message,
@@ -390,7 +390,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
     if names.is_some() {
         lines.next();
     }
-    let find = |column: &str| -> Result<usize, FrfError> {
+    let find = |column: &str| -> Result<usize, RecordError> {
         if let Some(i) = names
             .as_ref()
             .and_then(|n| n.iter().position(|n| *n == column))
@@ -544,7 +544,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
             }
         }
         // An empty or non-finite field is a missing sample; anything else must be a number.
-        let number = |index: usize| -> Result<Option<f64>, FrfError> {
+        let number = |index: usize| -> Result<Option<f64>, RecordError> {
             let text = fields[index];
             if text.is_empty() {
                 return Ok(None);
@@ -585,7 +585,7 @@ fn swept_input(
     source: &str,
     columns: &CsvColumns,
     notes: &mut Vec<String>,
-) -> Result<(String, bool), FrfError> {
+) -> Result<(String, bool), RecordError> {
     let input_names = || {
         columns
             .inputs
@@ -605,7 +605,7 @@ fn swept_input(
                 .find(|(name, _)| name == axis)
                 .or_else(|| columns.inputs.iter().find(|(_, c)| *c == command_column))
                 .map(|(name, _)| name.clone());
-            Some(input.ok_or_else(|| FrfError::Csv {
+            Some(input.ok_or_else(|| RecordError::Csv {
                 path: source.into(),
                 line: 0,
                 message: format!(
