@@ -23,9 +23,10 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::mode_text::hover_summary;
 use anyhow::anyhow;
 use clap::Args;
-use sysid::fit::modes::{hover_summary, HOVER_MODE_LIMIT_RAD_S};
+use sysid::fit::modes::HOVER_MODE_LIMIT_RAD_S;
 use sysid::frf::analysis::CoherenceCurve;
 use sysid::frf::Record;
 
