@@ -7,7 +7,6 @@
 //! Inside it, the verbs (`fly`, `frf`, `fit`, `verify`, `decode`, `sim`) own their
 //! options; `campaign` runs them as stages and writes `artifacts`, which `report`
 //! only reads; `plot` draws every figure.
-#![forbid(unsafe_code)]
 // Standard error through `note!` (it never panics on a full or closed stderr).
 #![deny(clippy::print_stderr)]
 

@@ -1,5 +1,4 @@
 //! `sweephold`: see `sweephold --help`. Without arguments: `sweephold campaign`.
-#![forbid(unsafe_code)]
 
 use std::io::Write;
 use std::process::ExitCode;

@@ -19,7 +19,6 @@
 //! [`margins`] (crossover, margins, DRB of a sampled loop), [`handling`] (ADS-33
 //! bandwidth, phase delay, level), [`uncertainty`] (Monte-Carlo over the parameter
 //! covariance), [`analysis`] (everything for one model, the JSON document).
-#![forbid(unsafe_code)]
 
 pub mod analysis;
 pub mod handling;

@@ -11,8 +11,6 @@
 //! This crate is the aircraft only: it builds on general-purpose crates and never imports
 //! the identification library (`sysid`), the mapping of its linearization onto a model
 //! structure (`truth`) or the command-line tool, which build on it.
-#![forbid(unsafe_code)]
-#![warn(missing_docs)]
 
 mod integrator;
 mod linear_plant;

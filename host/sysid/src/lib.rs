@@ -27,7 +27,6 @@
 //! the command-line program. It never imports the simulator (`bo105`) or the command-line program
 //! (`sweephold`): they use it. What it needs to know of a vehicle (the TREX 700L's
 //! geometry and trim, say) the caller passes in.
-#![forbid(unsafe_code)]
 
 pub mod document;
 pub mod fit;
