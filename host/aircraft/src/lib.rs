@@ -14,6 +14,8 @@
 //!
 //! **What it may import.** serde, toml and thiserror; no other crate of the workspace.
 //! The simulator, the identification's priors and the command-line tool import it.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 mod check;
 mod flight_controller;
