@@ -21,7 +21,8 @@
 //! items, never the internals of its parent's siblings.
 //!
 //! **What it may import.** This crate is numerics and file formats, and nothing else: it
-//! depends on numeric crates (nalgebra, num-complex, rustfft), serialization crates
+//! depends on numeric crates (nalgebra, num-complex, rustfft, and rand_core with
+//! rand_xoshiro for [`random`]), serialization crates
 //! (serde, serde_json, toml, and the project's wire protocol `sweephold-protocol`, for
 //! the telemetry dumps it reads) and thiserror for its error types; plots are drawn by
 //! the command-line program. It never imports the simulator (`bo105`) or the command-line program

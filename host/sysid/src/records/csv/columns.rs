@@ -31,7 +31,7 @@ pub struct CsvColumns {
     /// Units of channels, by channel name (a reference takes its input's); channels not
     /// named are used as written.
     pub units: Vec<(String, Unit)>,
-    /// Unit of the time column; `None`: told from its median step ([`units`]).
+    /// Unit of the time column; `None`: told from its median step ([`units`](super::units)).
     pub time_unit: Option<TimeUnit>,
     /// Keep only the rows whose time \[s\] lies in [t0, t1].
     pub window_s: Option<[f64; 2]>,
