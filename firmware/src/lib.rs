@@ -54,8 +54,6 @@
 //! decoder and channel map, and the application's control tick); [`params`] (the
 //! board's parameter table, its typed view and its flash store).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
-#![forbid(unsafe_code)]
-#![deny(missing_docs)]
 #![cfg_attr(
     not(test),
     deny(

@@ -24,8 +24,6 @@
 //! assert_eq!(frames, vec![Ok(event)]);
 //! ```
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
 
 pub mod board_events;
 pub mod cobs;

@@ -1,9 +1,9 @@
 //! The options that say how to read a CSV log (columns, units, window, swept input), for
-//! `frf` and `verify` alike; the rules are in `sysid::frf::csv` and docs/formats.md.
+//! `frf` and `verify` alike; the rules are in `sysid::records::csv` and docs/formats.md.
 
 use anyhow::bail;
 use clap::Args;
-use sysid::frf::{CsvColumns, TimeUnit, Unit};
+use sysid::records::{CsvColumns, TimeUnit, Unit};
 
 /// How to read CSV files.
 #[derive(Args, Clone, Debug)]

@@ -8,6 +8,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use crate::arg_values;
+use crate::fit_tables::{
+    cost_table, parameter_table, parameter_table_with_truth, reduction_table, truth_cost_table,
+};
+use crate::mode_text::{hover_summary, mode_table, origin_text};
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use crate::vehicle::Vehicle;
 use anyhow::{bail, Context};
@@ -15,14 +19,11 @@ use clap::Args;
 use sysid::document::FrfDocument;
 use sysid::fit::equation_error::equation_error_start;
 use sysid::fit::modes::{
-    eigenvalue_text, hover_summary, mode_records, mode_table, origin_text, poles_at_origin,
-    ModeComparison, ModeError, ModeRecord, HOVER_MODE_LIMIT_RAD_S,
+    eigenvalue_text, mode_records, poles_at_origin, ModeComparison, ModeError, ModeRecord,
+    HOVER_MODE_LIMIT_RAD_S,
 };
 use sysid::fit::plausible::{describe, implausible_parameters};
-use sysid::fit::report::{
-    cost_table, parameter_table, parameter_table_with_truth, reduction_table, ScoredModelDocument,
-    TruthSection,
-};
+use sysid::fit::report::{ScoredModelDocument, TruthSection};
 use sysid::fit::trim::{TrimBalance, TrimPoints};
 use sysid::fit::{
     fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
@@ -480,7 +481,7 @@ fn write_report(
     write!(out, "{}", cost_table(result))?;
     if let Some(section) = truth {
         writeln!(out)?;
-        write!(out, "{}", section.cost_table())?;
+        write!(out, "{}", truth_cost_table(section))?;
     }
     if !result.skipped_pairs.is_empty() {
         writeln!(out, "\nskipped (no usable coherent range in the data):")?;

@@ -9,9 +9,9 @@ use crate::output::{
 };
 use clap::Args;
 use sysid::frf::{
-    analyse, check_one_origin, group_by_primary, load_csv_records, load_dump_with_origin,
-    FrfAnalysis, FrfOptions, Record, ResponseEstimator, ResponseInputs,
+    analyse, group_by_primary, FrfAnalysis, FrfOptions, ResponseEstimator, ResponseInputs,
 };
+use sysid::records::{check_one_origin, load_csv_records, load_dump_with_origin, Record};
 
 /// Arguments of `sweephold frf`.
 #[derive(Args, Debug)]

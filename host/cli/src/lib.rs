@@ -2,12 +2,14 @@
 //! benchmarks drive the same code the binary runs.
 //!
 //! **What it may import.** Every library crate of the workspace: the protocol, the
-//! firmware (with `std`, flown in-process), the simulator `bo105`, the identification
-//! `sysid` and the `truth` mapping. Nothing imports it but the integration tests.
+//! firmware (with `std`, flown in-process), the aircraft files (`aircraft`), the
+//! simulator (`rotorsim`), the identification (`sysid`), the `truth` mapping and the
+//! loop margins (`control`). Nothing imports it but the integration tests. The console
+//! text of the library's results (tables, summary lines) is written here
+//! (`fit_tables`, `mode_text`); the libraries return data.
 //! Inside it, the verbs (`fly`, `frf`, `fit`, `verify`, `decode`, `sim`) own their
 //! options; `campaign` runs them as stages and writes `artifacts`, which `report`
 //! only reads; `plot` draws every figure.
-#![forbid(unsafe_code)]
 // Standard error through `note!` (it never panics on a full or closed stderr).
 #![deny(clippy::print_stderr)]
 
@@ -20,11 +22,13 @@ pub mod csv_args;
 pub mod decode;
 pub mod fc;
 pub mod fit;
+pub mod fit_tables;
 pub mod fly;
 pub mod frf;
 pub mod interrupt;
 pub mod logs;
 pub mod margins;
+pub mod mode_text;
 pub mod output;
 pub mod plot;
 pub mod report;

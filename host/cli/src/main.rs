@@ -1,5 +1,8 @@
 //! `sweephold`: see `sweephold --help`. Without arguments: `sweephold campaign`.
-#![forbid(unsafe_code)]
+//!
+//! **Its room and what it may import.** The binary parses the command line and runs the
+//! verb through the `sweephold` library crate, the only workspace crate it imports (with
+//! clap); all the work is in the library.
 
 use std::io::Write;
 use std::process::ExitCode;

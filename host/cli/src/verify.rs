@@ -13,7 +13,7 @@ use anyhow::{anyhow, Context};
 use clap::Args;
 use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification, VerifyError};
 use sysid::fit::ModelDocument;
-use sysid::frf::{load_csv_records, load_test_dump, Record};
+use sysid::records::{load_csv_records, load_test_dump, Record};
 
 /// Arguments of `sweephold verify`.
 #[derive(Args, Debug)]

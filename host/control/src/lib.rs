@@ -14,12 +14,16 @@
 //! knows nothing of the flight controller; this crate joins the two (firmware control
 //! law and identified model), which neither may depend on the other for.
 //!
+//! **What it may import.** Of the workspace: the firmware (`sweephold-firmware` with
+//! `std`: the gains, tick and IMU filter bank), the wire protocol and `sysid` (the model
+//! and its structure); otherwise nalgebra, num-complex and serde. Only the command-line
+//! tool imports it.
+//!
 //! Modules: [`plant`] (the model's responses at the board's sensors), [`law`] (the
 //! control law as it runs), [`loops`] (loop matrix, broken loops, stick responses),
 //! [`margins`] (crossover, margins, DRB of a sampled loop), [`handling`] (ADS-33
 //! bandwidth, phase delay, level), [`uncertainty`] (Monte-Carlo over the parameter
 //! covariance), [`analysis`] (everything for one model, the JSON document).
-#![forbid(unsafe_code)]
 
 pub mod analysis;
 pub mod handling;

@@ -8,11 +8,11 @@
 //! dynamic inflow), hub spring and thrust-offset moments, tail rotor, fuselage drag, fin
 //! and tailplane. See `README.md` for the validation against Padfield's Helisim.
 //!
-//! This crate is the aircraft only: it builds on general-purpose crates and never imports
-//! the identification library (`sysid`), the mapping of its linearization onto a model
-//! structure (`truth`) or the command-line tool, which build on it.
-#![forbid(unsafe_code)]
-#![warn(missing_docs)]
+//! **Its room and what it may import.** This crate is the aircraft only. Of the
+//! workspace it imports `aircraft` alone (the aircraft file is its input); otherwise
+//! general-purpose crates (nalgebra, rand_core and rand_xoshiro, thiserror). It never
+//! imports the identification library (`sysid`), the mapping of its linearization onto a
+//! model structure (`truth`) or the command-line tool, which build on it.
 
 mod integrator;
 mod linear_plant;

@@ -7,7 +7,8 @@
 
 use num_complex::Complex64;
 use sysid::document::{FrfDocument, PairResponse};
-use sysid::frf::{analyse, group_by_primary, load_csv, CsvColumns, FrfOptions};
+use sysid::frf::{analyse, group_by_primary, FrfOptions};
+use sysid::records::{load_csv, CsvColumns};
 
 const CSV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/two_input.csv");
 const BAND: [f64; 2] = [0.5, 20.0];

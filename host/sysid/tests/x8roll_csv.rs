@@ -11,9 +11,8 @@
 
 use num_complex::Complex64;
 use sysid::document::PairResponse;
-use sysid::frf::{
-    analyse, group_by_primary, parse_csv_records, CsvColumns, FrfOptions, Record, Unit,
-};
+use sysid::frf::{analyse, group_by_primary, FrfOptions};
+use sysid::records::{parse_csv_records, CsvColumns, Record, Unit};
 
 const X8ROLL: &str = include_str!("data/x8roll.csv");
 const SCIPY_H1: &str = include_str!("data/x8roll_scipy_h1.json");

@@ -12,11 +12,10 @@
 //! - [`with_vehicle_data`], [`nine_dof_hybrid`]: a shipped structure with the flown
 //!   vehicle's geometry, rotor data and trim attitude ([`TrimAttitude`]) in it.
 //!
-//! It builds on the simulator (`bo105`), the identification library (`sysid`) and the
-//! aircraft files (`aircraft`), and joins them; none of them imports it, nor does it import the command-line tool or
-//! read telemetry.
-#![forbid(unsafe_code)]
-#![warn(missing_docs)]
+//! **Its room and what it may import.** It joins the simulator (`rotorsim`), the
+//! identification library (`sysid`) and the aircraft files (`aircraft`), its only
+//! workspace imports (besides nalgebra and thiserror); none of them imports it, nor does
+//! it import the command-line tool (its one user) or read telemetry.
 
 mod error;
 pub mod file_constants;

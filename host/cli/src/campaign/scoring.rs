@@ -2,7 +2,7 @@
 //! `truth-model9.json`, the truth section of `model9.json`, and the truth figures of the
 //! summary's `fit` section.
 
-use sysid::fit::modes::hover_summary;
+use crate::mode_text::hover_summary;
 use sysid::fit::report::ScoredModelDocument;
 use sysid::fit::FitResult;
 

@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::anyhow;
 use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification};
 use sysid::fit::Model;
-use sysid::frf::load_test_dump;
+use sysid::records::load_test_dump;
 
 use super::{verb_args, Campaign};
 use crate::artifacts::files;

@@ -11,7 +11,7 @@ use serde::de::DeserializeOwned;
 use sysid::document::FrfDocument;
 use sysid::fit::report::ModelMatrices;
 use sysid::fit::{Model, PairFit};
-use sysid::frf::{load_dump, Record};
+use sysid::records::{load_dump, Record};
 
 use crate::artifacts::files;
 use crate::artifacts::flown::{lateral_coherence, FlownRecords, ModeCoherence, LATERAL};

@@ -3,9 +3,11 @@
 
 use super::cost::{self, PairGrid};
 use super::error::FitError;
+use super::options::FitOptions;
+use super::result::{FitResult, SkippedPair, StartSetOutcome};
 use super::search::{finish_fit, fit_on_grids, search_minima, StartSearch};
 use super::structure::{self, ModelStructure, ParameterKind};
-use super::{plausible, reduce, trim, FitOptions, FitResult, SkippedPair, StartSetOutcome};
+use super::{plausible, reduce, trim};
 use crate::document::FrfDocument;
 
 /// Fit `structure` to the responses in `data`.

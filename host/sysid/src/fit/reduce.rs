@@ -27,11 +27,12 @@ use super::cost::PairGrid;
 use super::error::FitError;
 use super::model::Model;
 use super::modes::{eigenvalue_text, modes, pair_modes, relative_error_percent, ModeName};
+use super::options::FitOptions;
 pub use super::result::ReductionStep;
+use super::result::{AccuracyFlag, FitResult, ParameterReport, ParameterStatus};
 use super::search::fit_on_grids;
 use super::structure::ParameterKind;
 use super::trim::TrimBalance;
-use super::{AccuracyFlag, FitOptions, FitResult, ParameterReport, ParameterStatus};
 
 /// How the refit `after` changed the hover modes of `before` (module documentation), in
 /// words, when it moved one by more than `limit_percent` or added a pole at the origin;

@@ -1,15 +1,12 @@
-//! Fit reports: the `model.json` document (layout in `host/sysid/models/README.md`) and
-//! the text tables `sweephold fit` prints (parameters like the paper's Table 3, J per
-//! pair, reduction steps).
-
-use std::fmt::Write as _;
+//! Fit reports: the `model.json` document (layout in `host/sysid/models/README.md`), with
+//! its truth section. The text tables `sweephold fit` prints from them are the
+//! command-line program's.
 
 use serde::{Deserialize, Serialize};
 
 use super::model::{Actuator, Model, RowMajor};
 use super::modes::{ModeRecord, TruthModeRecord};
-use super::reduce::ReductionStep;
-use super::{AccuracyFlag, FitResult, PairFit, ParameterReport, ParameterStatus, StartOutcome};
+use super::result::{FitResult, PairFit, ParameterReport, ReductionStep, StartOutcome};
 
 /// Version of the `model.json` layout.
 pub const MODEL_DOCUMENT_VERSION: u32 = 1;
@@ -226,17 +223,6 @@ pub struct TruthSection {
     pub modes: Vec<TruthModeRecord>,
 }
 
-impl TruthSection {
-    /// The text table of J against the truth model per pair, then J_ave (the parameters
-    /// with their truth are in [`parameter_table_with_truth`]).
-    pub fn cost_table(&self) -> String {
-        let mut out = String::new();
-        let _ = writeln!(out, "J against the truth model ({}):", self.vehicle);
-        write_pair_costs(&mut out, "J truth", &self.pairs, self.average_cost);
-        out
-    }
-}
-
 fn finite(value: Option<f64>) -> Option<f64> {
     value.filter(|v| v.is_finite())
 }
@@ -315,138 +301,11 @@ pub fn no_actuators(actuators: &[Option<Actuator>]) -> bool {
     actuators.iter().all(Option::is_none)
 }
 
-fn percent_cell(value: Option<f64>) -> String {
-    match value {
-        Some(v) if v.is_finite() => format!("{v:.3}"),
-        Some(_) => "inf".into(),
-        None => "-".into(),
-    }
-}
-
-/// The parameter table (like the paper's Table 3): name, value, CR %, insensitivity %,
-/// status and flags (`CR>20%`, `I>10%`, `|r|>0.9 with X`).
-pub fn parameter_table(result: &FitResult) -> String {
-    parameter_rows(result, None)
-}
-
-/// [`parameter_table`] with two more columns from a truth scoring: the truth value and the
-/// error in % of |truth| (`-` where the truth mapping has no value).
-pub fn parameter_table_with_truth(result: &FitResult, truth: &TruthSection) -> String {
-    parameter_rows(result, Some(truth))
-}
-
-fn parameter_rows(result: &FitResult, truth: Option<&TruthSection>) -> String {
-    let mut out = String::new();
-    let truth_header = if truth.is_some() {
-        format!(" {:>14} {:>10}", "truth", "error %")
-    } else {
-        String::new()
-    };
-    let _ = writeln!(
-        out,
-        "{:<10} {:>14} {:>10} {:>10}{truth_header}  {:<11} flags",
-        "parameter", "value", "CR %", "insens. %", "status"
-    );
-    for p in &result.parameters {
-        let status = match p.status {
-            ParameterStatus::Free => "free",
-            ParameterStatus::Fixed => "fixed",
-            ParameterStatus::Trim => "trim",
-            ParameterStatus::Constrained => "constrained",
-        };
-        let flags: Vec<String> = p
-            .flags
-            .iter()
-            .map(|flag| match flag {
-                AccuracyFlag::CramerRao => "CR>20%".to_string(),
-                AccuracyFlag::Insensitive => "I>10%".to_string(),
-                AccuracyFlag::Correlated { with, correlation } => {
-                    format!("r={correlation:+.2} with {with}")
-                }
-                AccuracyFlag::Needed { .. } => "needed".to_string(),
-            })
-            .collect();
-        let truth_cells = match truth {
-            Some(section) => {
-                let entry = section.parameters.iter().find(|t| t.name == p.name);
-                let cell = |v: Option<f64>, precision: usize| {
-                    v.map_or_else(|| "-".to_string(), |v| format!("{v:.precision$}"))
-                };
-                format!(
-                    " {:>14} {:>10}",
-                    cell(entry.and_then(|t| t.truth), 6),
-                    cell(entry.and_then(|t| t.error_percent), 1)
-                )
-            }
-            None => String::new(),
-        };
-        let _ = writeln!(
-            out,
-            "{:<10} {:>14.6} {:>10} {:>10}{truth_cells}  {:<11} {}",
-            p.name,
-            p.value,
-            percent_cell(p.cramer_rao_percent),
-            percent_cell(p.insensitivity_percent),
-            status,
-            flags.join(", ")
-        );
-    }
-    out
-}
-
-/// The cost table: output/input, range and J per pair, then J_ave.
-pub fn cost_table(result: &FitResult) -> String {
-    let mut out = String::new();
-    write_pair_costs(&mut out, "J", &result.pairs, result.average_cost);
-    out
-}
-
-/// Rows `output/input  lo-hi  J` under a header naming the cost column, then J_ave.
-fn write_pair_costs(out: &mut String, cost_column: &str, pairs: &[PairFit], average: f64) {
-    let _ = writeln!(
-        out,
-        "{:<12} {:>17} {:>10}",
-        "pair", "range [rad/s]", cost_column
-    );
-    for pair in pairs {
-        let _ = writeln!(
-            out,
-            "{:<12} {:>8.3}-{:<8.3} {:>10.3}",
-            format!("{}/{}", pair.output, pair.input),
-            pair.range[0],
-            pair.range[1],
-            pair.cost
-        );
-    }
-    let _ = writeln!(out, "{:<12} {:>17} {:>10.3}", "J_ave", "", average);
-}
-
-/// The reduction steps, one line each.
-pub fn reduction_table(steps: &[ReductionStep]) -> String {
-    let mut out = String::new();
-    for (number, step) in steps.iter().enumerate() {
-        let _ = writeln!(
-            out,
-            "step {}: drop {} ({}): J_ave {:.3} -> {:.3}  {}",
-            number + 1,
-            step.dropped,
-            step.reason,
-            step.average_cost_before,
-            step.average_cost_after,
-            match step.needed_because() {
-                None => "kept out".to_string(),
-                Some(reason) => format!("restored: needed ({reason})"),
-            }
-        );
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fit::test_support::*;
-    use crate::fit::{fit, FitOptions};
+    use crate::fit::{fit, AccuracyFlag, FitOptions};
 
     #[test]
     fn document_round_trips_through_json_and_rebuilds_the_model() {
@@ -465,10 +324,6 @@ mod tests {
         assert_eq!(back.parameter("b"), result.parameter("b"));
         let correlation = back.correlation.unwrap();
         assert_eq!(correlation.values.len(), correlation.names.len().pow(2));
-        let table = parameter_table(&result);
-        assert!(table.contains("tau") && table.contains("CR %"));
-        let costs = cost_table(&result);
-        assert!(costs.contains("x/u") && costs.contains("J_ave"));
     }
 
     #[test]

@@ -9,8 +9,9 @@ use serde::{Deserialize, Serialize};
 use super::accuracy::{self, AccuracyAnalysis};
 use super::cost::PairBand;
 use super::model::Model;
+use super::options::FitOptions;
 use super::structure::{ModelStructure, ParameterKind};
-use super::{trim, FitOptions};
+use super::trim;
 
 /// How a parameter entered the fit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

@@ -4,13 +4,15 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::accuracy;
 use super::cost::{self, PairGrid};
 use super::error::FitError;
 use super::optimizer;
+use super::options::FitOptions;
 use super::result::parameter_reports;
+use super::result::{FitResult, PairFit, StartOutcome};
 use super::structure::ModelStructure;
 use super::trim::{joint::JointBalance, TrimBalance, TrimError};
-use super::{accuracy, FitOptions, FitResult, PairFit, StartOutcome};
 
 /// What a free parameter starting at exactly zero starts at instead (the first start;
 /// the perturbed ones add spread·U(−1, 1)·0.1 to it).

@@ -37,8 +37,8 @@
 
 use crate::document::{FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
 
+use super::groups::RecordGroup;
 use super::options::{FrfOptions, RangeSource, ResponseEstimator};
-use super::records::RecordGroup;
 use super::FrfError;
 
 mod cross_coherence;

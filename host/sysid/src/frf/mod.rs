@@ -2,11 +2,11 @@
 //! FRESPID (windowed Chirp-Z spectra), MISOSA (multi-input conditioning) and COMPOSITE
 //! (blending several window lengths).
 //!
-//! The chain, one module per step:
+//! The records come from [`crate::records`] (telemetry dumps, CSV files, other tools'
+//! logs); this module never reads a file. The chain, one module per step:
 //!
-//! 1. [`records`] — [`Record`]s (from telemetry dumps via [`load_dump`] or from CSV via
-//!    [`load_csv`]) are gathered into one [`RecordGroup`] per swept axis; the records of
-//!    a group are detrended and joined into one excitation record.
+//! 1. [`groups`] — [`Record`]s are gathered into one [`RecordGroup`] per swept axis; the
+//!    records of a group are detrended and joined into one excitation record.
 //! 2. [`spectra`] — Hann-tapered, overlapped windows of several lengths; each window of
 //!    each channel is transformed once with the [`chirp_z()`] transform and all auto- and
 //!    cross-spectra are formed from those transforms, then interpolated onto a
@@ -21,8 +21,13 @@
 //! 6. [`analysis`] — the whole computation into an [`FrfDocument`], and the
 //!    cross-control coherence.
 //!
+//! [`Record`], [`Channel`] and the dump reader [`load_dump_bytes`] are re-exported from
+//! [`crate::records`]: the record is this module's input, and the flight loop goes from
+//! a dump in memory straight to its cross-control coherence.
+//!
 //! ```no_run
-//! use sysid::frf::{compute_frequency_responses, group_by_primary, load_dump, FrfOptions};
+//! use sysid::frf::{compute_frequency_responses, group_by_primary, FrfOptions};
+//! use sysid::records::load_dump;
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let records = vec![load_dump("lat-1.dump")?, load_dump("lat-2.dump")?, load_dump("lon.dump")?];
@@ -41,12 +46,9 @@ pub mod analysis;
 pub mod chirp_z;
 pub mod coherence;
 pub mod composite;
-pub mod csv;
-pub mod dump;
+pub mod groups;
 pub mod miso;
 pub mod options;
-pub mod origin;
-pub mod records;
 pub mod reference;
 pub mod spectra;
 
@@ -59,88 +61,26 @@ pub use analysis::{
 };
 pub use chirp_z::{chirp_z, ChirpZ};
 pub use coherence::{debiased_coherence, random_error, valid_range};
-pub use csv::units::{TimeUnit, Unit};
-pub use csv::{load_csv, load_csv_records, parse_csv_records, CsvColumns};
-pub use dump::{
-    load_dump, load_dump_bytes, load_dump_with_origin, load_test_dump, record_from_samples,
-    test_record_from_samples,
-};
+pub use groups::{group_by_primary, RecordGroup};
 pub use options::{FrfOptions, RangeSource, ResponseEstimator, ResponseInputs};
-pub use origin::{check_one_origin, DumpOrigin};
-pub use records::{group_by_primary, Channel, Record, RecordGroup};
 pub use spectra::welch_independent_averages;
 
-use std::path::PathBuf;
+use crate::records::RecordError;
+pub use crate::records::{load_dump_bytes, Channel, Record};
 
 /// Why frequency responses could not be computed. Every message fits on one line.
 ///
-/// No variant has a `source()`: where one wraps an error (the I/O cause), its message is
-/// part of this one already (`path: cause`), and error chains printed with `{:#}` would
-/// say it twice.
+/// No variant has a `source()` of its own: a [`RecordError`] is shown as it is, and its
+/// I/O cause is part of its message already (`path: cause`), so error chains printed with
+/// `{:#}` would say it twice.
 #[derive(Debug, thiserror::Error)]
 pub enum FrfError {
-    /// A file could not be read or written.
-    #[error("{}: {error}", .path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        error: std::io::Error,
-    },
-    /// The dump was written with another protocol major version.
-    #[error("{path}: {message}")]
-    Protocol {
-        /// The dump.
-        path: String,
-        /// The decoder's message.
-        message: String,
-    },
-    /// The dump has no Header frame: rate and primary axis are unknown.
-    #[error("{path}: no Header frame (sample rate and swept axis unknown)")]
-    NoHeader {
-        /// The dump.
-        path: String,
-    },
-    /// The dump holds no sweep (no Sample in the fade-in, sweep or fade-out phases, or
-    /// the test was not a sweep).
-    #[error("{path}: no sweep in this dump ({detail})")]
-    NoSweep {
-        /// The dump.
-        path: String,
-        /// What was found instead.
-        detail: String,
-    },
-    /// A CSV file is malformed.
-    #[error("{path}{}: {message}", csv_line(.line))]
-    Csv {
-        /// The file.
-        path: String,
-        /// Line number (1-based), 0 for the whole file.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A record is unusable (inconsistent lengths, non-finite values, bad rate, …).
-    #[error("{record}: {message}")]
-    InvalidRecord {
-        /// The record's source (file name or label).
-        record: String,
-        /// What is wrong.
-        message: String,
-    },
+    /// A record could not be read or is unusable (its message unchanged).
+    #[error(transparent)]
+    Record(#[from] RecordError),
     /// Records grouped together disagree (primary axis, rate, channel names).
     #[error("records do not fit together: {0}")]
     InconsistentGroup(String),
-    /// Dumps whose Headers name different vehicles, protocol versions or rates.
-    #[error("{first} and {other} cannot be joined: their Headers name {what}")]
-    MixedDumps {
-        /// The first dump.
-        first: String,
-        /// The dump that differs from it.
-        other: String,
-        /// What differs, e.g. `vehicle bo105 vs trex700l`.
-        what: String,
-    },
     /// Two groups sweep the same axis.
     #[error("two record groups sweep `{0}`: put its records in one group")]
     DuplicateAxis(String),
@@ -169,13 +109,4 @@ pub enum FrfError {
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
-}
-
-/// `:N` after a CSV file's name for a problem on line N (none for the whole file, 0).
-fn csv_line(line: &usize) -> String {
-    if *line > 0 {
-        format!(":{line}")
-    } else {
-        String::new()
-    }
 }

@@ -106,7 +106,7 @@ pub enum ResponseEstimator {
     /// H = G_zu⁻¹·G_zy with the swept control's recorded excitation (the sweep) as its
     /// instrument and the other controls as their own ([`reference`](super::reference)).
     /// Needs records with reference channels (telemetry dumps, CSV files read with
-    /// [`CsvColumns::references`](super::CsvColumns::references)). Coherences stay those of
+    /// [`CsvColumns::references`](crate::records::CsvColumns::references)). Coherences stay those of
     /// the cross-spectral estimate; the random error grows by the estimator's variance
     /// ratio, and the valid ranges with it. Less biased, more scattered: the measured trade is
     /// in docs/decisions/2026-11-21-sweep-reference-estimator.md.

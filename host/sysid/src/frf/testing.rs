@@ -7,8 +7,8 @@ use sweephold_protocol::{
     MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 
-use super::records::{Channel, Record};
 use crate::random::SplitMix64;
+use crate::records::{Channel, Record};
 
 /// Tischler's exponential sweep, closed form:
 /// θ(t) = ω_min t + (ω_max − ω_min)·C2·[(T/C1)(e^{C1 t/T} − 1) − t], C1 = 4,
@@ -180,7 +180,7 @@ pub fn sample(signal: &dyn Fn(f64) -> f64, rate: f64, len: usize) -> Vec<f64> {
 
 /// Add white Gaussian noise of standard deviation `ratio`·RMS(values).
 pub fn add_noise(values: &mut [f64], ratio: f64, noise: &mut Noise) {
-    let rms = super::records::rms(values);
+    let rms = crate::records::rms(values);
     for v in values.iter_mut() {
         *v += ratio * rms * noise.gaussian();
     }

@@ -1,8 +1,9 @@
 //! The modes of the identified model beside the truth's: one row per identified mode with
 //! the truth mode paired with it, then the truth modes left without a counterpart.
 
+use crate::mode_text::hover_summary;
 use sysid::fit::modes::{
-    eigenvalue_text, hover_summary, ModeName, HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT,
+    eigenvalue_text, ModeName, HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT,
     ORIGIN_LIMIT_RAD_S,
 };
 

@@ -1,7 +1,8 @@
 //! The campaign summary: the setup, the issues' bars with pass/fail, the wall time per
 //! stage.
 
-use sysid::fit::modes::{origin_text, HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT};
+use crate::mode_text::origin_text;
+use sysid::fit::modes::{HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT};
 
 use super::{fmt, mode_of, KEY_PARAMETERS};
 use crate::artifacts::stage::Stage;

@@ -1,6 +1,14 @@
 //! Tests of the mode computation and naming on exact synthetic systems.
 
+use std::f64::consts::LN_2;
+
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+use super::eigen::*;
+use super::naming::*;
 use super::*;
+use crate::fit::model::Model;
 use crate::fit::test_support::*;
 
 fn names(list: &[&str]) -> Vec<String> {
@@ -289,17 +297,11 @@ fn a_lost_mode_at_the_origin_is_counted_and_fails_its_match() {
     assert!(close(origin.error_percent.unwrap(), 100.0, 1e-9));
     assert_eq!(comparison.hover.matched, 3);
     assert!(!comparison.hover.all_matched());
-    let line = hover_summary(&comparison.hover, comparison.poles_at_origin);
-    assert_eq!(
-        line,
-        "hover modes 3/4 within 25 % of the truth (worst 100.0 %), 1 pole at the origin"
-    );
-    let table = mode_table(&comparison.identified);
-    assert!(
-        table.contains("origin") && table.contains("error %"),
-        "{table}"
-    );
-    assert!(!mode_table(&mode_records(&truth).unwrap()).contains("error %"));
+    assert_eq!(comparison.hover.worst_error_percent, Some(100.0));
+    assert!(mode_records(&truth)
+        .unwrap()
+        .iter()
+        .all(|r| r.truth.is_none() && r.error_percent.is_none()));
 }
 
 #[test]
@@ -308,7 +310,6 @@ fn bo105_reference_hybrid_has_its_hover_modes() {
     let structure = hybrid_structure();
     let model = structure.model(&hybrid_truth_values(&structure)).unwrap();
     let records = mode_records(&model).unwrap();
-    let table = mode_table(&records);
     let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
     assert_eq!(
         names,
@@ -320,7 +321,7 @@ fn bo105_reference_hybrid_has_its_hover_modes() {
             "pitch–flap",
             "roll–flap"
         ],
-        "{table}"
+        "{records:#?}"
     );
     assert_eq!(poles_at_origin(&records), 0);
     let hover = records

@@ -60,7 +60,7 @@ use std::fmt;
 use nalgebra::DVector;
 
 use super::model::Model;
-use crate::frf::records::Record;
+use crate::records::Record;
 
 mod score;
 mod simulate;

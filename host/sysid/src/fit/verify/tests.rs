@@ -5,7 +5,7 @@ use nalgebra::DMatrix;
 
 use super::score::rms;
 use super::*;
-use crate::frf::records::Channel;
+use crate::records::Channel;
 
 fn names(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()

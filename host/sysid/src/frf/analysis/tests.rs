@@ -5,9 +5,9 @@ use num_complex::Complex64;
 use super::responses::anchor_phase_branch;
 use super::*;
 use crate::frf::options::{ResponseEstimator, ResponseInputs};
-use crate::frf::records::Channel;
 use crate::frf::testing::{add_noise, dump_bytes, record, sample, Block, DumpSpec, Noise, Sweep};
 use crate::frf::{load_dump_bytes, Record, RecordGroup};
+use crate::records::Channel;
 
 const RATE: f64 = 200.0;
 
@@ -542,16 +542,16 @@ fn a_csv_reference_column_feeds_the_reference_estimator() {
         let t = k as f64 / RATE;
         text += &format!("{t},{},{},{}\n", control[k], output[k], excitation[k]);
     }
-    let columns = crate::frf::CsvColumns {
+    let columns = crate::records::CsvColumns {
         time: "t".into(),
         inputs: vec![("lat".into(), "stick".into())],
         outputs: vec![("p".into(), "rate".into())],
         references: vec![("lat".into(), "injected".into())],
         primary: Some("lat".into()),
         sweep_band: Some([0.5, 20.0]),
-        ..crate::frf::CsvColumns::default()
+        ..crate::records::CsvColumns::default()
     };
-    let record = crate::frf::csv::parse_csv(&text, "loop.csv", &columns).unwrap();
+    let record = crate::records::csv::parse_csv(&text, "loop.csv", &columns).unwrap();
     let mean_error = |estimator| {
         let opts = FrfOptions {
             estimator,

@@ -1,6 +1,7 @@
 //! Tests of the CSV reader.
 
 use super::*;
+use units::Unit;
 
 fn columns() -> CsvColumns {
     CsvColumns {

@@ -6,7 +6,7 @@
 
 use sweephold_protocol::{Header, ProtocolVersion, VehicleId};
 
-use super::FrfError;
+use super::RecordError;
 
 /// What a dump's Header says about the record's origin.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -56,13 +56,13 @@ impl DumpOrigin {
 
 /// Refuse dumps whose Headers name different vehicles, protocol versions or rates: the
 /// first that differs from the first dump is named with it and what differs.
-pub fn check_one_origin(origins: &[DumpOrigin]) -> Result<(), FrfError> {
+pub fn check_one_origin(origins: &[DumpOrigin]) -> Result<(), RecordError> {
     let Some(first) = origins.first() else {
         return Ok(());
     };
     for origin in &origins[1..] {
         if let Some(what) = first.difference(origin) {
-            return Err(FrfError::MixedDumps {
+            return Err(RecordError::MixedDumps {
                 first: first.source.clone(),
                 other: origin.source.clone(),
                 what,
@@ -75,8 +75,8 @@ pub fn check_one_origin(origins: &[DumpOrigin]) -> Result<(), FrfError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frf::dump::load_dump_with_origin;
     use crate::frf::testing::{dump_bytes, DumpSpec};
+    use crate::records::dump::load_dump_with_origin;
 
     fn origin(source: &str, vehicle: VehicleId, minor: u16, rate_hz: u16) -> DumpOrigin {
         DumpOrigin {

@@ -16,8 +16,8 @@ use std::path::Path;
 use sweephold_protocol::{tick_step, Decoder, Frame, FrameError, Header, Phase, Sample, TickStep};
 
 use super::origin::DumpOrigin;
-use super::records::{Channel, Record};
-use super::FrfError;
+use super::record::{Channel, Record};
+use super::RecordError;
 
 /// Names of the dump's input channels, in wire order.
 pub const DUMP_INPUTS: [&str; 4] = ["lat", "lon", "ped", "col"];
@@ -31,13 +31,13 @@ pub const DUMP_OUTPUTS: [&str; 11] = [
 const MAX_MISSING_FRACTION: f64 = 0.1;
 
 /// Load the excitation record of a telemetry dump file.
-pub fn load_dump(path: impl AsRef<Path>) -> Result<Record, FrfError> {
+pub fn load_dump(path: impl AsRef<Path>) -> Result<Record, RecordError> {
     load_dump_with(path, Excitation::Sweep)
 }
 
 /// Like [`load_dump`], but the test may be any excitation (sweep, doublet, 3-2-1-1): the
 /// records time-domain verification replays.
-pub fn load_test_dump(path: impl AsRef<Path>) -> Result<Record, FrfError> {
+pub fn load_test_dump(path: impl AsRef<Path>) -> Result<Record, RecordError> {
     load_dump_with(path, Excitation::Any)
 }
 
@@ -53,9 +53,9 @@ enum Excitation {
 /// Like [`load_dump`], with what the record's Header says about where it came from: the
 /// vehicle, protocol version and rate that [`check_one_origin`](super::origin::check_one_origin)
 /// compares before dumps are joined.
-pub fn load_dump_with_origin(path: impl AsRef<Path>) -> Result<(Record, DumpOrigin), FrfError> {
+pub fn load_dump_with_origin(path: impl AsRef<Path>) -> Result<(Record, DumpOrigin), RecordError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|error| FrfError::Io {
+    let bytes = std::fs::read(path).map_err(|error| RecordError::Io {
         path: path.to_path_buf(),
         error,
     })?;
@@ -64,9 +64,9 @@ pub fn load_dump_with_origin(path: impl AsRef<Path>) -> Result<(Record, DumpOrig
     Ok((record, DumpOrigin::of(&source, &header)))
 }
 
-fn load_dump_with(path: impl AsRef<Path>, excitation: Excitation) -> Result<Record, FrfError> {
+fn load_dump_with(path: impl AsRef<Path>, excitation: Excitation) -> Result<Record, RecordError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|error| FrfError::Io {
+    let bytes = std::fs::read(path).map_err(|error| RecordError::Io {
         path: path.to_path_buf(),
         error,
     })?;
@@ -108,7 +108,7 @@ fn outputs_of(sample: &Sample) -> [f64; 11] {
 pub const SETTLE_S: f64 = 2.0;
 
 /// Load the excitation record from the bytes of a dump; `source` names it in messages.
-pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, FrfError> {
+pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, RecordError> {
     load_dump_bytes_with(bytes, source, Excitation::Sweep).map(|(record, _)| record)
 }
 
@@ -117,7 +117,7 @@ fn load_dump_bytes_with(
     bytes: &[u8],
     source: &str,
     excitation: Excitation,
-) -> Result<(Record, Header), FrfError> {
+) -> Result<(Record, Header), RecordError> {
     let mut decoder = Decoder::new();
     // Samples per test: a new segment starts at every Header.
     let mut segments: Vec<(Option<Header>, Vec<Sample>)> = vec![(None, Vec::new())];
@@ -131,7 +131,7 @@ fn load_dump_bytes_with(
             }
             Ok(_) => {}
             Err(mismatch @ FrameError::VersionMismatch { .. }) => {
-                return Err(FrfError::Protocol {
+                return Err(RecordError::Protocol {
                     path: source.into(),
                     message: mismatch.to_string(),
                 })
@@ -146,22 +146,22 @@ fn load_dump_bytes_with(
     let Some((record_header, all)) = chosen.map(|index| &segments[index]) else {
         let any_header = segments.iter().any(|(h, _)| h.is_some());
         return Err(if stats.good_frames == 0 {
-            FrfError::NoSweep {
+            RecordError::NoSweep {
                 path: source.into(),
                 detail: "no valid frame".into(),
             }
         } else if !any_header {
-            FrfError::NoHeader {
+            RecordError::NoHeader {
                 path: source.into(),
             }
         } else {
-            FrfError::NoSweep {
+            RecordError::NoSweep {
                 path: source.into(),
                 detail: "no Sample in the fade-in, sweep or fade-out phases".into(),
             }
         });
     };
-    let header = record_header.ok_or_else(|| FrfError::NoHeader {
+    let header = record_header.ok_or_else(|| RecordError::NoHeader {
         path: source.into(),
     })?;
     // Samples of the dump before the chosen test's: messages count from the dump's first.
@@ -181,7 +181,7 @@ pub fn record_from_samples(
     header: &Header,
     all: &[Sample],
     source: &str,
-) -> Result<Record, FrfError> {
+) -> Result<Record, RecordError> {
     record_from_samples_at(header, all, 0, source, Excitation::Sweep)
 }
 
@@ -191,7 +191,7 @@ pub fn test_record_from_samples(
     header: &Header,
     all: &[Sample],
     source: &str,
-) -> Result<Record, FrfError> {
+) -> Result<Record, RecordError> {
     record_from_samples_at(header, all, 0, source, Excitation::Any)
 }
 
@@ -210,9 +210,9 @@ fn record_from_samples_at(
     offset: usize,
     source: &str,
     excitation: Excitation,
-) -> Result<Record, FrfError> {
+) -> Result<Record, RecordError> {
     let Some(first) = all.iter().position(|s| is_excitation(s.phase)) else {
-        return Err(FrfError::NoSweep {
+        return Err(RecordError::NoSweep {
             path: source.into(),
             detail: "no Sample in the fade-in, sweep or fade-out phases".into(),
         });
@@ -236,13 +236,13 @@ fn record_from_samples_at(
     let samples = &all[first - before..=last + after];
     let test = header.test;
     if excitation == Excitation::Sweep && !test.input.is_sweep() {
-        return Err(FrfError::NoSweep {
+        return Err(RecordError::NoSweep {
             path: source.into(),
             detail: format!("the test is a {:?}, not a sweep", test.input),
         });
     }
     if header.rate_hz == 0 {
-        return Err(FrfError::InvalidRecord {
+        return Err(RecordError::InvalidRecord {
             record: source.into(),
             message: "Header rate is 0 Hz".into(),
         });
@@ -252,7 +252,7 @@ fn record_from_samples_at(
     // rather than drop samples (or read a step back as ~4·10⁹ missing ticks).
     if let Some((at, before_tick, tick)) = first_step_back(samples) {
         let index = offset + (first - before) + at;
-        return Err(FrfError::InvalidRecord {
+        return Err(RecordError::InvalidRecord {
             record: source.into(),
             message: format!("ticks step back at sample {index} (tick {before_tick} → {tick})"),
         });
@@ -266,7 +266,7 @@ fn record_from_samples_at(
     let span = usize::try_from(span).unwrap_or(usize::MAX);
     let missing = span.saturating_sub(samples.len());
     if missing as f64 > MAX_MISSING_FRACTION * span as f64 {
-        return Err(FrfError::InvalidRecord {
+        return Err(RecordError::InvalidRecord {
             record: source.into(),
             message: format!("{missing} of {span} sweep ticks are missing"),
         });
@@ -526,7 +526,7 @@ mod tests {
             .copied()
             .collect();
         let err = record_from_samples(&header, &idle, "idle").unwrap_err();
-        assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
+        assert!(matches!(err, RecordError::NoSweep { .. }), "{err}");
     }
 
     #[test]
@@ -536,15 +536,15 @@ mod tests {
             ..DumpSpec::default()
         };
         let err = load_dump_bytes(&dump_bytes(&no_sweep), "idle.dump").unwrap_err();
-        assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
+        assert!(matches!(err, RecordError::NoSweep { .. }), "{err}");
         let headless = DumpSpec {
             with_header: false,
             ..DumpSpec::default()
         };
         let err = load_dump_bytes(&dump_bytes(&headless), "x.dump").unwrap_err();
-        assert!(matches!(err, FrfError::NoHeader { .. }), "{err}");
+        assert!(matches!(err, RecordError::NoHeader { .. }), "{err}");
         let err = load_dump_bytes(b"not a dump at all", "junk").unwrap_err();
-        assert!(matches!(err, FrfError::NoSweep { .. }), "{err}");
+        assert!(matches!(err, RecordError::NoSweep { .. }), "{err}");
         let doublet = DumpSpec {
             input: sweephold_protocol::InputKind::Doublet,
             ..DumpSpec::default()

@@ -32,84 +32,17 @@
 //! row; else the input with the largest RMS about its trend line, and the record is
 //! marked [`Record::primary_guessed`].
 
+pub mod columns;
 pub mod timing;
 pub mod units;
 
 use std::path::Path;
 
-use super::records::{remove_line, rms, Channel, Record};
-use super::FrfError;
+use super::record::{remove_line, rms, Channel, Record};
+use super::RecordError;
+pub use columns::{CsvColumns, PRIMARY_COLUMN};
 use timing::{median, uniform_samples};
-use units::{deg_per_s_note, detected_time_unit, TimeUnit, Unit};
-
-/// Which CSV columns to read, and how.
-#[derive(Clone, Debug, PartialEq)]
-pub struct CsvColumns {
-    /// Time column: a header name or a position (1 = first).
-    pub time: String,
-    /// Inputs as (channel name, column).
-    pub inputs: Vec<(String, String)>,
-    /// Outputs as (channel name, column).
-    pub outputs: Vec<(String, String)>,
-    /// References as (input name, column): the excitation injected into that input (the
-    /// sweep), for [`ResponseEstimator::SweepReference`](super::ResponseEstimator::SweepReference).
-    pub references: Vec<(String, String)>,
-    /// The swept input (a channel name, `frf --swept`); it overrides the file's primary
-    /// column. `None`: the primary column names it, else the input with the largest RMS
-    /// about its trend line does.
-    pub primary: Option<String>,
-    /// Column naming the swept axis on each row, read when the file has it and `primary`
-    /// is `None`. Its value must be the same on every kept row and name an input, by its
-    /// channel name or by the decode command column it is read from (`lat` names the
-    /// input read from `cmd_lat`, whatever that input is called).
-    pub primary_column: Option<String>,
-    /// Phase column used to keep only excitation rows, when the file has it.
-    pub phase_column: Option<String>,
-    /// Sweep band [rad/s], if known.
-    pub sweep_band: Option<[f64; 2]>,
-    /// Units of channels, by channel name (a reference takes its input's); channels not
-    /// named are used as written.
-    pub units: Vec<(String, Unit)>,
-    /// Unit of the time column; `None`: told from its median step ([`units`]).
-    pub time_unit: Option<TimeUnit>,
-    /// Keep only the rows whose time \[s\] lies in [t0, t1].
-    pub window_s: Option<[f64; 2]>,
-}
-
-impl Default for CsvColumns {
-    /// The columns of `sweephold decode` CSV output.
-    fn default() -> Self {
-        let same = |names: &[&str]| {
-            names
-                .iter()
-                .map(|n| (n.to_string(), n.to_string()))
-                .collect()
-        };
-        CsvColumns {
-            time: "time_s".into(),
-            inputs: vec![
-                ("lat".into(), "cmd_lat".into()),
-                ("lon".into(), "cmd_lon".into()),
-                ("ped".into(), "cmd_ped".into()),
-                ("col".into(), "cmd_col".into()),
-            ],
-            outputs: same(&[
-                "u", "v", "w", "p", "q", "r", "ax", "ay", "az", "phi", "theta",
-            ]),
-            references: Vec::new(),
-            primary: None,
-            primary_column: Some(PRIMARY_COLUMN.into()),
-            phase_column: Some("phase".into()),
-            sweep_band: None,
-            units: Vec::new(),
-            time_unit: None,
-            window_s: None,
-        }
-    }
-}
-
-/// The column `sweephold decode` writes the swept axis into.
-pub const PRIMARY_COLUMN: &str = "primary";
+use units::{deg_per_s_note, detected_time_unit, TimeUnit};
 
 /// Phases kept when the file has a phase column.
 const EXCITATION_PHASES: [&str; 3] = ["fade_in", "sweep", "fade_out"];
@@ -118,8 +51,8 @@ fn field(raw: &str) -> &str {
     raw.trim().trim_matches('"').trim()
 }
 
-fn read(path: &Path) -> Result<String, FrfError> {
-    std::fs::read_to_string(path).map_err(|error| FrfError::Io {
+fn read(path: &Path) -> Result<String, RecordError> {
+    std::fs::read_to_string(path).map_err(|error| RecordError::Io {
         path: path.to_path_buf(),
         error,
     })
@@ -127,7 +60,7 @@ fn read(path: &Path) -> Result<String, FrfError> {
 
 /// Load a record from a CSV file; a file that long gaps split into several records is
 /// refused (read it with [`load_csv_records`]).
-pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, FrfError> {
+pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, RecordError> {
     let path = path.as_ref();
     parse_csv(&read(path)?, &path.display().to_string(), columns)
 }
@@ -136,17 +69,17 @@ pub fn load_csv(path: impl AsRef<Path>, columns: &CsvColumns) -> Result<Record, 
 pub fn load_csv_records(
     path: impl AsRef<Path>,
     columns: &CsvColumns,
-) -> Result<Vec<Record>, FrfError> {
+) -> Result<Vec<Record>, RecordError> {
     let path = path.as_ref();
     parse_csv_records(&read(path)?, &path.display().to_string(), columns)
 }
 
 /// Parse CSV text into one record; `source` names it in messages. A file that long gaps
 /// split into several records is refused (read it with [`parse_csv_records`]).
-pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Record, FrfError> {
+pub fn parse_csv(text: &str, source: &str, columns: &CsvColumns) -> Result<Record, RecordError> {
     let mut records = parse_csv_records(text, source, columns)?;
     if records.len() > 1 {
-        return Err(FrfError::Csv {
+        return Err(RecordError::Csv {
             path: source.into(),
             line: 0,
             message: format!(
@@ -179,8 +112,8 @@ pub fn parse_csv_records(
     text: &str,
     source: &str,
     columns: &CsvColumns,
-) -> Result<Vec<Record>, FrfError> {
-    let error = |line: usize, message: String| FrfError::Csv {
+) -> Result<Vec<Record>, RecordError> {
+    let error = |line: usize, message: String| RecordError::Csv {
         path: source.into(),
         line,
         message,
@@ -374,8 +307,8 @@ fn header(first: &str) -> (Option<Vec<&str>>, usize) {
 }
 
 /// Read the rows of `text`: the kept rows' times and channel values.
-fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Rows, FrfError> {
-    let error = |line: usize, message: String| FrfError::Csv {
+fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Rows, RecordError> {
+    let error = |line: usize, message: String| RecordError::Csv {
         path: source.into(),
         line,
         message,
@@ -390,7 +323,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
     if names.is_some() {
         lines.next();
     }
-    let find = |column: &str| -> Result<usize, FrfError> {
+    let find = |column: &str| -> Result<usize, RecordError> {
         if let Some(i) = names
             .as_ref()
             .and_then(|n| n.iter().position(|n| *n == column))
@@ -544,7 +477,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
             }
         }
         // An empty or non-finite field is a missing sample; anything else must be a number.
-        let number = |index: usize| -> Result<Option<f64>, FrfError> {
+        let number = |index: usize| -> Result<Option<f64>, RecordError> {
             let text = fields[index];
             if text.is_empty() {
                 return Ok(None);
@@ -585,7 +518,7 @@ fn swept_input(
     source: &str,
     columns: &CsvColumns,
     notes: &mut Vec<String>,
-) -> Result<(String, bool), FrfError> {
+) -> Result<(String, bool), RecordError> {
     let input_names = || {
         columns
             .inputs
@@ -605,7 +538,7 @@ fn swept_input(
                 .find(|(name, _)| name == axis)
                 .or_else(|| columns.inputs.iter().find(|(_, c)| *c == command_column))
                 .map(|(name, _)| name.clone());
-            Some(input.ok_or_else(|| FrfError::Csv {
+            Some(input.ok_or_else(|| RecordError::Csv {
                 path: source.into(),
                 line: 0,
                 message: format!(
