@@ -4,6 +4,7 @@
 pub mod board_flash;
 pub mod defmt_log;
 pub mod frame_channel;
+pub mod imu_fault;
 pub mod link;
 pub mod link_board_sim;
 pub mod link_qemu;
