@@ -2,7 +2,7 @@
 //! file describes is its firmware preset with the file's `[flight_controller]` settings
 //! (the configuration `fly` and `campaign` build from it) and the mixer and servo frame
 //! rates of its `[swash]` table; its values are the parameter table's
-//! ([`typed::values_of`](sweephold_firmware::params::typed::values_of)).
+//! ([`sweephold_firmware::params::typed::values_of`]).
 //!
 //! Pushed are the parameters the file determines — swash type, phase and lead servo,
 //! every servo's direction, centre, limits and throw, the frame rates, the mixer's

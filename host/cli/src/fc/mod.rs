@@ -105,7 +105,7 @@ pub enum ParamsAction {
         file: PathBuf,
     },
     /// Set the board's RAM to a params file's values, or to an aircraft file's (its
-    /// [flight_controller] and [swash] tables), all or nothing.
+    /// `[flight_controller]` and `[swash]` tables), all or nothing.
     Push {
         /// The params file or aircraft file to read.
         file: PathBuf,

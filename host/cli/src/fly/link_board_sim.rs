@@ -15,7 +15,7 @@
 //!    and the sequencer's telemetry goes into the dump as with the in-process link;
 //! 5. the servo pulses reach the simulated rotor through the aircraft's servo geometry
 //!    (its `[swash]` table), each servo taking a new pulse only when one of its frames
-//!    starts ([`servo_plant`](super::servo_plant)): the simulator flies what the servos
+//!    starts ([`super::servo_plant`]): the simulator flies what the servos
 //!    do, not the command.
 //!
 //! # The board's setup

@@ -203,7 +203,7 @@ pub struct FlyArgs {
     /// default 460800 Bd; records flown one at a time) or `board-sim` (the board
     /// application's sensor-to-servo stack on an emulated IMU and SBUS receiver, booted,
     /// armed and hovering before each record, its servo pulses flown through the
-    /// aircraft's [swash] geometry; see --vibration, --rc-loss, --imu-fault, --fly-on).
+    /// aircraft's `[swash]` geometry; see --vibration, --rc-loss, --imu-fault, --fly-on).
     /// `board-sim` is set up from the aircraft file; `board-sim:FLASH` boots the
     /// parameter set saved in FLASH (`sweephold fc params … --fc board-sim:FLASH`; never
     /// written here) and takes only each record's test and rate from the command line.
