@@ -117,11 +117,11 @@ PHASES = ["idle", "armed", "trim_capture", "fade_in", "sweep", "fade_out", "done
 ABORT_REASONS = ["attitude_limit", "rate_limit", "sensor_not_finite", "sensor_stale",
                  "pilot_override", "switch_released", "rc_lost", "imu_fault", "disarmed"]
 EVENTS = ["phase_change", "hold_engaged", "hold_released", "trim_captured", "abort",
-          "mode_change", "imu_health", "refused", "host_link_ignored"]
+          "mode_change", "imu_health", "refused", "host_link_ignored", "param_store"]
 IMU_HEALTH = ["ok", "calibrating", "missing", "stuck", "saturated", "not_ready", "not_finite",
               "stale"]
 FRAME_KINDS = ["header", "sample", "event", "sensor_in", "actuator_out", "configure",
-               "configure_result"]
+               "configure_result", "param_request", "param_reply"]
 
 
 def varint(n):
@@ -188,6 +188,8 @@ def parse(raw):
     if zlib.crc32(payload) != crc:
         raise ValueError("CRC mismatch")
     kind, i = read_varint(payload, 0)
+    if kind >= len(FRAME_KINDS):
+        raise ValueError(f"frame kind {kind} unknown to this check (protocol newer than it)")
     if FRAME_KINDS[kind] == "actuator_out":
         tick, i = read_varint(payload, i)
         seq, i = read_varint(payload, i)
@@ -201,6 +203,8 @@ def parse(raw):
     if FRAME_KINDS[kind] == "event":
         variant, i = read_varint(payload, i)
         tick, i = read_varint(payload, i)
+        if variant >= len(EVENTS):
+            raise ValueError(f"event {variant} unknown to this check (protocol newer than it)")
         if EVENTS[variant] == "phase_change":
             return ("event", "phase_change", tick, PHASES[payload[i]], PHASES[payload[i + 1]])
         if EVENTS[variant] == "abort":
@@ -254,13 +258,15 @@ def check(elf, steps, workdir):
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         link = Link(socket_path)
-        # The board application: its Header, the IMU reported missing on its first
-        # tick (nothing on QEMU's SPI1), then one Sample per tick.
-        standalone = [link.frame(5.0) for _ in range(11)]
+        # The board application: its Header, what its parameter store held (QEMU's
+        # flash is blank: the defaults), the IMU reported missing on its first tick
+        # (nothing on QEMU's SPI1), then one Sample per tick.
+        standalone = [link.frame(5.0) for _ in range(12)]
         kinds = [f[0] if f else None for f in standalone]
-        assert kinds[:2] == ["header", "event"] and kinds[2:] == ["sample"] * 9, f"standalone stream: {kinds}"
-        assert standalone[1][1:] == ("imu_health", 0, "missing"), f"first event: {standalone[1]}"
-        say("standalone: Header, IMU missing at tick 0, Samples")
+        assert kinds[:3] == ["header", "event", "event"] and kinds[3:] == ["sample"] * 9, f"standalone stream: {kinds}"
+        assert standalone[1][1] == "param_store", f"first event: {standalone[1]}"
+        assert standalone[2][1:] == ("imu_health", 0, "missing"), f"second event: {standalone[2]}"
+        say("standalone: Header, parameter store, IMU missing at tick 0, Samples")
 
         sticks = (0.1, -0.1, 0.05, 0.2)
         first_tick = last_tick = None
