@@ -46,6 +46,11 @@ pub fn params(vehicle: &Vehicle) -> anyhow::Result<Params> {
     let mut flight = vehicle.firmware_config(Axis::Lat);
     flight.mixer = servo_plant::board_mixer(swash);
     let mut params = Params::preset(flight.vehicle);
+    // The board's collective source (the pilot's) unless the file states one: the
+    // in-the-loop default, the trim, is not the board's.
+    if vehicle.aircraft().flight_controller.collective.is_none() {
+        flight.collective = params.stack.app.flight.collective;
+    }
     params.stack.app.flight = flight;
     [params.swash_frame_hz, params.tail_frame_hz] = servo_plant::board_frame_rates(swash);
     // The table's own check: every value in range and the set consistent.
