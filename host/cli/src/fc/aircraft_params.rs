@@ -8,9 +8,12 @@
 //! every servo's direction, centre, limits and throw, the frame rates, the mixer's
 //! scales and ring, the hold's gains, limits, time constants, directions, reference and
 //! thresholds, the abort limits, the pulse width, the excitation scale and the command
-//! slew — each the file's value or, where the file states none, its preset's. Not pushed:
-//! the board's installation (receiver map and ranges, IMU mounting), the head and tail
-//! rotor speeds of the notches (the presets' filter bank, as `fly` flies it) and the test
+//! slew — each the file's value or, where the file states none, its preset's — and the
+//! test's collective source (`TEST_COL_SRC`) only if the file states `collective` (the
+//! presets' `trim` is the in-the-loop choice, the board's own default is `pilot`). Not
+//! pushed: the board's installation (receiver map and ranges, IMU mounting), the head and
+//! tail rotor speeds of the notches (the presets' filter bank, as `fly` flies it), the
+//! airborne rule (`AIR_COL_MIN`, `AIR_TIME`: the pilot's collective habits) and the test
 //! (chosen per record).
 
 use sweephold_firmware::params::{typed, ParamId, ParamTable, Params};
@@ -21,7 +24,7 @@ use crate::fly::servo_plant;
 use crate::vehicle::Vehicle;
 
 /// The parameters an aircraft file does not set.
-const NOT_FROM_THE_AIRCRAFT: [&str; 8] = [
+const NOT_FROM_THE_AIRCRAFT: [&str; 9] = [
     "RC_",
     "IMU_ROT",
     "HEAD_RPM",
@@ -30,10 +33,14 @@ const NOT_FROM_THE_AIRCRAFT: [&str; 8] = [
     "SWP_",
     "PULSE_AMP",
     "NOISE_",
+    "AIR_",
 ];
 
-/// Whether `id` is one the aircraft file determines.
-fn from_the_aircraft(id: ParamId) -> bool {
+/// Whether `id` is one `vehicle`'s file determines.
+fn from_the_aircraft(id: ParamId, vehicle: &Vehicle) -> bool {
+    if id == ParamId::TestColSrc {
+        return vehicle.aircraft().flight_controller.collective.is_some();
+    }
     let name = id.def().name;
     !NOT_FROM_THE_AIRCRAFT
         .iter()
@@ -78,7 +85,7 @@ pub fn values(vehicle: &Vehicle) -> anyhow::Result<Vec<BoardValue>> {
     let values = typed::values_of(&params(vehicle)?);
     Ok(ParamId::ALL
         .iter()
-        .filter(|id| from_the_aircraft(**id))
+        .filter(|id| from_the_aircraft(**id, vehicle))
         .map(|id| BoardValue {
             name: id.def().name.to_string(),
             value: values[id.index()],
@@ -89,6 +96,41 @@ pub fn values(vehicle: &Vehicle) -> anyhow::Result<Vec<BoardValue>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sweephold_firmware::CollectiveSource;
+
+    #[test]
+    fn a_stated_collective_is_pushed_and_the_board_default_kept_otherwise() {
+        let dir = std::env::temp_dir().join(format!("sweephold-col-src-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("trex-trim-collective.toml");
+        let text = aircraft::SHIPPED[1]
+            .1
+            .replacen("name = \"trex700l\"", "name = \"trex-trim-collective\"", 1)
+            .replacen(
+                "preset = \"trex700l\"",
+                "preset = \"trex700l\"\ncollective = \"trim\"",
+                1,
+            );
+        std::fs::write(&path, text).unwrap();
+        let stated = Vehicle::parse(path.to_str().unwrap()).unwrap();
+        let pushed = values(&stated).unwrap();
+        let col_src: Vec<f32> = pushed
+            .iter()
+            .filter(|v| v.name == "TEST_COL_SRC")
+            .map(|v| v.value)
+            .collect();
+        assert_eq!(col_src, [0.0]);
+        assert_eq!(
+            params(&stated).unwrap().stack.app.flight.collective,
+            CollectiveSource::Trim
+        );
+        let shipped = Vehicle::shipped("trex700l");
+        assert_eq!(
+            params(&shipped).unwrap().stack.app.flight.collective,
+            CollectiveSource::Pilot
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn the_fbl700_file_maps_onto_its_servo_geometry_and_settings() {
@@ -137,13 +179,19 @@ mod tests {
             "TEST_AXIS",
             "SWP_AMP",
             "NOISE_RMS",
+            "TEST_COL_SRC",
+            "AIR_COL_MIN",
+            "AIR_TIME",
         ] {
             assert!(values.iter().all(|v| v.name != name), "{name} pushed");
         }
-        // The typed set flies the configuration `fly` builds from the file.
+        // The typed set flies the configuration `fly` builds from the file, but for the
+        // collective: the file states none, so the board keeps its own, the pilot's.
         let params = params(&vehicle).unwrap();
         let mut expected = vehicle.firmware_config(Axis::Lat);
         expected.mixer = servo_plant::board_mixer(&vehicle.aircraft().swash);
+        assert_eq!(expected.collective, CollectiveSource::Trim);
+        expected.collective = CollectiveSource::Pilot;
         assert_eq!(params.stack.app.flight, expected);
     }
 
