@@ -8,10 +8,10 @@
 //! every servo's direction, centre, limits and throw, the frame rates, the mixer's
 //! scales and ring, the hold's gains, limits, time constants, directions, reference and
 //! thresholds, the abort limits, the pulse width, the excitation scale and the command
-//! slew — each the file's value or, where the file states none, its preset's — and the
-//! test's collective source (`TEST_COL_SRC`) only if the file states `collective` (the
-//! presets' `trim` is the in-the-loop choice, the board's own default is `pilot`). Not
-//! pushed: the board's installation (receiver map and ranges, IMU mounting), the head and
+//! slew and the test's collective source (`TEST_COL_SRC`: the board's table defaults to
+//! `pilot`, an aircraft file that states no `collective` has its preset's `trim`, so
+//! that a board set up from a file flies as `--fc board-sim` flies that file) — each the
+//! file's value or, where the file states none, its preset's. Not pushed: the board's installation (receiver map and ranges, IMU mounting), the head and
 //! tail rotor speeds of the notches (the presets' filter bank, as `fly` flies it), the
 //! airborne rule (`AIR_COL_MIN`, `AIR_TIME`: the pilot's collective habits) and the test
 //! (chosen per record).
@@ -36,10 +36,11 @@ const NOT_FROM_THE_AIRCRAFT: [&str; 9] = [
     "AIR_",
 ];
 
-/// Whether `id` is one `vehicle`'s file determines.
-fn from_the_aircraft(id: ParamId, vehicle: &Vehicle) -> bool {
+/// Whether `id` is one the aircraft file determines.
+fn from_the_aircraft(id: ParamId) -> bool {
     if id == ParamId::TestColSrc {
-        return vehicle.aircraft().flight_controller.collective.is_some();
+        // A `TEST_` parameter, but the flight logic's, not the test's.
+        return true;
     }
     let name = id.def().name;
     !NOT_FROM_THE_AIRCRAFT
@@ -53,11 +54,6 @@ pub fn params(vehicle: &Vehicle) -> anyhow::Result<Params> {
     let mut flight = vehicle.firmware_config(Axis::Lat);
     flight.mixer = servo_plant::board_mixer(swash);
     let mut params = Params::preset(flight.vehicle);
-    // The board's collective source (the pilot's) unless the file states one: the
-    // in-the-loop default, the trim, is not the board's.
-    if vehicle.aircraft().flight_controller.collective.is_none() {
-        flight.collective = params.stack.app.flight.collective;
-    }
     params.stack.app.flight = flight;
     [params.swash_frame_hz, params.tail_frame_hz] = servo_plant::board_frame_rates(swash);
     // The table's own check: every value in range and the set consistent.
@@ -85,7 +81,7 @@ pub fn values(vehicle: &Vehicle) -> anyhow::Result<Vec<BoardValue>> {
     let values = typed::values_of(&params(vehicle)?);
     Ok(ParamId::ALL
         .iter()
-        .filter(|id| from_the_aircraft(**id, vehicle))
+        .filter(|id| from_the_aircraft(**id))
         .map(|id| BoardValue {
             name: id.def().name.to_string(),
             value: values[id.index()],
@@ -99,16 +95,16 @@ mod tests {
     use sweephold_firmware::CollectiveSource;
 
     #[test]
-    fn a_stated_collective_is_pushed_and_the_board_default_kept_otherwise() {
+    fn the_file_s_collective_is_pushed() {
         let dir = std::env::temp_dir().join(format!("sweephold-col-src-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("trex-trim-collective.toml");
+        let path = dir.join("trex-pilot-collective.toml");
         let text = aircraft::SHIPPED[1]
             .1
-            .replacen("name = \"trex700l\"", "name = \"trex-trim-collective\"", 1)
+            .replacen("name = \"trex700l\"", "name = \"trex-pilot-collective\"", 1)
             .replacen(
                 "preset = \"trex700l\"",
-                "preset = \"trex700l\"\ncollective = \"trim\"",
+                "preset = \"trex700l\"\ncollective = \"pilot\"",
                 1,
             );
         std::fs::write(&path, text).unwrap();
@@ -119,15 +115,15 @@ mod tests {
             .filter(|v| v.name == "TEST_COL_SRC")
             .map(|v| v.value)
             .collect();
-        assert_eq!(col_src, [0.0]);
+        assert_eq!(col_src, [1.0]);
         assert_eq!(
             params(&stated).unwrap().stack.app.flight.collective,
-            CollectiveSource::Trim
-        );
-        let shipped = Vehicle::shipped("trex700l");
-        assert_eq!(
-            params(&shipped).unwrap().stack.app.flight.collective,
             CollectiveSource::Pilot
+        );
+        // The board's own table defaults to the pilot's collective.
+        assert_eq!(
+            ParamTable::defaults(sweephold_protocol::VehicleId::Trex700l).get(ParamId::TestColSrc),
+            1.0
         );
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -179,20 +175,17 @@ mod tests {
             "TEST_AXIS",
             "SWP_AMP",
             "NOISE_RMS",
-            "TEST_COL_SRC",
             "AIR_COL_MIN",
             "AIR_TIME",
         ] {
             assert!(values.iter().all(|v| v.name != name), "{name} pushed");
         }
-        // The typed set flies the configuration `fly` builds from the file, but for the
-        // collective: the file states none, so the board keeps its own, the pilot's.
+        // The typed set flies the configuration `fly` builds from the file.
         let params = params(&vehicle).unwrap();
         let mut expected = vehicle.firmware_config(Axis::Lat);
         expected.mixer = servo_plant::board_mixer(&vehicle.aircraft().swash);
-        assert_eq!(expected.collective, CollectiveSource::Trim);
-        expected.collective = CollectiveSource::Pilot;
         assert_eq!(params.stack.app.flight, expected);
+        assert_eq!(get("TEST_COL_SRC"), 0.0, "the preset's trim collective");
     }
 
     #[test]
