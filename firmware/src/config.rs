@@ -65,6 +65,23 @@ pub struct Config {
     /// The share of the test's amplitude and noise each axis gets (the vehicle's stick
     /// units; [`ExcitationScale::UNIT`] flies the test as sent).
     pub excitation_scale: ExcitationScale,
+    /// Where the collective of the excitation phases comes from.
+    pub collective: CollectiveSource,
+}
+
+/// The collective command during a test's excitation (FadeIn, Sweep, FadeOut).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CollectiveSource {
+    /// The captured trim collective (plus the excitation on a collective test): the
+    /// collective is never held and never moved by the pilot. The in-the-loop presets'
+    /// choice: their pilot has no height to keep.
+    Trim,
+    /// The pilot's collective stick as the sequencer gets it (plus the excitation on a
+    /// collective test), so the pilot keeps height with it, as ArduPilot's SystemID mode
+    /// leaves the collective with the pilot. The collective is then left out of the
+    /// pilot-override check. The board application's parameter table's choice.
+    Pilot,
 }
 
 /// What the conditional-hold thresholds (engage 6°, release 4°) apply to on the roll and
@@ -228,6 +245,7 @@ impl Config {
             adaptive: AdaptiveSettings::PRESET,
             slew: CommandSlew::NONE,
             excitation_scale: ExcitationScale::UNIT,
+            collective: CollectiveSource::Trim,
         }
     }
 
@@ -252,6 +270,7 @@ impl Config {
             adaptive: AdaptiveSettings::PRESET,
             slew: TREX700L_SLEW,
             excitation_scale: ExcitationScale::trex700l(),
+            collective: CollectiveSource::Trim,
         }
     }
 

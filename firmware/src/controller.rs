@@ -57,7 +57,7 @@ use sweephold_protocol::{
 
 use crate::amplitude::{AmplitudeShaper, AxisEnvelope};
 use crate::attitude_hold::{AttitudeController, AxisGains};
-use crate::config::{Config, ConfigError, HoldReference};
+use crate::config::{CollectiveSource, Config, ConfigError, HoldReference};
 use crate::excitation::{Excitation, ExcitationSample, ExcitationTicker};
 use crate::hold::{next_hold_state, HoldThresholds};
 use crate::mixer::mix;
@@ -333,11 +333,18 @@ impl FlightController {
         }
 
         if is_guarded(self.phase) {
-            let stick_reference = match self.phase {
+            let mut stick_reference = match self.phase {
                 Phase::TrimCapture => self.trim_accumulator.mean_sticks(),
                 Phase::FadeIn | Phase::Sweep | Phase::FadeOut => Some(self.trim.sticks),
                 _ => None,
             };
+            if self.config.collective == CollectiveSource::Pilot {
+                // The collective is the pilot's to move: compared with itself, it never
+                // overrides (a non-finite stick is still a sensor fault).
+                if let Some([_, _, _, col]) = stick_reference.as_mut() {
+                    *col = input.pilot.sticks.col;
+                }
+            }
             let verdict = safety::check(
                 &self.config.safety,
                 &SafetyInput {
@@ -497,6 +504,7 @@ impl FlightController {
         let scale = self.config.excitation_scale;
         sample.value *= scale.of(self.config.test.primary);
         let trim = self.trim;
+        let [_, _, _, pilot_col] = pilot;
         let [noise_lat, noise_lon, noise_ped] = self.noise.next_sample();
         let [noise_lat, noise_lon, noise_ped] = [
             noise_lat * scale.of(Axis::Lat),
@@ -611,8 +619,8 @@ impl FlightController {
             }
         }
 
-        // The collective is never held and never gets noise: trim, plus the excitation
-        // when it is the primary axis.
+        // The collective is never held and never gets noise: trim (or the pilot's stick,
+        // `CollectiveSource::Pilot`), plus the excitation when it is the primary axis.
         let collective_sweep = if primary == Axis::Col {
             sample.value
         } else {
@@ -620,7 +628,10 @@ impl FlightController {
         };
         let [lat, lon, ped, _] = parts.command;
         let [sweep_lat, sweep_lon, sweep_ped, _] = parts.sweep;
-        let [_, _, _, trim_col] = trim.sticks;
+        let trim_col = match self.config.collective {
+            CollectiveSource::Trim => trim.sticks[3],
+            CollectiveSource::Pilot => pilot_col,
+        };
         let [_, _, _, last_col] = self.last_command;
         let [_, _, _, col_step] = self.slew_steps;
         let col = slew::limit(last_col, clamp_unit(trim_col + collective_sweep), col_step);

@@ -94,7 +94,7 @@ pub mod trim;
 pub mod turns;
 
 pub use attitude_hold::{AxisGains, Gains};
-pub use config::{paper_test, Config, ConfigError, HoldReference};
+pub use config::{paper_test, CollectiveSource, Config, ConfigError, HoldReference};
 pub use controller::{FlightController, Output, FIRMWARE_VERSION};
 pub use mixer::{mix, MixerConfig, ServoConfig};
 pub use safety::SafetyLimits;

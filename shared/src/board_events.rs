@@ -123,6 +123,9 @@ pub enum RefusedCheck {
     /// The board stands more than 25° from level (or the IMU mounting is wrong).
     /// Since 1.5.
     NotLevel,
+    /// The aircraft is not airborne by the board application's rule (a test request on
+    /// the ground). Since 1.6.
+    NotAirborne,
 }
 
 impl RefusedCheck {
@@ -139,6 +142,7 @@ impl RefusedCheck {
             RefusedCheck::SequencerBusy => "sequencer_busy",
             RefusedCheck::ParamsInvalid => "params_invalid",
             RefusedCheck::NotLevel => "not_level",
+            RefusedCheck::NotAirborne => "not_airborne",
         }
     }
 }

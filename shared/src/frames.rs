@@ -36,8 +36,9 @@ pub struct ProtocolVersion {
 /// application's events ([`Event::ModeChange`], [`Event::ImuHealthChange`],
 /// [`Event::Refused`], [`Event::HostLinkIgnored`]); 1.5 the parameter frames
 /// ([`Frame::ParamRequest`], [`Frame::ParamReply`]), [`Event::ParamStore`] and the
-/// refusals [`RefusedCheck::ParamsInvalid`] and [`RefusedCheck::NotLevel`].
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 5 };
+/// refusals [`RefusedCheck::ParamsInvalid`] and [`RefusedCheck::NotLevel`]; 1.6 the
+/// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 6 };
 
 impl ProtocolVersion {
     /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
@@ -247,6 +248,9 @@ pub enum AbortReason {
     ImuFault,
     /// The pilot disarmed (arm switch off: throttle cut) during the test.
     Disarmed,
+    /// The board application's landed condition held during the test (collective stick
+    /// low for a time, or the throttle below the rotor-under-power level). Since 1.6.
+    Landed,
 }
 
 impl AbortReason {
@@ -262,6 +266,7 @@ impl AbortReason {
             AbortReason::RcLost => "rc_lost",
             AbortReason::ImuFault => "imu_fault",
             AbortReason::Disarmed => "disarmed",
+            AbortReason::Landed => "landed",
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Protocol 1.5's parameter frames: round trips, their place at the end of every
+//! Protocol 1.5's parameter frames (and 1.6's additions): round trips, their place at the end of every
 //! enum (so the older encodings stay as they were), and parameter names.
 
 mod strategies;
@@ -43,7 +43,6 @@ proptest! {
 
 #[test]
 fn parameter_frames_are_appended_and_keep_the_older_encodings() {
-    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 5 });
     // Frame: ConfigureResult stays variant 6, the new frames are 7 and 8.
     let result = Frame::ConfigureResult(ConfigureResult {
         accepted: true,
@@ -126,4 +125,23 @@ fn names_are_checked() {
     assert_eq!(ParamRefusal::NotAChoice.name(), "not_a_choice");
     assert_eq!(ParamStoreStatus::FlashError.name(), "flash_error");
     assert_eq!(RefusedCheck::ParamsInvalid.name(), "params_invalid");
+}
+
+#[test]
+fn protocol_1_6_appends_landed_and_not_airborne() {
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 6 });
+    // AbortReason: Disarmed stays 8, Landed is 9.
+    assert_eq!(postcard_bytes(&AbortReason::Disarmed), [8]);
+    assert_eq!(postcard_bytes(&AbortReason::Landed), [9]);
+    assert_eq!(AbortReason::Landed.name(), "landed");
+    // RefusedCheck: NotLevel stays 8, NotAirborne is 9.
+    assert_eq!(postcard_bytes(&RefusedCheck::NotLevel), [8]);
+    assert_eq!(postcard_bytes(&RefusedCheck::NotAirborne), [9]);
+    assert_eq!(RefusedCheck::NotAirborne.name(), "not_airborne");
+    // Board streams still announce 1.4: an older host reads a 1.6 abort or refusal as
+    // a corrupt frame and skips it.
+    assert_eq!(
+        ProtocolVersion::BOARD_APPLICATION,
+        ProtocolVersion { major: 1, minor: 4 }
+    );
 }

@@ -17,7 +17,8 @@
 //! switch off.
 //! Test-entry checks (armed, in the pilot mode): IMU healthy, attitude valid, receiver
 //! valid, the soft start finished (a sweep on a rotor still spooling up would measure a
-//! changing aircraft), the sequencer idle.
+//! changing aircraft), airborne by the rule of [`super::airborne`] (a test engaged on
+//! the skids would excite an aircraft the ground holds), the sequencer idle.
 
 use super::failsafe::ImuProblem;
 use super::inputs::RcInput;
@@ -45,6 +46,8 @@ pub enum CheckFailure {
     ParamsInvalid,
     /// The attitude estimate is more than [`MAX_ARM_TILT_DEG`] from level.
     NotLevel,
+    /// Not airborne by the rule of [`super::airborne`] (a test request on the ground).
+    NotAirborne,
 }
 
 /// A request that was refused, and why.
@@ -127,10 +130,12 @@ pub fn pre_arm(input: &CheckInput<'_>, arm_max: f32) -> Result<(), CheckFailure>
 }
 
 /// The test-entry checks: `soft_start_done` whether the throttle has reached its stick,
-/// `sequencer_idle` whether the sequencer is in Idle.
+/// `airborne` the airborne rule's verdict, `sequencer_idle` whether the sequencer is in
+/// Idle.
 pub fn test_entry(
     input: &CheckInput<'_>,
     soft_start_done: bool,
+    airborne: bool,
     sequencer_idle: bool,
 ) -> Result<(), CheckFailure> {
     healthy(input)?;
@@ -139,6 +144,9 @@ pub fn test_entry(
     }
     if !soft_start_done {
         return Err(CheckFailure::SoftStartRunning);
+    }
+    if !airborne {
+        return Err(CheckFailure::NotAirborne);
     }
     if !sequencer_idle {
         return Err(CheckFailure::SequencerBusy);

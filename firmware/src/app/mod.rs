@@ -10,6 +10,8 @@
 //!   transition rule;
 //! * [`pilot_mode`]: the stabilised pilot mode's rate loops and heading hold;
 //! * [`arming`]: pre-arm and test-entry checks, switch edges;
+//! * [`airborne`]: the airborne and landed rule (no test on the ground, a landing
+//!   aborts);
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
 //! * [`throttle`]: the ESC channel and its soft start;
 //! * [`inputs`]: the input types;
@@ -50,6 +52,7 @@
 //! Every tick runs in bounded time, allocates nothing and cannot panic; non-finite
 //! inputs become faults or invalid frames, never non-finite outputs.
 
+pub mod airborne;
 pub mod arming;
 pub mod failsafe;
 pub mod inputs;
@@ -73,6 +76,7 @@ use crate::mixer::mix;
 use crate::sink::FrameSink;
 use crate::trim::Trim;
 
+use airborne::{AirborneDetector, AirborneInput, AirborneSettings};
 use arming::{CheckInput, SwitchEdge};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
@@ -108,17 +112,20 @@ pub struct AppConfig {
     pub throttle: ThrottleSettings,
     /// Failsafes.
     pub failsafe: FailsafeSettings,
+    /// The airborne and landed rule.
+    pub airborne: AirborneSettings,
 }
 
 impl AppConfig {
     /// TREX 700L: [`Config::trex700l_default`], [`PilotModeGains::trex700l`], standard
-    /// throttle and failsafe settings.
+    /// throttle and failsafe settings, [`AirborneSettings::trex700l`].
     pub const fn trex700l(primary: Axis) -> Self {
         AppConfig {
             flight: Config::trex700l_default(primary),
             pilot: PilotModeGains::trex700l(),
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
+            airborne: AirborneSettings::trex700l(),
         }
     }
 
@@ -131,13 +138,14 @@ impl AppConfig {
     }
 
     /// Bo-105 (simulator): [`Config::bo105_default`], [`PilotModeGains::bo105`],
-    /// standard throttle and failsafe settings.
+    /// standard throttle and failsafe settings, [`AirborneSettings::bo105`].
     pub const fn bo105(primary: Axis) -> Self {
         AppConfig {
             flight: Config::bo105_default(primary),
             pilot: PilotModeGains::bo105(),
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
+            airborne: AirborneSettings::bo105(),
         }
     }
 
@@ -152,6 +160,9 @@ impl AppConfig {
         }
         if !self.failsafe.is_valid() {
             return Err(AppConfigError::FailsafeInvalid);
+        }
+        if !self.airborne.is_valid() {
+            return Err(AppConfigError::AirborneInvalid);
         }
         Ok(())
     }
@@ -169,6 +180,8 @@ pub enum AppConfigError {
     ThrottleInvalid,
     /// A failsafe setting is out of range.
     FailsafeInvalid,
+    /// An airborne-rule setting is out of range.
+    AirborneInvalid,
 }
 
 impl AppConfigError {
@@ -179,6 +192,7 @@ impl AppConfigError {
             AppConfigError::PilotGainsInvalid => "pilot-mode gains or limits invalid",
             AppConfigError::ThrottleInvalid => "throttle settings invalid",
             AppConfigError::FailsafeInvalid => "failsafe settings invalid",
+            AppConfigError::AirborneInvalid => "airborne settings invalid",
         }
     }
 }
@@ -223,6 +237,8 @@ pub struct BoardApp {
     stale_limit_ticks: u32,
     regain_ticks: u32,
     recover_ticks: u32,
+    /// `airborne.time_s` in ticks.
+    airborne_ticks: u32,
     /// Largest throttle rise per tick (the soft start).
     throttle_rise: f32,
     mode: Mode,
@@ -232,6 +248,8 @@ pub struct BoardApp {
     rc: RcMonitor,
     arm_switch: SwitchEdge,
     test_switch: SwitchEdge,
+    /// The airborne and landed rule's counts.
+    airborne: AirborneDetector,
     /// The command applied last tick.
     last_command: Controls,
     /// The loops take over from `last_command` on their next step.
@@ -279,6 +297,7 @@ impl BoardApp {
             stale_limit_ticks: u32::from(config.flight.safety.stale_limit_ticks),
             regain_ticks: ticks_in(config.failsafe.rc_regain_s, dt_s),
             recover_ticks: ticks_in(config.failsafe.imu_recover_s, dt_s),
+            airborne_ticks: ticks_in(config.airborne.time_s, dt_s),
             throttle_rise: dt_s / config.throttle.soft_start_s,
             mode: Mode::Disarmed,
             loops: PilotLoops::default(),
@@ -287,6 +306,7 @@ impl BoardApp {
             rc: RcMonitor::default(),
             arm_switch: SwitchEdge::default(),
             test_switch: SwitchEdge::default(),
+            airborne: AirborneDetector::default(),
             last_command: SAFE_COMMAND,
             preload: false,
             trim: None,
@@ -385,6 +405,17 @@ impl BoardApp {
                 .is_some_and(|[phi, theta, _]| arming::is_level(phi, theta)),
             params_valid: self.params_valid,
         };
+        let soft_start_done = rc.is_some_and(|frame| self.throttle.settled(frame.throttle));
+        // The throttle output of the last tick: this tick's follows the transition.
+        let air = self.airborne.observe(
+            &self.config.airborne,
+            &AirborneInput {
+                collective: rc.map(|frame| frame.sticks.col),
+                spooled: self.throttle.output() >= self.config.throttle.spooled_min,
+                soft_start_done,
+            },
+            self.airborne_ticks,
+        );
         let failsafe = &self.config.failsafe;
         let conditions = modes::Conditions {
             rc_valid: rc.is_some(),
@@ -398,10 +429,12 @@ impl BoardApp {
             imu_healthy: imu.health.is_ok(),
             imu_recovered: imu.recovered,
             attitude_valid: imu.attitude.is_some(),
+            landed: air.landed,
             pre_arm: arming::pre_arm(&checks, self.config.throttle.arm_max),
             test_ready: arming::test_entry(
                 &checks,
-                rc.is_some_and(|frame| self.throttle.settled(frame.throttle)),
+                soft_start_done,
+                air.airborne,
                 self.fc.phase() == Phase::Idle,
             ),
         };
@@ -506,6 +539,7 @@ impl BoardApp {
         match to {
             Mode::Disarmed => {
                 self.throttle.cut();
+                self.airborne.reset();
                 self.loops.reset();
                 self.trim = None;
                 self.loss = None;

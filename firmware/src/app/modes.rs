@@ -8,7 +8,7 @@
 //!        │ Disarmed │                                  │ Pilot │ ───────────────────────▶ │ Test │
 //!        └──────────┘ ◀── arm switch off (any armed    └───────┘ ◀─────────────────────── └──────┘
 //!          ▲    ▲          mode; a test is aborted)      ▲   ▲    Done / sequencer abort /    │
-//!          │    │                                        │   │    attitude invalid           │
+//!          │    │                                        │   │    attitude invalid / landed  │
 //!          │    │ receiver lost ≥ rc_cut_s               │   │                               │
 //!          │  ┌────────────┐ ◀── receiver lost ──────────┘   │     receiver lost (abort)     │
 //!          │  │ RcFailsafe │ ◀─────────────────────────────────┼───────────────────────────────┤
@@ -88,6 +88,8 @@ pub struct Conditions {
     pub imu_recovered: bool,
     /// Attitude estimate valid.
     pub attitude_valid: bool,
+    /// The airborne rule's landed condition (see [`super::airborne`]).
+    pub landed: bool,
     /// The pre-arm checks' verdict.
     pub pre_arm: Result<(), CheckFailure>,
     /// The test-entry checks' verdict.
@@ -168,6 +170,7 @@ pub fn next(from: Mode, c: &Conditions) -> Transition {
     }
     match from {
         Mode::Test if !c.attitude_valid => leave(Mode::Pilot, AbortReason::ImuFault),
+        Mode::Test if c.landed => leave(Mode::Pilot, AbortReason::Landed),
         Mode::Pilot if c.test_rising => match c.test_ready {
             Ok(()) => Transition::to(Mode::Test),
             Err(failure) => Transition {

@@ -55,6 +55,7 @@ pub const fn refused_check(check: CheckFailure) -> RefusedCheck {
         CheckFailure::SequencerBusy => RefusedCheck::SequencerBusy,
         CheckFailure::ParamsInvalid => RefusedCheck::ParamsInvalid,
         CheckFailure::NotLevel => RefusedCheck::NotLevel,
+        CheckFailure::NotAirborne => RefusedCheck::NotAirborne,
     }
 }
 

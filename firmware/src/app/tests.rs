@@ -12,6 +12,8 @@ use super::*;
 use proptest::prelude::*;
 use sweephold_protocol::{AbortReason, Decoder, Event, Frame};
 
+mod airborne;
+
 const DEG: f32 = core::f32::consts::PI / 180.0;
 const STICKS: [f32; 4] = [0.05, -0.1, 0.02, 0.3];
 const FLIGHT_THROTTLE: f32 = 0.8;
@@ -706,6 +708,7 @@ fn calm() -> Conditions {
         imu_healthy: true,
         imu_recovered: true,
         attitude_valid: true,
+        landed: false,
         pre_arm: Ok(()),
         test_ready: Ok(()),
     }
@@ -740,6 +743,17 @@ fn the_transition_rule_as_a_table() {
             Some(A::ImuFault),
         ),
         (Test, |c| c.attitude_valid = false, Pilot, Some(A::ImuFault)),
+        (Test, |c| c.landed = true, Pilot, Some(A::Landed)),
+        (Pilot, |c| c.landed = true, Pilot, None),
+        (
+            Test,
+            |c| {
+                c.landed = true;
+                c.imu_healthy = false;
+            },
+            ImuFailsafe,
+            Some(A::ImuFault),
+        ),
         (Test, |c| c.test_rising = true, Test, None),
         (RcFailsafe, |c| c.rc_regained = false, RcFailsafe, None),
         (RcFailsafe, |_| {}, Pilot, None),
@@ -1315,7 +1329,7 @@ fn arming_is_refused_for_each_failed_check() {
     assert!(is_level(0.0, -24f32.to_radians()));
     assert!(!is_level(24f32.to_radians(), 24f32.to_radians()));
     assert_eq!(
-        test_entry(&imu_ok, true, true),
+        test_entry(&imu_ok, true, true, true),
         Err(CheckFailure::ReceiverInvalid)
     );
     let mut rig = Rig::in_mode(Mode::Disarmed);

@@ -36,9 +36,10 @@ pub const MAX_NAME_LEN: usize = 16;
 /// The version of the table's layout, stored with every record: a record of another
 /// version is not loaded (its values could mean other things). Version 2 appended
 /// `FRAME`, version 3 the excitation scales, slew limits and the holds' reference,
-/// integrator limits, time constants and directions: a record of an older version holds
-/// no base preset or none of those and boots the defaults.
-pub const TABLE_VERSION: u16 = 3;
+/// integrator limits, time constants and directions, version 4 the test's collective
+/// source and the airborne rule: a record of an older version holds no base preset or
+/// none of those and boots the defaults.
+pub const TABLE_VERSION: u16 = 4;
 
 /// Swash type codes: H1, 120°, 135°, 140°.
 const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
@@ -207,6 +208,9 @@ params! {
     HoldPedBump = "HOLD_PED_TBUMP", "s", 0.0, 10.0, Real, "Heading hold: bumpless hand-over time constant.";
     HoldPedFade = "HOLD_PED_TFADE", "s", 0.0, 10.0, Real, "Heading hold: output fade time constant after a release.";
     HoldPedRev = "HOLD_PED_REV", "", 0.0, 1.0, Integer, "Heading hold: 1 if a positive command gives a negative moment.";
+    TestColSrc = "TEST_COL_SRC", "", 0.0, 1.0, Integer, "Collective during a test: 0 the captured trim, 1 the pilot's stick (plus the sweep on col tests).";
+    AirColMin = "AIR_COL_MIN", "", -1.0, 1.0, Real, "Airborne: collective stick at or above this for AIR_TIME; landed: below it for AIR_TIME.";
+    AirTime = "AIR_TIME", "s", 0.0, 10.0, Real, "Time the collective must stay above (airborne) or below (landed) AIR_COL_MIN.";
 }
 
 /// The vehicle whose preset a `FRAME` value names (ArduPilot's `FRAME_CLASS` idea: one

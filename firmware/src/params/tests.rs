@@ -44,10 +44,11 @@ fn the_defaults_are_the_presets_bit_for_bit() {
         assert_eq!(ParamTable::from_values(*table.values()), Ok(table));
         let params = table.params().unwrap();
         assert_eq!(params, Params::preset(vehicle));
-        assert_eq!(
-            params.stack,
-            StackConfig::with_app(crate::app::AppConfig::preset(vehicle, Axis::Lat))
-        );
+        // The application's preset, but for the collective: the pilot's on the board.
+        let mut app = crate::app::AppConfig::preset(vehicle, Axis::Lat);
+        assert_eq!(app.flight.collective, crate::CollectiveSource::Trim);
+        app.flight.collective = crate::CollectiveSource::Pilot;
+        assert_eq!(params.stack, StackConfig::with_app(app));
     }
     let table = ParamTable::defaults(VehicleId::Trex700l);
     // A few defaults by name, from the TREX 700L preset.
@@ -65,6 +66,9 @@ fn the_defaults_are_the_presets_bit_for_bit() {
         ("IMU_ROT", 0.0),
         ("SERVO_RATE", 333.0),
         ("TAIL_RATE", 333.0),
+        ("TEST_COL_SRC", 1.0),
+        ("AIR_COL_MIN", -0.2),
+        ("AIR_TIME", 1.0),
     ] {
         assert_eq!(table.get_by_name(name), Ok(value), "{name}");
     }
@@ -295,7 +299,13 @@ fn frame_names_the_preset_under_the_table() {
     // FRAME came right after the first table's 80 parameters: a table only ever grows
     // at its end, each growth a new version.
     assert_eq!(ParamId::ALL[80], ParamId::Frame);
-    assert_eq!(TABLE_VERSION, 3);
+    // Version 4 appended the collective source and the airborne rule after version 3's
+    // last parameter.
+    assert_eq!(TABLE_VERSION, 4);
+    assert_eq!(
+        ParamId::ALL[ParamId::HoldPedRev.index() + 1..],
+        [ParamId::TestColSrc, ParamId::AirColMin, ParamId::AirTime]
+    );
     for vehicle in VEHICLES {
         let table = ParamTable::defaults(vehicle);
         assert_eq!(table.get(ParamId::Frame), frame_code(vehicle));

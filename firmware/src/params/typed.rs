@@ -12,7 +12,7 @@ use sweephold_protocol::{Axis, ExcitationMode, InputKind, VehicleId};
 use super::table::{frame_code, frame_vehicle, ParamId, COUNT};
 use crate::app::{AppConfig, AppConfigError};
 use crate::board_stack::StackConfig;
-use crate::config::{ConfigError, HoldReference};
+use crate::config::{CollectiveSource, ConfigError, HoldReference};
 use crate::filters::{FilterBank, FilterBankConfig, FilterError};
 use crate::imu::ImuRotation;
 use crate::mixer::ServoConfig;
@@ -159,11 +159,15 @@ impl ParamsError {
 
 impl Params {
     /// The preset of `vehicle`: [`AppConfig::preset`] on the lateral axis in the board's
-    /// standard stack, no IMU rotation, 333 Hz servo frames ([`DEFAULT_FRAME_HZ`],
+    /// standard stack with the collective the pilot's during a test
+    /// ([`CollectiveSource::Pilot`]), no IMU rotation, 333 Hz servo frames ([`DEFAULT_FRAME_HZ`],
     /// [`DEFAULT_TAIL_FRAME_HZ`]).
     pub const fn preset(vehicle: VehicleId) -> Self {
+        let mut app = AppConfig::preset(vehicle, Axis::Lat);
+        // On the board the pilot keeps height with the collective during a test.
+        app.flight.collective = CollectiveSource::Pilot;
         Params {
-            stack: StackConfig::with_app(AppConfig::preset(vehicle, Axis::Lat)),
+            stack: StackConfig::with_app(app),
             imu_rotation: ImuRotation::None,
             swash_frame_hz: DEFAULT_FRAME_HZ,
             tail_frame_hz: DEFAULT_TAIL_FRAME_HZ,
@@ -336,6 +340,14 @@ impl Params {
         test.noise_cutoff_rad_s = v(ParamId::NoiseCutoff);
         test.seed = v(ParamId::TestSeed) as u32;
         test.freeze_in_band = v(ParamId::TestFreeze) != 0.0;
+        flight.collective = if v(ParamId::TestColSrc) == 0.0 {
+            CollectiveSource::Trim
+        } else {
+            CollectiveSource::Pilot
+        };
+        stack.app.airborne.col_min = v(ParamId::AirColMin);
+        stack.app.airborne.time_s = v(ParamId::AirTime);
+        let flight = &mut stack.app.flight;
         flight.test.warnings = flight.validate().map_err(ParamsError::Flight)?;
         stack.app.validate().map_err(ParamsError::App)?;
         Ok(params)
@@ -540,5 +552,14 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
         if test.freeze_in_band { 1.0 } else { 0.0 },
     );
     put(ParamId::Frame, frame_code(flight.vehicle));
+    put(
+        ParamId::TestColSrc,
+        match flight.collective {
+            CollectiveSource::Trim => 0.0,
+            CollectiveSource::Pilot => 1.0,
+        },
+    );
+    put(ParamId::AirColMin, stack.app.airborne.col_min);
+    put(ParamId::AirTime, stack.app.airborne.time_s);
     values
 }

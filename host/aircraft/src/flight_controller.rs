@@ -30,6 +30,8 @@ pub struct FlightController {
     pub preset: String,
     /// What the hold's engage and release angles are measured from.
     pub hold_reference: Option<HoldReference>,
+    /// Where the collective of a test's excitation comes from.
+    pub collective: Option<CollectiveSource>,
     /// Conditional attitude hold: engage angle \[rad\].
     pub hold_engage: Option<f64>,
     /// Conditional attitude hold: release angle \[rad\].
@@ -58,6 +60,15 @@ pub enum HoldReference {
     Level,
     /// The deviation from the captured trim attitude.
     Trim,
+}
+
+/// The collective during a test's excitation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CollectiveSource {
+    /// The captured trim collective (the in-the-loop presets' choice).
+    Trim,
+    /// The pilot's collective stick (the board's parameter table's choice).
+    Pilot,
 }
 
 /// One held axis' gains; each `None` when the file leaves it to the preset.
@@ -124,6 +135,20 @@ pub(crate) fn read(
             }
         }),
     };
+    let collective = match &f.collective {
+        None => None,
+        Some(written) => Some(match written.get_ref().as_str() {
+            "trim" => CollectiveSource::Trim,
+            "pilot" => CollectiveSource::Pilot,
+            other => {
+                return Err(r.error(
+                    written.span().start,
+                    "flight_controller.collective",
+                    format!("`{other}`: expected pilot or trim"),
+                ))
+            }
+        }),
+    };
     let angle = Positive(90.0 * DEG);
     let hold_engage = setting(r, &f.hold_engage, "hold_engage", D::Angle, angle)?;
     let hold_release = setting(r, &f.hold_release, "hold_release", D::Angle, angle)?;
@@ -182,6 +207,7 @@ pub(crate) fn read(
     Ok(FlightController {
         preset: preset.clone(),
         hold_reference,
+        collective,
         hold_engage,
         hold_release,
         pulse_width: setting(r, &f.pulse_width, "pulse_width", D::Time, Positive(60.0))?,

@@ -26,7 +26,9 @@ mod swash;
 
 use std::path::{Path, PathBuf};
 
-pub use flight_controller::{FlightController, HoldGains, HoldReference, FIRMWARE_PRESETS};
+pub use flight_controller::{
+    CollectiveSource, FlightController, HoldGains, HoldReference, FIRMWARE_PRESETS,
+};
 pub use quantity::{Dimension, Quantity};
 pub use swash::{ServoOutput, Swash, SwashKind};
 

@@ -54,6 +54,7 @@ pub(crate) struct File {
 pub(crate) struct FlightController {
     pub preset: Spanned<String>,
     pub hold_reference: Option<Spanned<String>>,
+    pub collective: Option<Spanned<String>>,
     pub hold_engage: Option<Value>,
     pub hold_release: Option<Value>,
     pub pulse_width: Option<Value>,

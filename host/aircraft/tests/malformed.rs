@@ -354,6 +354,11 @@ const SETTING_CASES: &[(&str, &str, &str)] = &[
         "flight_controller.hold_reference: `horizon`: expected level or trim",
     ),
     (
+        "unknown collective source",
+        "collective = \"autopilot\"",
+        "flight_controller.collective: `autopilot`: expected pilot or trim",
+    ),
+    (
         "excitation scale above one",
         "excitation_scale = [1.0, 1.2, 0.2, 1.0]",
         "flight_controller.excitation_scale[1]: 1.2 must be positive and at most 1",
@@ -424,7 +429,8 @@ fn every_malformed_flight_controller_setting_is_refused_on_its_line() {
 
 #[test]
 fn flight_controller_settings_read_in_si_and_default_to_none() {
-    let settings = "preset = \"trex700l\"\nhold_reference = \"level\"\nhold_engage = \"5 deg\"\n\
+    let settings = "preset = \"trex700l\"\nhold_reference = \"level\"\ncollective = \"pilot\"\n\
+         hold_engage = \"5 deg\"\n\
          hold_release = \"3 deg\"\npulse_width = \"300 ms\"\n\
          excitation_scale = [0.9, 0.8, 0.2, 1.0]\ncommand_slew = { ped = \"4 /s\" }\n\
          attitude_limit = \"20 deg\"\nrate_limits = [\"180 deg/s\", \"3 rad/s\", \"250 deg/s\"]\n\
@@ -436,6 +442,7 @@ fn flight_controller_settings_read_in_si_and_default_to_none() {
         .flight_controller;
     let deg = std::f64::consts::PI / 180.0;
     assert_eq!(read.hold_reference, Some(aircraft::HoldReference::Level));
+    assert_eq!(read.collective, Some(aircraft::CollectiveSource::Pilot));
     assert_eq!(read.hold_engage, Some(5.0 * deg));
     assert_eq!(read.hold_release, Some(3.0 * deg));
     assert_eq!(read.pulse_width, Some(0.3));

@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use aircraft::{Aircraft, TrimBalance, ValidRanges};
 use rotorsim::{ActuatorModel, Helicopter};
-use sweephold_firmware::{Config, HoldReference};
+use sweephold_firmware::{CollectiveSource, Config, HoldReference};
 use sweephold_protocol::{Axis, VehicleId};
 use sysid::frf::RangeSource;
 
@@ -122,6 +122,12 @@ impl Vehicle {
             config.hold_reference = match reference {
                 aircraft::HoldReference::Level => HoldReference::Level,
                 aircraft::HoldReference::Trim => HoldReference::Trim,
+            };
+        }
+        if let Some(source) = file.collective {
+            config.collective = match source {
+                aircraft::CollectiveSource::Trim => CollectiveSource::Trim,
+                aircraft::CollectiveSource::Pilot => CollectiveSource::Pilot,
             };
         }
         set(&mut config.test.hold_engage_rad, file.hold_engage);

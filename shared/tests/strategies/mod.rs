@@ -50,6 +50,7 @@ pub fn reason() -> impl Strategy<Value = AbortReason> {
         Just(AbortReason::RcLost),
         Just(AbortReason::ImuFault),
         Just(AbortReason::Disarmed),
+        Just(AbortReason::Landed),
     ]
 }
 

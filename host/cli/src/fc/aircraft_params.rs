@@ -8,9 +8,12 @@
 //! every servo's direction, centre, limits and throw, the frame rates, the mixer's
 //! scales and ring, the hold's gains, limits, time constants, directions, reference and
 //! thresholds, the abort limits, the pulse width, the excitation scale and the command
-//! slew — each the file's value or, where the file states none, its preset's. Not pushed:
-//! the board's installation (receiver map and ranges, IMU mounting), the head and tail
-//! rotor speeds of the notches (the presets' filter bank, as `fly` flies it) and the test
+//! slew and the test's collective source (`TEST_COL_SRC`: the board's table defaults to
+//! `pilot`, an aircraft file that states no `collective` has its preset's `trim`, so
+//! that a board set up from a file flies as `--fc board-sim` flies that file) — each the
+//! file's value or, where the file states none, its preset's. Not pushed: the board's installation (receiver map and ranges, IMU mounting), the head and
+//! tail rotor speeds of the notches (the presets' filter bank, as `fly` flies it), the
+//! airborne rule (`AIR_COL_MIN`, `AIR_TIME`: the pilot's collective habits) and the test
 //! (chosen per record).
 
 use sweephold_firmware::params::{typed, ParamId, ParamTable, Params};
@@ -21,7 +24,7 @@ use crate::fly::servo_plant;
 use crate::vehicle::Vehicle;
 
 /// The parameters an aircraft file does not set.
-const NOT_FROM_THE_AIRCRAFT: [&str; 8] = [
+const NOT_FROM_THE_AIRCRAFT: [&str; 9] = [
     "RC_",
     "IMU_ROT",
     "HEAD_RPM",
@@ -30,10 +33,15 @@ const NOT_FROM_THE_AIRCRAFT: [&str; 8] = [
     "SWP_",
     "PULSE_AMP",
     "NOISE_",
+    "AIR_",
 ];
 
 /// Whether `id` is one the aircraft file determines.
 fn from_the_aircraft(id: ParamId) -> bool {
+    if id == ParamId::TestColSrc {
+        // A `TEST_` parameter, but the flight logic's, not the test's.
+        return true;
+    }
     let name = id.def().name;
     !NOT_FROM_THE_AIRCRAFT
         .iter()
@@ -84,6 +92,41 @@ pub fn values(vehicle: &Vehicle) -> anyhow::Result<Vec<BoardValue>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sweephold_firmware::CollectiveSource;
+
+    #[test]
+    fn the_file_s_collective_is_pushed() {
+        let dir = std::env::temp_dir().join(format!("sweephold-col-src-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("trex-pilot-collective.toml");
+        let text = aircraft::SHIPPED[1]
+            .1
+            .replacen("name = \"trex700l\"", "name = \"trex-pilot-collective\"", 1)
+            .replacen(
+                "preset = \"trex700l\"",
+                "preset = \"trex700l\"\ncollective = \"pilot\"",
+                1,
+            );
+        std::fs::write(&path, text).unwrap();
+        let stated = Vehicle::parse(path.to_str().unwrap()).unwrap();
+        let pushed = values(&stated).unwrap();
+        let col_src: Vec<f32> = pushed
+            .iter()
+            .filter(|v| v.name == "TEST_COL_SRC")
+            .map(|v| v.value)
+            .collect();
+        assert_eq!(col_src, [1.0]);
+        assert_eq!(
+            params(&stated).unwrap().stack.app.flight.collective,
+            CollectiveSource::Pilot
+        );
+        // The board's own table defaults to the pilot's collective.
+        assert_eq!(
+            ParamTable::defaults(sweephold_protocol::VehicleId::Trex700l).get(ParamId::TestColSrc),
+            1.0
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn the_fbl700_file_maps_onto_its_servo_geometry_and_settings() {
@@ -132,6 +175,8 @@ mod tests {
             "TEST_AXIS",
             "SWP_AMP",
             "NOISE_RMS",
+            "AIR_COL_MIN",
+            "AIR_TIME",
         ] {
             assert!(values.iter().all(|v| v.name != name), "{name} pushed");
         }
@@ -140,6 +185,7 @@ mod tests {
         let mut expected = vehicle.firmware_config(Axis::Lat);
         expected.mixer = servo_plant::board_mixer(&vehicle.aircraft().swash);
         assert_eq!(params.stack.app.flight, expected);
+        assert_eq!(get("TEST_COL_SRC"), 0.0, "the preset's trim collective");
     }
 
     #[test]

@@ -9,6 +9,7 @@ pub mod link;
 pub mod link_board_sim;
 pub mod link_qemu;
 pub mod link_serial;
+pub mod pilot_collective;
 pub mod plan;
 pub mod record;
 pub mod servo_plant;
@@ -183,6 +184,13 @@ pub struct FlyArgs {
         value_parser = arg_values::below_half
     )]
     pub pilot_noise: f64,
+    /// The pilot's collective stick moves by DELTA (fraction of travel, -2 to 2) at
+    /// record time AT_S (seconds from the record's first tick; the test switch goes on
+    /// at 0.05 s) and stays there while the test runs: `-1@0` keeps it down from the
+    /// start (a test request on the ground), `-1@10` lowers it during the test (a
+    /// landing).
+    #[arg(long = "collective-step", value_name = "DELTA@AT_S", value_parser = pilot_collective::CollectiveStep::parse, allow_hyphen_values = true)]
+    pub collective_step: Option<pilot_collective::CollectiveStep>,
     /// Perfect sensors (no noise, bias or latency).
     #[arg(long = "perfect-sensors")]
     pub perfect_sensors: bool,
@@ -681,6 +689,7 @@ pub fn fly_with_workers(
         sensor_spike: args.sensor_spike,
         pilot_override_at_s: args.pilot_override_at_s,
         pilot_stick_noise: args.pilot_noise,
+        collective_step: args.collective_step,
         fly_on_s: args.fly_on_s.unwrap_or(0.0),
     };
 
@@ -805,6 +814,9 @@ fn finish_record(
 ) -> anyhow::Result<FinishedRecord> {
     write_atomic(&args.out.join(plan.file_name()), &flown.dump)?;
     if !flown.began {
+        if let Some(refusal) = &flown.test_refused {
+            bail!("the flight controller refused the test ({refusal}): no test started");
+        }
         if let Some(fault) = args.board_fault() {
             let mode = flown
                 .first_mode_change

@@ -1,13 +1,15 @@
 //! Flying one record: the simulator and a flight-controller link in lockstep.
 
 use rotorsim::{Helicopter, Sim, SimOptions, Trim};
-use sweephold_firmware::Config;
+use sweephold_firmware::{CollectiveSource, Config};
 use sweephold_protocol::{
-    Controls, Decoder, Event, Frame, HoldState, Measurements, Phase, PilotInput, Sample, SensorIn,
+    Controls, Decoder, Event, Frame, HoldState, Measurements, Phase, PilotInput, Request, Sample,
+    SensorIn,
 };
 use sysid::random::SplitMix64;
 
 use super::link::FlightControllerLink;
+use super::pilot_collective::{CollectiveStep, HeightHold};
 use super::summary::{AfterTest, AttitudeDeg, FromTrimDeg, HoldFraction, MaxAbsDeg};
 
 /// Disturbances and faults injected into one record.
@@ -23,6 +25,8 @@ pub struct Disturbances {
     pub pilot_override_at_s: Option<f64>,
     /// RMS of random pilot stick motion around trim, fraction of travel (0: hands still).
     pub pilot_stick_noise: f64,
+    /// The pilot's collective stick step (`--collective-step`).
+    pub collective_step: Option<CollectiveStep>,
     /// Seconds flown on after the test ended (Done or Aborted), the pilot's hands at trim
     /// (0: the record ends with the test).
     pub fly_on_s: f64,
@@ -44,6 +48,8 @@ pub struct FlownRecord {
     /// The board application's first mode change (`pilot → rc_failsafe at tick 3520`),
     /// if any: what stopped a test that never began.
     pub first_mode_change: Option<String>,
+    /// The check that refused the test request (`not_airborne`), if one did.
+    pub test_refused: Option<String>,
     /// Peak attitude excursions over the excitation.
     pub max_abs_deg: MaxAbsDeg,
     /// Peak excursions from the captured trim over the excitation (None without a trim
@@ -88,6 +94,8 @@ struct TelemetryMonitor {
     began: bool,
     /// The board application's first mode change, as `pilot → rc_failsafe at tick 3520`.
     first_mode_change: Option<String>,
+    /// The check that refused the first test request.
+    test_refused: Option<String>,
 }
 
 impl TelemetryMonitor {
@@ -118,6 +126,14 @@ impl TelemetryMonitor {
                 }
                 Frame::Event(Event::Abort { reason, .. }) => self.abort = Some(reason),
                 Frame::Header(_) => self.began = true,
+                Frame::Event(Event::Refused {
+                    request: Request::Test,
+                    check,
+                    ..
+                }) => {
+                    self.test_refused
+                        .get_or_insert_with(|| check.name().to_string());
+                }
                 Frame::Event(Event::ModeChange { tick, from, to }) => {
                     self.first_mode_change.get_or_insert_with(|| {
                         format!("{} → {} at tick {tick}", from.name(), to.name())
@@ -240,6 +256,18 @@ pub fn fly_record(
     let mut sim = Sim::at_trim(aircraft.heli.clone(), trim, options);
     let trim_sticks = trim.controls.map(|c| c as f32);
     let mut pilot_rng = SplitMix64::new(u64::from(config.test.seed) ^ 0x9170_7D15_7A2B);
+    // With the collective the pilot's during the test, the pilot holds height with it.
+    let mut height_hold = match config.collective {
+        CollectiveSource::Trim => None,
+        CollectiveSource::Pilot => {
+            let z_col = rotorsim::linearize(aircraft.heli, trim)
+                .quasi_static
+                .get("Zcol")
+                .copied()
+                .unwrap_or(0.0);
+            HeightHold::new(z_col)
+        }
+    };
 
     link.begin_record(config)?;
     crate::interrupt::pause_point("fly");
@@ -273,6 +301,17 @@ pub fn fly_record(
         if let (Some(at), None) = (disturbances.pilot_override_at_s, ended) {
             if ticks >= IDLE_TICKS && armed_s >= at {
                 sticks[0] += 0.2;
+            }
+        }
+        if ended.is_none() {
+            if let Some(hold) = height_hold.as_mut() {
+                let height = -sim.state().0[rotorsim::model::DOWN];
+                sticks[3] += hold.correction(height, dt) as f32;
+            }
+            if let Some(step) = disturbances.collective_step {
+                if ticks as f64 * dt >= step.at_s {
+                    sticks[3] += step.delta as f32;
+                }
             }
         }
         let input = SensorIn {
@@ -320,6 +359,9 @@ pub fn fly_record(
                     if fly_on_ticks == 0 {
                         break;
                     }
+                } else if !monitor.began && monitor.test_refused.is_some() {
+                    // The test switch stays on: no test starts without its cycling.
+                    break;
                 } else if ticks >= max_ticks {
                     break;
                 }
@@ -339,6 +381,7 @@ pub fn fly_record(
         abort: monitor.abort,
         began: monitor.began,
         first_mode_change: monitor.first_mode_change.clone(),
+        test_refused: monitor.test_refused.clone(),
         trim_captured: monitor.trim_captured,
         max_abs_deg: monitor.max_abs,
         max_from_trim_deg: monitor.max_from_trim,
