@@ -115,7 +115,7 @@ import os, socket, struct, subprocess, sys, time, zlib
 
 PHASES = ["idle", "armed", "trim_capture", "fade_in", "sweep", "fade_out", "done", "aborted"]
 ABORT_REASONS = ["attitude_limit", "rate_limit", "sensor_not_finite", "sensor_stale",
-                 "pilot_override", "switch_released", "rc_lost", "imu_fault", "disarmed"]
+                 "pilot_override", "switch_released", "rc_lost", "imu_fault", "disarmed", "landed"]
 EVENTS = ["phase_change", "hold_engaged", "hold_released", "trim_captured", "abort",
           "mode_change", "imu_health", "refused", "host_link_ignored", "param_store"]
 IMU_HEALTH = ["ok", "calibrating", "missing", "stuck", "saturated", "not_ready", "not_finite",
