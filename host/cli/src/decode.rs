@@ -11,6 +11,8 @@ use sweephold_protocol::{
     tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, RefusedCheck, TickStep,
 };
 
+use sysid::records::{test_line, TestProgress};
+
 use crate::output::{refuse_inputs_as_outputs, AtomicFile, StdoutWriter};
 use crate::table::{axis_name, phase_name, RowWriter};
 
@@ -29,8 +31,10 @@ pub enum Format {
 #[command(
     after_help = "Columns are listed in docs/formats.md. A summary goes to \
 stderr: good frames, corrupt frames skipped, tick gaps, tick steps back (a Sample whose tick \
-is not after the previous one's), duration, vehicle, protocol version; with CSV output the \
-events are listed there too. With -o FILE the file appears only when decoding \
+is not after the previous one's), duration, vehicle, protocol version, then one line per test \
+(a dump holds one test per Header: number, axis, input, mode, duration, and how it ended: \
+completed, aborted, partial when the file ends during the excitation, or not started); with \
+CSV output the events are listed there too. Every Sample of every test is written. With -o FILE the file appears only when decoding \
 succeeded (an earlier FILE stays as it was otherwise); a FILE that is one of the dumps is \
 refused.\n\nExit status: 0 when at least one good frame was read; 1 on a missing or \
 unreadable file or a folder, an output that is an input, a dump of another protocol major \
@@ -80,6 +84,20 @@ pub struct DumpSummary {
     pub forward_ticks: u64,
     /// Events in stream order.
     pub events: Vec<Event>,
+    /// One per Header: the test it starts, its Samples and how far it got.
+    pub tests: Vec<DecodedTest>,
+}
+
+/// A test of a dump as decoding sees it (the same rule as `frf`'s:
+/// [`sysid::records::TestProgress`]).
+#[derive(Debug, Clone)]
+pub struct DecodedTest {
+    /// Its Header.
+    pub header: Header,
+    /// Samples up to the next Header.
+    pub samples: usize,
+    /// The phases and Events seen.
+    pub progress: TestProgress,
 }
 
 impl DumpSummary {
@@ -154,9 +172,16 @@ fn handle_frame<W: Write>(
                 .map(|h| summary.forward_ticks as f64 / f64::from(h.rate_hz));
             rows.sample(&sample, time)?;
             summary.samples += 1;
+            if let Some(test) = summary.tests.last_mut() {
+                test.samples += 1;
+                test.progress.see(sample.phase);
+            }
         }
         Frame::Event(event) => {
             rows.json_line(&event_json(&event).to_string())?;
+            if let Some(test) = summary.tests.last_mut() {
+                test.progress.see_event(&event);
+            }
             summary.events.push(event);
         }
         Frame::Header(header) => {
@@ -164,6 +189,11 @@ fn handle_frame<W: Write>(
             if summary.header.is_none() {
                 summary.header = Some(header);
             }
+            summary.tests.push(DecodedTest {
+                header,
+                samples: 0,
+                progress: TestProgress::default(),
+            });
         }
         // In-the-loop and parameter traffic is not telemetry; a dump of a serial link may
         // hold it.
@@ -432,6 +462,13 @@ fn print_summary(path: &Path, s: &DumpSummary, list_events: bool) {
     crate::note!(
         "  duration {duration}, vehicle {vehicle}, rate {rate}, protocol {protocol}, firmware {firmware}"
     );
+    for (index, test) in s.tests.iter().enumerate() {
+        let end = test.progress.end();
+        crate::note!(
+            "  {}",
+            test_line(index + 1, &test.header, test.samples, end)
+        );
+    }
     if list_events {
         for event in &s.events {
             crate::note!("  {}", event_text(event));

@@ -26,7 +26,8 @@ use sysid::fit::plausible::{describe, implausible_parameters};
 use sysid::fit::report::{ScoredModelDocument, TruthSection};
 use sysid::fit::trim::{TrimBalance, TrimPoints};
 use sysid::fit::{
-    fit_from_alternative_starts, start_from_quasi_steady, FitOptions, ModelDocument, ModelStructure,
+    fit_from_alternative_starts, measured_outputs, reduce_to_measured, start_from_quasi_steady,
+    FitOptions, ModelDocument, ModelStructure,
 };
 
 /// Arguments of `sweephold fit`.
@@ -227,9 +228,19 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     })?;
     let constants: BTreeMap<String, f64> = args.constants.iter().cloned().collect();
     let structure = model_structure(&args.model, &constants)?;
+    // A board without air data gives no response of u, v, w: those pairs are left out.
+    let (structure, unmeasured) = reduce_to_measured(structure, &measured_outputs(&data))?;
 
     // Everything goes to one report printed at the end (see `emit`).
     let mut report = String::new();
+    if !unmeasured.is_empty() {
+        let _ = writeln!(
+            report,
+            "pairs of {} left out: {} holds no response of them\n",
+            unmeasured.join(", "),
+            args.frf.display()
+        );
+    }
     let mut starts = Vec::new();
     if let Some(path) = &args.start_from {
         let text =

@@ -11,7 +11,7 @@ use clap::Args;
 use sysid::frf::{
     analyse, group_by_primary, FrfAnalysis, FrfOptions, ResponseEstimator, ResponseInputs,
 };
-use sysid::records::{check_one_origin, load_csv_records, load_dump_with_origin, Record};
+use sysid::records::{check_one_origin, load_csv_records, Record};
 
 /// Arguments of `sweephold frf`.
 #[derive(Args, Debug)]
@@ -38,7 +38,11 @@ channels in rad/s, deg/s, rad or deg, converted to rad/s and rad; a body-rate ch
 15 gets a note that it looks like deg/s.\n\nThe swept input of a CSV file is, in this order: \
 --swept; else the value of its --primary-column (as `sweephold decode` writes it), which \
 must be the same on every row kept; else the input with the largest RMS about its trend \
-line. A dump's Header names its swept axis.\n\nWhich inputs get responses \
+line. A dump's Header names its swept axis.\n\nA dump holds one test per Header (a logger's \
+file per power-up, or records concatenated): each test is listed on stderr (number, axis, \
+input, mode, duration, how it ended) and every completed sweep is used; tests that are not \
+sweeps or never started are left out, and so are aborted and partial (cut-off) ones unless \
+--include-aborted.\n\nWhich inputs get responses \
 (--excited): `swept`, the swept input of each group; `all`, also every other input whose \
 RMS is at least 10 % of the group's largest input RMS (all from the same MISO solve, each \
 with its partial coherence; the pairs carry `group` and the output's \
@@ -122,6 +126,10 @@ pub struct FrfArgs {
     /// Flight-log options.
     #[command(flatten)]
     pub log: crate::logs::LogFrfArgs,
+    /// Also analyse the sweeps of dump tests that were aborted or cut off (partial); by
+    /// default they are listed and left out.
+    #[arg(long)]
+    pub include_aborted: bool,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -241,6 +249,7 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
     }
     let mut records: Vec<Record> = Vec::new();
     let mut origins = Vec::new();
+    let mut test_lines = Vec::new();
     for path in &args.files {
         if crate::logs::log_format(path).is_some() {
             let (inputs, outputs) = (columns.inputs.clone(), columns.outputs.clone());
@@ -251,14 +260,22 @@ pub fn run(args: &FrfArgs) -> anyhow::Result<()> {
         } else if is_csv(path) {
             records.extend(load_csv_records(path, &columns)?);
         } else {
-            let (record, origin) = load_dump_with_origin(path)?;
-            records.push(record);
-            origins.push(origin);
+            let sweeps = crate::dump_tests::sweep_records(path, args.include_aborted)?;
+            for (record, origin) in sweeps.records {
+                records.push(record);
+                origins.push(origin);
+            }
+            test_lines.extend(sweeps.lines);
         }
     }
     // Before any work: dumps of two vehicles (or flight controllers, or rates) are not
     // one aircraft's responses.
     check_one_origin(&origins)?;
+    if !args.quiet {
+        for line in &test_lines {
+            crate::note!("{line}");
+        }
+    }
     let groups = group_by_primary(records)?;
     let analysis = analyse(&groups, &opts)?;
 
@@ -365,9 +382,9 @@ mod tests {
         dir
     }
 
-    /// A dump of a lateral sweep (ω 0.5–12 rad/s, 50 Hz, `seconds` long) where the roll
-    /// rate is a discrete first-order lag of the lateral command; `sweep` false gives a
-    /// dump that never leaves the idle phase.
+    /// A dump of a lateral sweep (ω 0.5–12 rad/s, 50 Hz, `seconds` long, its last Sample
+    /// in the done phase) where the roll rate is a discrete first-order lag of the lateral
+    /// command; `sweep` false gives a dump that never leaves the idle phase.
     fn dump(seconds: f64, sweep: bool) -> Vec<u8> {
         dump_with_pedal(seconds, sweep, 0.0)
     }
@@ -428,7 +445,13 @@ mod tests {
             p = 0.9 * p + 0.1 * 2.0 * lat;
             push(Frame::Sample(Sample {
                 tick: k as u32,
-                phase: if sweep { Phase::Sweep } else { Phase::Idle },
+                // The last Sample in the done phase: the test completed, as the
+                // firmware's do (a test cut off in its sweep is left out).
+                phase: match (sweep, k + 1 == len) {
+                    (false, _) => Phase::Idle,
+                    (true, false) => Phase::Sweep,
+                    (true, true) => Phase::Done,
+                },
                 primary: Axis::Lat,
                 sweep_omega: 0.0,
                 hold: [HoldState::Released; 3],

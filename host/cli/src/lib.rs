@@ -20,6 +20,7 @@ pub mod artifacts;
 pub mod campaign;
 pub mod csv_args;
 pub mod decode;
+pub mod dump_tests;
 pub mod fc;
 pub mod fit;
 pub mod fit_tables;

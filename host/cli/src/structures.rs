@@ -10,19 +10,6 @@ use sysid::fit::{ModelStructure, StructureError};
 use sysid::models::{self, ShippedStructure, VehicleData};
 pub use truth::{nine_dof_hybrid, with_vehicle_data, TrimAttitude};
 
-/// The outputs only air data measures (the body velocities): a flight controller's IMU
-/// measures the rates, the attitude and the specific force, not these.
-pub const AIR_DATA_OUTPUTS: [&str; 3] = ["u", "v", "w"];
-
-/// `structure` for records without air data: its pairs of the [`AIR_DATA_OUTPUTS`] left
-/// out (the states stay: the accelerometer pairs and the trim points still see them).
-pub fn without_air_data(mut structure: ModelStructure) -> ModelStructure {
-    structure
-        .pairs
-        .retain(|pair| !AIR_DATA_OUTPUTS.contains(&pair.output.as_str()));
-    structure
-}
-
 /// The quasi-steady 6-DOF structure (both vehicles: it has no vehicle constants).
 pub fn six_dof() -> Result<ModelStructure, StructureError> {
     models::BO105_6DOF.parse()
@@ -61,26 +48,6 @@ fn shipped_for_its_vehicle(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn without_air_data_keeps_the_imu_pairs_only() {
-        let full = nine_dof_hybrid(&aircraft::shipped("bo105").unwrap(), None).unwrap();
-        let imu = without_air_data(full.clone());
-        assert_eq!(imu.states, full.states);
-        assert_eq!(imu.parameters, full.parameters);
-        assert!(imu
-            .pairs
-            .iter()
-            .all(|p| !AIR_DATA_OUTPUTS.contains(&p.output.as_str())));
-        let dropped = full.pairs.len() - imu.pairs.len();
-        let air = full
-            .pairs
-            .iter()
-            .filter(|p| AIR_DATA_OUTPUTS.contains(&p.output.as_str()))
-            .count();
-        assert_eq!(dropped, air);
-        assert!(air > 0 && !imu.pairs.is_empty());
-    }
 
     #[test]
     fn built_in_structures_parse() {

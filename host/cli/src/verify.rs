@@ -252,11 +252,11 @@ fn write_verification(out: &mut String, verification: &Verification) {
         );
     }
     let _ = writeln!(out, "{:<8} {:>8.4}", "mean", verification.theil_mean);
-    if !verification.not_recorded.is_empty() {
+    if !verification.not_measured.is_empty() {
         let _ = writeln!(
             out,
-            "not recorded (not compared): {}",
-            verification.not_recorded.join(" ")
+            "not measured (not scored, not in the mean): {}",
+            verification.not_measured.join(" ")
         );
     }
 }

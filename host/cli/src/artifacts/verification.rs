@@ -41,6 +41,11 @@ pub struct VerifiedRecord {
     pub diverged_at_s: Option<f64>,
     /// The compared outputs, model order.
     pub outputs: Vec<VerifiedOutput>,
+    /// Model outputs the record does not measure (absent, or zeros throughout as a board
+    /// without air data logs u, v, w): not scored, not in `tic_mean`. Left out of the
+    /// file when empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_measured: Vec<String>,
 }
 
 /// `verify.json`: the verification of the campaign's final model.
@@ -126,6 +131,7 @@ mod tests {
                     tic_mean: 0.2,
                     diverged_at_s: None,
                     outputs: vec![output("p", 0.1), output("q", 0.3)],
+                    not_measured: vec![],
                 },
                 VerifiedRecord {
                     file: "b.bin".into(),
@@ -133,6 +139,7 @@ mod tests {
                     tic_mean: 0.5,
                     diverged_at_s: None,
                     outputs: vec![output("p", 0.3), output("w", 0.7)],
+                    not_measured: vec![],
                 },
             ],
         };

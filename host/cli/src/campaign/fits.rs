@@ -13,7 +13,8 @@ use sysid::fit::modes::{mode_records, poles_at_origin};
 use sysid::fit::plausible::{implausible_parameters, HeldParameter};
 use sysid::fit::trim::TrimPoints;
 use sysid::fit::{
-    fit_from_alternative_starts, start_from_quasi_steady, FitOptions, FitResult, ModelStructure,
+    fit_from_alternative_starts, measured_outputs, reduce_to_measured, start_from_quasi_steady,
+    FitOptions, FitResult, ModelStructure,
 };
 use sysid::models;
 
@@ -31,14 +32,11 @@ use crate::structures;
 use truth::TrimAttitude;
 
 impl Campaign<'_> {
-    /// `structure` with the pairs the campaign's records measure: all of them in
-    /// process, none of the air-data outputs on the board (`--fc board-sim`).
-    fn measured(&self, structure: ModelStructure) -> ModelStructure {
-        if self.args.fc.measures_air_data() {
-            structure
-        } else {
-            structures::without_air_data(structure)
-        }
+    /// `structure` with the pairs of the outputs `frf` holds, as `sweephold fit` reduces
+    /// it ([`reduce_to_measured`]): all of them in process, none of the air-data outputs
+    /// on the board (`--fc board-sim`), whose u = v = w = 0 give no response.
+    fn measured(structure: ModelStructure, frf: &FrfDocument) -> anyhow::Result<ModelStructure> {
+        Ok(reduce_to_measured(structure, &measured_outputs(frf))?.0)
     }
 
     /// `sweephold fit` for this campaign: the structure `model` on `frf.json`, with the
@@ -102,7 +100,7 @@ impl Campaign<'_> {
             false,
             Some(SIX_DOF_MAX_STARTS),
         )?;
-        let structure = self.measured(structures::six_dof()?);
+        let structure = Self::measured(structures::six_dof()?, frf)?;
         // Nor does it take the trim points: its derivatives only start the hybrid, and on
         // most seeds it lands in a degenerate minimum (X_ped, Z_ped of 10⁶–10⁸ with long
         // delays) whose steady balance gives no usable Z_w.
@@ -177,10 +175,10 @@ impl Campaign<'_> {
         let structure = self.args.vehicle.structure().to_string();
         let args = self.fit_args(&structure, files::MODEL_9DOF, true, None)?;
         // Kinematics and gravity about the trim the flight controller captured.
-        let hybrid = self.measured(structures::nine_dof_hybrid(
-            self.args.vehicle.aircraft(),
-            trim,
-        )?);
+        let hybrid = Self::measured(
+            structures::nine_dof_hybrid(self.args.vehicle.aircraft(), trim)?,
+            frf,
+        )?;
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
         let starts = [
             (files::MODEL_6DOF.to_string(), started),

@@ -99,8 +99,9 @@ pub struct CampaignArgs {
     /// The flight controller that flies every record: `in-process` (the firmware's flight
     /// logic on the simulator's exact states) or `board-sim` (the board application on an
     /// emulated ICM-42688-P and SBUS receiver, as `fly --fc board-sim`). The board
-    /// measures no air data (u, v, w), so with `board-sim` the fits leave out the pairs of
-    /// those outputs and the verification scores the outputs the board measures.
+    /// measures no air data (u = v = w = 0), so with `board-sim` the frequency responses
+    /// have no pair of those outputs, the fits leave their pairs out as `fit` does, and the
+    /// verification scores the outputs the board measures.
     /// `board-sim:FLASH`: the board boots the parameter set saved in FLASH (`sweephold fc
     /// params push FILE --fc board-sim:FLASH`, then `save`; refused if FLASH holds none)
     /// and flies the aircraft --vehicle describes; the campaign chooses only each
@@ -229,12 +230,6 @@ impl CampaignLink {
             CampaignLink::BoardSim(None) => "board-sim".to_string(),
             CampaignLink::BoardSim(Some(flash)) => format!("board-sim:{}", flash.display()),
         }
-    }
-
-    /// Whether the records carry air data (u, v, w): only the simulator's exact states
-    /// do; the board measures rates, attitude and specific force.
-    pub const fn measures_air_data(&self) -> bool {
-        matches!(self, CampaignLink::InProcess)
     }
 }
 

@@ -15,7 +15,6 @@ use super::{verb_args, Campaign};
 use crate::artifacts::files;
 use crate::artifacts::verification::{VerifiedOutput, VerifiedRecord, VerifyDocument};
 use crate::output::write_json;
-use crate::structures;
 use crate::verify::VerifyArgs;
 
 /// Every `DECIMATION`-th sample is kept in `verify.json` (200 Hz → 50 Hz): the doublets'
@@ -39,14 +38,12 @@ impl Campaign<'_> {
         // each input's trim likewise), not fitted to the prediction.
         let args: VerifyArgs = verb_args("verify", argv)?;
         let (segment_s, bias) = (args.segment, args.bias.mode());
-        let mut records = doublets
+        // Outputs a record does not measure (the board's u, v, w) are left out of the
+        // scores by `verify_record_in_segments` and listed in `not_measured`.
+        let records = doublets
             .iter()
             .map(|file| verify_dump(model, self.dir(), file, segment_s, bias))
             .collect::<anyhow::Result<Vec<_>>>()?;
-        if !self.args.fc.measures_air_data() {
-            // The board measures no u, v, w: its zeros are no measurement to score.
-            records.iter_mut().for_each(without_air_data);
-        }
         let document = VerifyDocument {
             model_file: files::MODEL_9DOF.to_string(),
             segment_s,
@@ -67,17 +64,6 @@ impl Campaign<'_> {
         );
         self.summary.verify = Some(summary);
         Ok(((), line))
-    }
-}
-
-/// `record` with the air-data outputs left out and its mean TIC over the others.
-fn without_air_data(record: &mut VerifiedRecord) {
-    record
-        .outputs
-        .retain(|output| !structures::AIR_DATA_OUTPUTS.contains(&output.name.as_str()));
-    let tics: Vec<f64> = record.outputs.iter().map(|output| output.tic).collect();
-    if !tics.is_empty() {
-        record.tic_mean = tics.iter().sum::<f64>() / tics.len() as f64;
     }
 }
 
@@ -137,5 +123,6 @@ fn verified_record(file: &str, verification: &Verification) -> VerifiedRecord {
                     .map_or_else(Vec::new, |s| decimate(s)),
             })
             .collect(),
+        not_measured: verification.not_measured.clone(),
     }
 }

@@ -139,6 +139,18 @@ pub enum FitError {
         /// Line of the pair in the structure file.
         line: usize,
     },
+    /// Reduced to the outputs the data hold, the structure has no pair of a control left.
+    #[error(
+        "structure {structure}: no pair of control `{control}` left: its outputs ({outputs}) are not in the frequency-response data"
+    )]
+    NoMeasuredPairOfControl {
+        /// Structure name.
+        structure: String,
+        /// Control name.
+        control: String,
+        /// The outputs of the control's pairs, space-separated.
+        outputs: String,
+    },
     /// A pair with `range = "auto"` whose data has no valid (coherent) range.
     #[error(
         "line {line}: pair {output}/{input} has range \"auto\" but its data have no \

@@ -1,7 +1,8 @@
 //! Records from telemetry dumps.
 //!
 //! The excitation record of a dump is every Sample whose phase is fade-in, sweep or
-//! fade-out, of the first test (Header) that has any, plus up to [`SETTLE_S`] of trim
+//! fade-out, of the first test (Header) that has any ([`load_dump`]; every test's, each
+//! on its own: [`load_dump_tests`], the tests split by [`super::dump_tests`]), plus up to [`SETTLE_S`] of trim
 //! on either side. Inputs are the applied commands
 //! `lat lon ped col`; outputs are `u v w p q r ax ay az phi theta`; the references are
 //! what the firmware injected into each control (`sweep` + `noise`). The rate and the
@@ -13,8 +14,11 @@
 
 use std::path::Path;
 
-use sweephold_protocol::{tick_step, Decoder, Frame, FrameError, Header, Phase, Sample, TickStep};
+use sweephold_protocol::{tick_step, Header, Phase, Sample, TickStep};
 
+#[cfg(test)]
+use super::dump_tests::TestEnd;
+use super::dump_tests::{is_excitation, split_tests, TestRecord};
 use super::origin::DumpOrigin;
 use super::record::{Channel, Record};
 use super::RecordError;
@@ -73,10 +77,6 @@ fn load_dump_with(path: impl AsRef<Path>, excitation: Excitation) -> Result<Reco
     load_dump_bytes_with(&bytes, &path.display().to_string(), excitation).map(|(r, _)| r)
 }
 
-fn is_excitation(phase: Phase) -> bool {
-    matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
-}
-
 /// The commands `lat lon ped col`, then the excitation injected into each (sweep +
 /// off-axis noise): the reference channels.
 fn input_row(sample: &Sample) -> [f64; 8] {
@@ -112,65 +112,63 @@ pub fn load_dump_bytes(bytes: &[u8], source: &str) -> Result<Record, RecordError
     load_dump_bytes_with(bytes, source, Excitation::Sweep).map(|(record, _)| record)
 }
 
-/// The record and the Header of its test.
+/// The record and the Header of its test: the first test (Header) with excitation.
 fn load_dump_bytes_with(
     bytes: &[u8],
     source: &str,
     excitation: Excitation,
 ) -> Result<(Record, Header), RecordError> {
-    let mut decoder = Decoder::new();
-    // Samples per test: a new segment starts at every Header.
-    let mut segments: Vec<(Option<Header>, Vec<Sample>)> = vec![(None, Vec::new())];
-    for result in decoder.feed(bytes) {
-        match result {
-            Ok(Frame::Header(h)) => segments.push((Some(h), Vec::new())),
-            Ok(Frame::Sample(sample)) => {
-                if let Some((_, samples)) = segments.last_mut() {
-                    samples.push(sample);
-                }
-            }
-            Ok(_) => {}
-            Err(mismatch @ FrameError::VersionMismatch { .. }) => {
-                return Err(RecordError::Protocol {
-                    path: source.into(),
-                    message: mismatch.to_string(),
-                })
-            }
-            Err(_) => {} // counted by the decoder; a damaged frame is skipped
-        }
-    }
-    let stats = decoder.stats();
-    let chosen = segments
+    let split = split_tests(bytes, source)?;
+    let chosen = split
+        .tests
         .iter()
-        .position(|(_, samples)| samples.iter().any(|s| is_excitation(s.phase)));
-    let Some((record_header, all)) = chosen.map(|index| &segments[index]) else {
-        let any_header = segments.iter().any(|(h, _)| h.is_some());
-        return Err(if stats.good_frames == 0 {
-            RecordError::NoSweep {
-                path: source.into(),
-                detail: "no valid frame".into(),
-            }
-        } else if !any_header {
-            RecordError::NoHeader {
-                path: source.into(),
-            }
-        } else {
-            RecordError::NoSweep {
-                path: source.into(),
-                detail: "no Sample in the fade-in, sweep or fade-out phases".into(),
-            }
-        });
+        .find(|test| test.samples.iter().any(|s| is_excitation(s.phase)));
+    let Some(test) = chosen else {
+        return Err(split.no_record_error(source));
     };
-    let header = record_header.ok_or_else(|| RecordError::NoHeader {
-        path: source.into(),
+    let record =
+        record_from_samples_at(&test.header, &test.samples, test.offset, source, excitation)?;
+    Ok((record, test.header))
+}
+
+/// Every test of the dump file `path` ([`split_tests`]), each with its sweep record, and
+/// where the file says it came from (its first Header). A file with no valid frame or no
+/// Header is an error, as for [`load_dump`].
+pub fn load_dump_tests(
+    path: impl AsRef<Path>,
+) -> Result<(Vec<TestRecord>, DumpOrigin), RecordError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|error| RecordError::Io {
+        path: path.to_path_buf(),
+        error,
     })?;
-    // Samples of the dump before the chosen test's: messages count from the dump's first.
-    let offset = segments[..chosen.unwrap_or(0)]
-        .iter()
-        .map(|(_, samples)| samples.len())
-        .sum();
-    let record = record_from_samples_at(&header, all, offset, source, excitation)?;
-    Ok((record, header))
+    let file = path.display().to_string();
+    let split = split_tests(&bytes, &file)?;
+    let Some(first) = split.tests.first() else {
+        return Err(split.no_record_error(&file));
+    };
+    let origin = DumpOrigin::of(&file, &first.header);
+    let several = split.tests.len() > 1;
+    let tests = split
+        .tests
+        .into_iter()
+        .map(|test| {
+            let source = if several {
+                format!("{file} test {}", test.number)
+            } else {
+                file.clone()
+            };
+            let record = record_from_samples_at(
+                &test.header,
+                &test.samples,
+                test.offset,
+                &source,
+                Excitation::Sweep,
+            );
+            TestRecord { test, record }
+        })
+        .collect();
+    Ok((tests, origin))
 }
 
 /// The excitation record of one test from its Header and its Samples in stream order
@@ -347,6 +345,48 @@ fn record_from_samples_at(
 mod tests {
     use super::*;
     use crate::frf::testing::{dump_bytes, DumpSpec};
+    use sweephold_protocol::{Decoder, Frame};
+
+    #[test]
+    fn every_test_of_a_concatenation_gives_the_record_of_its_own_file() {
+        let lat = DumpSpec::default();
+        let lon = DumpSpec {
+            primary: sweephold_protocol::Axis::Lon,
+            sweep_samples: 500,
+            ..DumpSpec::default()
+        };
+        let dir = std::env::temp_dir().join(format!("sysid-dump-tests-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let both = dir.join("both.dump");
+        std::fs::write(&both, [dump_bytes(&lat), dump_bytes(&lon)].concat()).unwrap();
+        let (tests, origin) = load_dump_tests(&both).unwrap();
+        assert_eq!(
+            origin,
+            DumpOrigin::of(&both.display().to_string(), &tests[0].test.header)
+        );
+        assert_eq!(tests.len(), 2);
+        for (test, spec) in tests.iter().zip([&lat, &lon]) {
+            let alone = load_dump_bytes(&dump_bytes(spec), "alone").unwrap();
+            let record = test.record.as_ref().unwrap();
+            assert_eq!(record.primary, spec.primary.name());
+            let name = format!("{} test {}", both.display(), test.test.number);
+            assert_eq!(
+                *record,
+                Record {
+                    source: name,
+                    ..alone
+                }
+            );
+            assert_eq!(test.test.end(), TestEnd::Completed);
+        }
+        // A file of one test names its record by the file alone.
+        let one = dir.join("one.dump");
+        std::fs::write(&one, dump_bytes(&lat)).unwrap();
+        let (one_test, _) = load_dump_tests(&one).unwrap();
+        let record = one_test[0].record.as_ref().unwrap();
+        assert_eq!(record.source, one.display().to_string());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn reads_the_excitation_of_a_dump() {

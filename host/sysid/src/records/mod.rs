@@ -4,7 +4,8 @@
 //! * [`record`] — the [`Record`] (named, uniformly sampled input, output and reference
 //!   channels of one excitation);
 //! * [`dump`] — the project's telemetry dumps (the firmware's frames, decoded), with
-//!   [`origin`]: what a dump's Header says of where it was flown;
+//!   [`dump_tests`]: a dump split into its tests at its Headers, and [`origin`]: what a
+//!   dump's Header says of where it was flown;
 //! * [`csv`] — other loggers' CSV files, with their time and unit rules;
 //! * [`ulog`] — PX4 ULog files (`.ulg`);
 //! * [`dataflash`] — ArduPilot DataFlash binary logs (`.bin`, `.BIN`);
@@ -38,6 +39,7 @@ mod binary;
 pub mod csv;
 pub mod dataflash;
 pub mod dump;
+pub mod dump_tests;
 mod error;
 pub mod log;
 pub mod origin;
@@ -49,8 +51,11 @@ pub(crate) use binary::{text, Bytes, Primitive};
 pub use csv::units::{TimeUnit, Unit};
 pub use csv::{load_csv, load_csv_records, parse_csv_records, CsvColumns};
 pub use dump::{
-    load_dump, load_dump_bytes, load_dump_with_origin, load_test_dump, record_from_samples,
-    test_record_from_samples,
+    load_dump, load_dump_bytes, load_dump_tests, load_dump_with_origin, load_test_dump,
+    record_from_samples, test_record_from_samples,
+};
+pub use dump_tests::{
+    split_tests, test_line, DumpTest, SplitDump, TestEnd, TestProgress, TestRecord,
 };
 pub use error::RecordError;
 pub(crate) use log::median_rate_hz;

@@ -50,7 +50,10 @@
 //! 0 is a perfect prediction, 1 the worst (e.g. ŷ = −(y − b), or one of them zero);
 //! below ≈ 0.25–0.3 is the usual acceptance guideline (Jategaonkar; Tischler & Remple).
 //! The overall figure is the mean of the per-output TICs (the outputs have different
-//! units, so their squares are not pooled).
+//! units, so their squares are not pooled). Only measured outputs are scored: a model
+//! output the record lacks, or holds as zeros throughout ([`measured_output`]: a board
+//! without air data logs u = v = w = 0), is listed as not measured, outside the TICs and
+//! their mean.
 //!
 //! The submodules hold the parts: `simulate` (the discrete model and the simulation),
 //! `score` (bias and TIC of one output); their items are re-exported here.
@@ -167,8 +170,9 @@ pub struct Verification {
     pub trim_samples: usize,
     /// Per compared output (model outputs recorded in the record), model order.
     pub outputs: Vec<OutputScore>,
-    /// Model outputs the record does not have.
-    pub not_recorded: Vec<String>,
+    /// Model outputs the record does not measure ([`measured_output`]): not compared, and
+    /// not in [`Self::theil_mean`].
+    pub not_measured: Vec<String>,
     /// Mean of the per-output TICs.
     pub theil_mean: f64,
     /// Time \[s\] at which the simulated model overflowed (an unstable model running away):
@@ -178,6 +182,16 @@ pub struct Verification {
     pub measured: Vec<Vec<f64>>,
     /// Predicted series, per compared output.
     pub predicted: Vec<Vec<f64>>,
+}
+
+/// The series of output `name` when `record` measures it: a channel the record holds
+/// that is not exactly zero throughout. A logger writes zeros for what its board has no
+/// sensor for (a flight controller's u, v, w without air data); no sensor reads exactly
+/// 0.0 on every sample of a flight, so such a channel is no measurement to score.
+pub fn measured_output<'a>(record: &'a Record, name: &str) -> Option<&'a [f64]> {
+    record
+        .output(name)
+        .filter(|series| series.iter().any(|&value| value != 0.0))
 }
 
 /// Verify `model` on `record` over the whole record from trim: simulate it on the
@@ -246,7 +260,7 @@ pub fn verify_record_in_segments(
         .outputs
         .iter()
         .enumerate()
-        .filter_map(|(i, name)| record.output(name).map(|series| (i, series)))
+        .filter_map(|(i, name)| measured_output(record, name).map(|series| (i, series)))
         .collect();
     if compared.is_empty() {
         return Err(VerifyError::NoCommonOutput {
@@ -254,10 +268,10 @@ pub fn verify_record_in_segments(
             model_outputs: model.outputs.clone(),
         });
     }
-    let not_recorded = model
+    let not_measured = model
         .outputs
         .iter()
-        .filter(|name| record.output(name).is_none())
+        .filter(|name| measured_output(record, name).is_none())
         .cloned()
         .collect();
     // Samples whose means are the trims (biases), with the trim bias.
@@ -297,8 +311,7 @@ pub fn verify_record_in_segments(
             .states
             .iter()
             .map(|name| {
-                record
-                    .output(name)
+                measured_output(record, name)
                     .map(|series| (series, mean_of_first(series, averaged)))
             })
             .collect();
@@ -330,7 +343,7 @@ pub fn verify_record_in_segments(
                 bias,
                 trim_samples: trim_samples.unwrap_or(0),
                 outputs,
-                not_recorded,
+                not_measured,
                 theil_mean: 1.0,
                 diverged_at_s: Some(sample as f64 / record.sample_rate_hz),
                 measured: Vec::new(),
@@ -361,7 +374,7 @@ pub fn verify_record_in_segments(
         samples: record.len(),
         bias,
         trim_samples: trim_samples.unwrap_or(0),
-        not_recorded,
+        not_measured,
         outputs,
         theil_mean,
         diverged_at_s: None,

@@ -283,8 +283,32 @@ fn mismatches_are_reported() {
     let mut partial = record_of(&model, 0.0);
     partial.outputs.retain(|c| c.name != "ay");
     let result = verify_fitted(&model, &partial).unwrap();
-    assert_eq!(result.not_recorded, vec!["ay".to_string()]);
+    assert_eq!(result.not_measured, vec!["ay".to_string()]);
     assert_eq!(result.outputs.len(), 3);
+
+    // So is one the record holds as zeros throughout (a board without the sensor): it
+    // is neither scored nor in the mean.
+    let mut zeroed = record_of(&model, 0.0);
+    let full = verify_fitted(&model, &zeroed).unwrap();
+    let kept: Vec<f64> = full
+        .outputs
+        .iter()
+        .filter(|o| o.output != "ay")
+        .map(|o| o.theil)
+        .collect();
+    for channel in zeroed.outputs.iter_mut().filter(|c| c.name == "ay") {
+        channel.values.iter_mut().for_each(|v| *v = 0.0);
+    }
+    let result = verify_fitted(&model, &zeroed).unwrap();
+    assert_eq!(result.not_measured, vec!["ay".to_string()]);
+    let scored: Vec<f64> = result.outputs.iter().map(|o| o.theil).collect();
+    assert_eq!(scored, kept);
+    let mean = kept.iter().sum::<f64>() / kept.len() as f64;
+    assert!(
+        (result.theil_mean - mean).abs() < 1e-12,
+        "{}",
+        result.theil_mean
+    );
 }
 
 /// Trim samples at 100 Hz in front of the excitation of [`record_with_trim`].

@@ -1,0 +1,77 @@
+//! Which tests of a telemetry dump `frf` analyses: a dump (a logger's file per power-up,
+//! or records concatenated) holds one test per Header (split by
+//! [`sysid::records::load_dump_tests`]); every completed sweep is used, and every test is
+//! listed with how it ended and what became of it.
+
+use std::path::Path;
+
+use anyhow::anyhow;
+use sysid::records::{load_dump_tests, DumpOrigin, Record, TestEnd, TestRecord};
+
+/// What `frf` takes from one dump.
+pub struct DumpSweeps {
+    /// The sweep records used, each with the origin its Header gives.
+    pub records: Vec<(Record, DumpOrigin)>,
+    /// One line per test: what it is, how it ended, used or why not.
+    pub lines: Vec<String>,
+}
+
+/// The sweep records of the dump `path` that `frf` analyses, each with its origin, and one
+/// line per test for stderr. Aborted and partial tests are left out unless
+/// `include_aborted`; tests that are not sweeps, or never started, are left out. A test
+/// that would be used but gives no record (ticks that step back, too many missing) is an
+/// error, and so is a dump none of whose tests is used (the first test's reason: its
+/// record's error when it has one, else why it was left out).
+pub fn sweep_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpSweeps> {
+    let (tests, _) = load_dump_tests(path)?;
+    let file = path.display().to_string();
+    let mut used = Vec::new();
+    let mut lines = Vec::new();
+    let mut refusal: Option<String> = None;
+    for TestRecord { test, record } in tests {
+        let end = test.end();
+        let is_sweep = test.header.test.input.is_sweep();
+        let verdict = match (end, record) {
+            (TestEnd::NotStarted, record) => {
+                if let Err(error) = record {
+                    refusal.get_or_insert(error.to_string());
+                }
+                "left out: no excitation".to_string()
+            }
+            (_, Err(error)) if !is_sweep => {
+                refusal.get_or_insert(error.to_string());
+                "left out: not a sweep".to_string()
+            }
+            (TestEnd::Aborted | TestEnd::Partial, record) if !include_aborted => {
+                // A record that cannot be read says more than its test's end.
+                let why = match record {
+                    Err(error) => error.to_string(),
+                    Ok(_) => format!(
+                        "{file}: test {} {}: left out (--include-aborted uses it)",
+                        test.number,
+                        end.name()
+                    ),
+                };
+                refusal.get_or_insert(why);
+                "left out (--include-aborted uses it)".to_string()
+            }
+            (_, Err(error)) => return Err(anyhow!("{error}")),
+            (_, Ok(record)) => {
+                let origin = DumpOrigin::of(&record.source, &test.header);
+                used.push((record, origin));
+                "used".to_string()
+            }
+        };
+        lines.push(format!("{file}: {}: {verdict}", test.describe()));
+    }
+    if used.is_empty() {
+        return Err(anyhow!(
+            "{}",
+            refusal.unwrap_or_else(|| format!("{file}: no test with a sweep"))
+        ));
+    }
+    Ok(DumpSweeps {
+        records: used,
+        lines,
+    })
+}
