@@ -7,7 +7,7 @@
 //! other pairs stay (the accelerometer pairs and the trim points still see the velocity
 //! states). An output the document does hold keeps every pair the structure lists, so a
 //! pair missing for one control of a measured output is still the error it was
-//! ([`FitError::MissingPair`](super::FitError::MissingPair)). A control left with no pair
+//! ([`super::FitError::MissingPair`]). A control left with no pair
 //! is an error naming it: nothing in the data would identify its derivatives.
 
 use std::collections::BTreeSet;
