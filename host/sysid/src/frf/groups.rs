@@ -214,22 +214,7 @@ fn taper_end(values: &mut [f64], len: usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::records::Channel;
-
-    fn record(source: &str, primary: &str, lat: Vec<f64>, p: Vec<f64>) -> Record {
-        Record {
-            source: source.into(),
-            sample_rate_hz: 100.0,
-            primary: primary.into(),
-            primary_guessed: false,
-            sweep_band: Some([1.0, 10.0]),
-            inputs: vec![Channel::new("lat", lat)],
-            outputs: vec![Channel::new("p", p)],
-            references: Vec::new(),
-            notes: vec![],
-            trim_samples: 0,
-        }
-    }
+    use crate::records::record::tests::record;
 
     #[test]
     fn joins_have_no_step() {

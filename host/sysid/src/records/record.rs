@@ -205,10 +205,12 @@ pub(crate) fn remove_line(values: &mut [f64]) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn record(source: &str, primary: &str, lat: Vec<f64>, p: Vec<f64>) -> Record {
+    /// A 100 Hz record of one input `lat` and one output `p` (the tests of this module
+    /// and of `frf::groups`).
+    pub(crate) fn record(source: &str, primary: &str, lat: Vec<f64>, p: Vec<f64>) -> Record {
         Record {
             source: source.into(),
             sample_rate_hz: 100.0,
