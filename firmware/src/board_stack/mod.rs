@@ -269,9 +269,10 @@ pub struct BoardStack<SPI, D> {
 }
 
 impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
-    /// Check `config` and build the stack on the IMU's SPI device and a delay. Nothing
-    /// talks to the chip before [`boot`](Self::boot).
-    pub fn new(spi: SPI, delay: D, config: StackConfig) -> Result<Self, StackError> {
+    /// The parts `config` builds, each checked, and the checks of the whole: the filter
+    /// bank, the estimator and the application (for [`new`](Self::new) and
+    /// [`reconfigure`](Self::reconfigure) alike).
+    fn built_from(config: &StackConfig) -> Result<(FilterBank, Mahony, BoardApp), StackError> {
         let filters = FilterBank::new(config.filters).map_err(StackError::Filters)?;
         let estimator = Mahony::new(config.estimator).map_err(StackError::Estimator)?;
         if config.filters.sample_rate_hz != IMU_RATE_HZ
@@ -287,6 +288,13 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
             .validate()
             .map_err(StackError::ChannelMap)?;
         let app = BoardApp::new(config.app).map_err(StackError::App)?;
+        Ok((filters, estimator, app))
+    }
+
+    /// Check `config` and build the stack on the IMU's SPI device and a delay. Nothing
+    /// talks to the chip before [`boot`](Self::boot).
+    pub fn new(spi: SPI, delay: D, config: StackConfig) -> Result<Self, StackError> {
+        let (filters, estimator, app) = Self::built_from(&config)?;
         Ok(BoardStack {
             imu: Icm42688::with_orientation(spi, config.orientation),
             delay,
@@ -317,21 +325,7 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
         if !self.app.host_link_allowed() {
             return Err(StackError::Armed);
         }
-        let filters = FilterBank::new(config.filters).map_err(StackError::Filters)?;
-        let estimator = Mahony::new(config.estimator).map_err(StackError::Estimator)?;
-        if config.filters.sample_rate_hz != IMU_RATE_HZ
-            || config.estimator.sample_rate_hz != IMU_RATE_HZ
-        {
-            return Err(StackError::RateMismatch);
-        }
-        if !config.calibration.is_valid() {
-            return Err(StackError::Calibration);
-        }
-        config
-            .channel_map
-            .validate()
-            .map_err(StackError::ChannelMap)?;
-        let mut app = BoardApp::new(config.app).map_err(StackError::App)?;
+        let (filters, estimator, mut app) = Self::built_from(&config)?;
         app.set_params_valid(self.app.params_valid());
         let mounting_changed = config.orientation != self.config.orientation
             || config.calibration != self.config.calibration
