@@ -361,21 +361,13 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
             "need at least one input and one output column".into(),
         ));
     }
-    let input_names = || {
-        columns
-            .inputs
-            .iter()
-            .map(|(name, _)| name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
     for (name, _) in &columns.references {
         if !columns.inputs.iter().any(|(n, _)| n == name) {
             return Err(error(
                 0,
                 format!(
                     "reference `{name}` is not named after an input ({})",
-                    input_names()
+                    input_names(columns)
                 ),
             ));
         }
@@ -392,7 +384,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
                 0,
                 format!(
                     "unit given for `{name}`, which is neither an input ({}) nor an output ({})",
-                    input_names(),
+                    input_names(columns),
                     outputs.join(", ")
                 ),
             ));
@@ -404,7 +396,7 @@ fn read_rows<'a>(text: &str, source: &str, columns: &'a CsvColumns) -> Result<Ro
                 0,
                 format!(
                     "swept input `{name}` is not among the inputs ({})",
-                    input_names()
+                    input_names(columns)
                 ),
             ));
         }
@@ -519,14 +511,6 @@ fn swept_input(
     columns: &CsvColumns,
     notes: &mut Vec<String>,
 ) -> Result<(String, bool), RecordError> {
-    let input_names = || {
-        columns
-            .inputs
-            .iter()
-            .map(|(name, _)| name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
     let named = match (&columns.primary, &rows.named_axis, &rows.primary_column) {
         (Some(name), _, _) => Some(name.clone()),
         (None, Some((axis, _, _)), Some(column)) => {
@@ -543,7 +527,7 @@ fn swept_input(
                 line: 0,
                 message: format!(
                     "column `{column}` names `{axis}`, which is not among the inputs ({}); name the swept input (--swept)",
-                    input_names()
+                    input_names(columns)
                 ),
             })?)
         }
@@ -568,6 +552,16 @@ fn swept_input(
         "{source}: swept input taken to be `{name}` (the most active)"
     ));
     Ok((name, true))
+}
+
+/// The input columns' names, comma-separated (for the messages that name them).
+fn input_names(columns: &CsvColumns) -> String {
+    columns
+        .inputs
+        .iter()
+        .map(|(name, _)| name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 #[cfg(test)]
