@@ -88,6 +88,8 @@
 
 use core::f64::consts::PI;
 
+use sweephold_protocol::{MeasurementFilter, MEASUREMENT_FILTER_SECTIONS};
+
 /// Why a section cannot be designed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -340,6 +342,8 @@ pub const IMU_CHANNELS: usize = 6;
 pub const NOTCHES: usize = 3;
 /// Sections per channel: the low-pass, then the notches.
 const SECTIONS: usize = 1 + NOTCHES;
+// The telemetry describes the bank section by section.
+const _: () = assert!(SECTIONS == MEASUREMENT_FILTER_SECTIONS);
 
 /// One notch of the bank.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -428,6 +432,16 @@ impl FilterBankConfig {
             }
         }
         Ok(sections)
+    }
+
+    /// The bank as the telemetry describes it to the host ([`MeasurementFilter`]): the
+    /// designed sections' coefficients, in the order they run, at the bank's rate.
+    pub fn measurement_filter(&self) -> Result<MeasurementFilter, FilterError> {
+        let sections = self.design()?;
+        Ok(MeasurementFilter {
+            sample_rate_hz: self.sample_rate_hz,
+            sections: sections.map(|c| [c.b0, c.b1, c.b2, c.a1, c.a2]),
+        })
     }
 }
 

@@ -37,8 +37,9 @@ pub struct ProtocolVersion {
 /// [`Event::Refused`], [`Event::HostLinkIgnored`]); 1.5 the parameter frames
 /// ([`Frame::ParamRequest`], [`Frame::ParamReply`]), [`Event::ParamStore`] and the
 /// refusals [`RefusedCheck::ParamsInvalid`] and [`RefusedCheck::NotLevel`]; 1.6 the
-/// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`].
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 6 };
+/// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`]; 1.7
+/// [`Frame::MeasurementFilter`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 7 };
 
 impl ProtocolVersion {
     /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
@@ -59,7 +60,9 @@ impl ProtocolVersion {
 
 impl ProtocolVersion {
     /// The version the board application's Headers announce: its streams carry the
-    /// events added in 1.4.
+    /// events added in 1.4. What later minor versions appended (the 1.5 and 1.6 events,
+    /// the 1.7 [`Frame::MeasurementFilter`]) an older host reads as corrupt frames and
+    /// skips, so the announcement, and with it every Header's bytes, stays 1.4.
     pub const BOARD_APPLICATION: ProtocolVersion = ProtocolVersion { major: 1, minor: 4 };
 
     /// The later of `self` and `other`.
@@ -630,4 +633,32 @@ pub enum Frame {
     ParamRequest(ParamRequest),
     /// The answer to a [`Frame::ParamRequest`] (flight controller → host). Since 1.5.
     ParamReply(ParamReply),
+    /// The digital filter the test's IMU measurements went through before the flight
+    /// logic read them; sent by the board application right after each [`Header`].
+    /// Since 1.7.
+    MeasurementFilter(MeasurementFilter),
+}
+
+/// Biquad sections in series per [`MeasurementFilter`]: the board's low-pass and its
+/// three rotor notches.
+pub const MEASUREMENT_FILTER_SECTIONS: usize = 4;
+
+/// A chain of biquad sections run at `sample_rate_hz` on every IMU channel (the body
+/// rates and specific forces, and through them the attitude estimate) before the
+/// control tick reads the newest output. Section `k` is
+///
+/// ```text
+/// H_k(z) = (b₀ + b₁ z⁻¹ + b₂ z⁻²) / (1 + a₁ z⁻¹ + a₂ z⁻²),   sections[k] = [b₀, b₁, b₂, a₁, a₂]
+/// ```
+///
+/// and the filter is their product, evaluated at z = e^{jω/sample_rate_hz}. An unused
+/// section is the identity `[1, 0, 0, 0, 0]`. A frequency response identified from these
+/// measurements holds this filter as well as the aircraft; the host divides it out.
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MeasurementFilter {
+    /// Rate the sections run at \[Hz\].
+    pub sample_rate_hz: f32,
+    /// The sections, in the order they run.
+    pub sections: [[f32; 5]; MEASUREMENT_FILTER_SECTIONS],
 }

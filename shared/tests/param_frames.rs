@@ -129,7 +129,6 @@ fn names_are_checked() {
 
 #[test]
 fn protocol_1_6_appends_landed_and_not_airborne() {
-    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 6 });
     // AbortReason: Disarmed stays 8, Landed is 9.
     assert_eq!(postcard_bytes(&AbortReason::Disarmed), [8]);
     assert_eq!(postcard_bytes(&AbortReason::Landed), [9]);
@@ -140,6 +139,28 @@ fn protocol_1_6_appends_landed_and_not_airborne() {
     assert_eq!(RefusedCheck::NotAirborne.name(), "not_airborne");
     // Board streams still announce 1.4: an older host reads a 1.6 abort or refusal as
     // a corrupt frame and skips it.
+    assert_eq!(
+        ProtocolVersion::BOARD_APPLICATION,
+        ProtocolVersion { major: 1, minor: 4 }
+    );
+}
+
+#[test]
+fn protocol_1_7_appends_the_measurement_filter_frame() {
+    use sweephold_protocol::{Frame, MeasurementFilter};
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 7 });
+    let filter = MeasurementFilter {
+        sample_rate_hz: 1000.0,
+        sections: [[1.0, 0.0, 0.0, 0.0, 0.0]; 4],
+    };
+    // ParamReply stays variant 8; MeasurementFilter is 9, its f32s little-endian.
+    let bytes = postcard_bytes(&Frame::MeasurementFilter(filter));
+    assert_eq!(bytes[0], 9);
+    assert_eq!(&bytes[1..5], &1000.0f32.to_le_bytes());
+    assert_eq!(bytes.len(), 1 + 4 + 4 * 5 * 4);
+    // It does not raise the largest frame.
+    assert!(bytes.len() + 4 + 2 <= sweephold_protocol::MAX_FRAME_LEN);
+    // Board streams still announce 1.4.
     assert_eq!(
         ProtocolVersion::BOARD_APPLICATION,
         ProtocolVersion { major: 1, minor: 4 }

@@ -66,7 +66,8 @@ pub mod throttle;
 mod tests;
 
 use sweephold_protocol::{
-    Axis, Controls, Header, Measurements, Phase, PilotInput, ProtocolVersion, SensorIn, VehicleId,
+    Axis, Controls, Header, MeasurementFilter, Measurements, Phase, PilotInput, ProtocolVersion,
+    SensorIn, VehicleId,
 };
 
 use crate::attitude_hold::clamp_finite;
@@ -266,6 +267,9 @@ pub struct BoardApp {
     reporter: Reporter,
     /// A valid parameter set is in use ([`BoardApp::set_params_valid`]).
     params_valid: bool,
+    /// The filter the IMU measurements go through before the tick reads them, announced
+    /// after each Header ([`BoardApp::set_measurement_filter`]).
+    measurement_filter: Option<MeasurementFilter>,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -315,6 +319,7 @@ impl BoardApp {
             imu_trim: [0.0; 3],
             reporter: Reporter::default(),
             params_valid: true,
+            measurement_filter: None,
             fc,
             config,
         })
@@ -347,6 +352,14 @@ impl BoardApp {
     /// disarmed, never a takeover in flight.
     pub fn host_link_allowed(&self) -> bool {
         self.mode == Mode::Disarmed
+    }
+
+    /// The filter the measurements in [`TickInput`] went through (the board stack's IMU
+    /// filter bank), announced in a [`Frame::MeasurementFilter`](sweephold_protocol::Frame::MeasurementFilter)
+    /// after each Header so that the host can take it out of the responses. `None` (an
+    /// application fed measurements nothing filtered): no such frame.
+    pub fn set_measurement_filter(&mut self, filter: Option<MeasurementFilter>) {
+        self.measurement_filter = filter;
     }
 
     /// Whether a valid parameter set is in use: false (the parameter store held no valid
@@ -385,6 +398,7 @@ impl BoardApp {
         let mut sink = BoardTap {
             inner: sink,
             reason: None,
+            measurement_filter: None,
         };
         // The tick this step's Sample and Events carry.
         let tick = self.fc.tick();
@@ -476,6 +490,8 @@ impl BoardApp {
             self.mode,
             sink.inner,
         );
+        // Only the sequencer's step sends Headers.
+        sink.measurement_filter = self.measurement_filter.as_ref();
         let out = self.fc.step(&sensor, &mut sink);
         let reported_mode = self.mode;
         let command = if self.mode == Mode::Test {

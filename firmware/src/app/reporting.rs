@@ -4,12 +4,14 @@
 //! refused arm or test request with the check that refused it.
 //!
 //! The sequencer's Headers pass through [`BoardTap`], which raises their protocol
-//! version to [`ProtocolVersion::BOARD_APPLICATION`]: a decoder that reads a board
-//! application's stream must know these events.
+//! version to [`ProtocolVersion::BOARD_APPLICATION`] (a decoder that reads a board
+//! application's stream must know these events) and follows each with the
+//! [`Frame::MeasurementFilter`] the IMU measurements went through, when there is one.
 
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{
-    AbortReason, Event, FlightMode, Frame, ImuHealth, ProtocolVersion, RefusedCheck, Request,
+    AbortReason, Event, FlightMode, Frame, ImuHealth, MeasurementFilter, ProtocolVersion,
+    RefusedCheck, Request,
 };
 
 use super::arming::{CheckFailure, Refusal};
@@ -126,13 +128,16 @@ impl Reporter {
     }
 }
 
-/// Passes the sequencer's frames on: notes the reason of an Abort Event among them and
-/// raises each Header's protocol version to the board application's.
+/// Passes the sequencer's frames on: notes the reason of an Abort Event among them,
+/// raises each Header's protocol version to the board application's and follows it with
+/// the measurement filter.
 pub struct BoardTap<'a, S: FrameSink> {
     /// Where the frames go.
     pub inner: &'a mut S,
     /// The reason of the Abort Event that passed, if one did.
     pub reason: Option<AbortReason>,
+    /// Sent after each Header, when there is one.
+    pub measurement_filter: Option<&'a MeasurementFilter>,
 }
 
 impl<S: FrameSink> FrameSink for BoardTap<'_, S> {
@@ -149,7 +154,11 @@ impl<S: FrameSink> FrameSink for BoardTap<'_, S> {
             Frame::Header(header) => {
                 let mut header = *header;
                 header.protocol = header.protocol.max(ProtocolVersion::BOARD_APPLICATION);
-                self.inner.send_frame(&Frame::Header(header))
+                self.inner.send_frame(&Frame::Header(header))?;
+                match self.measurement_filter {
+                    Some(filter) => self.inner.send_frame(&Frame::MeasurementFilter(*filter)),
+                    None => Ok(()),
+                }
             }
             _ => self.inner.send_frame(frame),
         }

@@ -1993,3 +1993,43 @@ fn board_events_name_the_missing_imu_the_refusal_and_the_modes() {
     });
     assert_eq!(announced, Some(ProtocolVersion::BOARD_APPLICATION));
 }
+
+#[test]
+fn the_measurement_filter_follows_each_header_when_there_is_one() {
+    use sweephold_protocol::MeasurementFilter;
+    let filter = MeasurementFilter {
+        sample_rate_hz: 1000.0,
+        sections: [[0.25, 0.5, 0.25, -0.5, 0.25]; 4],
+    };
+    let kinds = |frames: &[Frame]| -> Vec<&'static str> {
+        frames
+            .iter()
+            .filter_map(|f| match f {
+                Frame::Header(_) => Some("header"),
+                Frame::MeasurementFilter(_) => Some("filter"),
+                _ => None,
+            })
+            .collect()
+    };
+
+    let mut rig = Rig::armed(test_config());
+    rig.app.set_measurement_filter(Some(filter));
+    rig.start_test();
+    rig.run_until_phase(Phase::Sweep);
+    let at = rig
+        .frames
+        .iter()
+        .position(|f| matches!(f, Frame::Header(_)))
+        .expect("a Header");
+    assert_eq!(
+        rig.frames.get(at + 1),
+        Some(&Frame::MeasurementFilter(filter))
+    );
+    assert_eq!(kinds(&rig.frames), ["header", "filter"]);
+
+    // An application fed measurements nothing filtered announces none.
+    let mut rig = Rig::armed(test_config());
+    rig.start_test();
+    rig.run_until_phase(Phase::Sweep);
+    assert_eq!(kinds(&rig.frames), ["header"]);
+}

@@ -287,7 +287,9 @@ impl<SPI: SpiDevice, D: DelayNs> BoardStack<SPI, D> {
             .channel_map
             .validate()
             .map_err(StackError::ChannelMap)?;
-        let app = BoardApp::new(config.app).map_err(StackError::App)?;
+        let mut app = BoardApp::new(config.app).map_err(StackError::App)?;
+        let announced = config.filters.measurement_filter();
+        app.set_measurement_filter(Some(announced.map_err(StackError::Filters)?));
         Ok((filters, estimator, app))
     }
 

@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use sweephold_protocol::{
-    tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, RefusedCheck, TickStep,
+    tick_step, DecodeStats, Decoder, Event, Frame, FrameError, Header, MeasurementFilter,
+    RefusedCheck, TickStep,
 };
 
 use sysid::records::{test_line, TestProgress};
@@ -195,6 +196,9 @@ fn handle_frame<W: Write>(
                 progress: TestProgress::default(),
             });
         }
+        Frame::MeasurementFilter(filter) => {
+            rows.json_line(&measurement_filter_json(&filter).to_string())?;
+        }
         // In-the-loop and parameter traffic is not telemetry; a dump of a serial link may
         // hold it.
         Frame::SensorIn(_)
@@ -216,6 +220,16 @@ pub fn header_json(h: &Header) -> serde_json::Value {
         "vehicle": h.vehicle.name(),
         "rate_hz": h.rate_hz,
         "test": serde_json::to_value(h.test).unwrap_or(serde_json::Value::Null),
+    })
+}
+
+/// A MeasurementFilter frame as a JSON object: the rate and each biquad section's
+/// `[b0, b1, b2, a1, a2]`.
+pub fn measurement_filter_json(filter: &MeasurementFilter) -> serde_json::Value {
+    serde_json::json!({
+        "type": "measurement_filter",
+        "sample_rate_hz": filter.sample_rate_hz,
+        "sections": filter.sections,
     })
 }
 

@@ -88,6 +88,7 @@ fn record(primary: usize, seed: u64) -> Record {
         references: Vec::new(),
         notes: Vec::new(),
         trim_samples: 0,
+        measurement_filter: None,
     }
 }
 

@@ -6,9 +6,12 @@
 //! and an SBUS byte stream. Per lockstep tick (one [`SensorIn`] at the record's rate):
 //!
 //! 1. the emulator is given the simulator's body rates and specific force (`input.meas`:
-//!    p, q, r and a_x, a_y, a_z, specific force, ≈ (0, 0, −g) in hover) as its truth;
-//! 2. it advances 1 ms at a time and the stack polls it after each sample
-//!    (`imu_sample`, 1 kHz: 5 samples per tick at 200 Hz);
+//!    p, q, r and a_x, a_y, a_z, specific force, ≈ (0, 0, −g) in hover) as its truth at
+//!    the end of the tick;
+//! 2. it advances 1 ms at a time, its truth on the line from the last tick's to this
+//!    one's (a chip samples the motion between the simulator's steps; the newest sample
+//!    is this tick's truth), and the stack polls it after each sample (`imu_sample`,
+//!    1 kHz: 5 samples per tick at 200 Hz);
 //! 3. the simulated transmitter sends an SBUS frame every 7 ms (high-speed mode); the
 //!    frames complete by the tick go into the tick's byte stream;
 //! 4. `control_tick` runs the application; its command and servo pulses are the reply,
@@ -183,18 +186,41 @@ struct Board {
     geometry: ServoGeometry,
     /// What the rotor gets over the current tick (lat, lon, ped, col).
     flown: [f64; 4],
+    /// The IMU's truth (rates, specific force) at the end of the last tick and at the
+    /// end of this one: the chip samples in between lie on the line joining them.
+    truth: Option<[Truth; 2]>,
 }
+
+/// Body rates \[rad/s\] and specific force \[m/s²\] the emulated chip senses.
+type Truth = ([f32; 3], [f32; 3]);
 
 impl Board {
     fn emulator(&mut self) -> &mut Icm42688Emulator {
         self.stack.imu_spi_mut()
     }
 
+    /// What the chip senses at the end of the next tick. The simulator gives the truth
+    /// once per tick; a real chip samples the motion in between, so the samples of the
+    /// tick are interpolated from the last tick's truth to this one (the newest sample,
+    /// the one the tick reads, is this truth itself). Holding the truth for the whole
+    /// tick instead would make the IMU filter bank's lag look half a tick shorter than on
+    /// a board.
+    fn set_truth(&mut self, rates: [f32; 3], force: [f32; 3]) {
+        let previous = self.truth.map_or((rates, force), |[_, end]| end);
+        self.truth = Some([previous, (rates, force)]);
+    }
+
     /// One control tick with the transmitter sending `rc` (if transmitting): the
     /// samples and frames that fall due, then the stack's control tick.
     fn tick(&mut self, rc: &RcInput, sink: &mut impl FrameSink) -> TickOutput {
         let map = ChannelMap::flybarless_default();
-        for _ in 0..self.samples_per_tick {
+        for sample in 1..=self.samples_per_tick {
+            if let Some([(rates_0, force_0), (rates_1, force_1)]) = self.truth {
+                let s = sample as f32 / self.samples_per_tick as f32;
+                let lerp = |a: [f32; 3], b: [f32; 3]| [0, 1, 2].map(|i| a[i] + s * (b[i] - a[i]));
+                self.emulator()
+                    .set_truth(lerp(rates_0, rates_1), lerp(force_0, force_1));
+            }
             self.emulator().advance_ns(u64::from(IMU_PERIOD_US) * 1000);
             self.now_us = self.now_us.wrapping_add(IMU_PERIOD_US);
             self.stack.imu_sample(self.now_us);
@@ -329,6 +355,7 @@ impl BoardSimLink {
             servos: FrameHold::new(swash_hz, tail_hz, [0; 4]),
             geometry: ServoGeometry::new(&settings.swash),
             flown: [0.0; 4],
+            truth: None,
         };
         let ticks_in = |seconds: f64| (seconds * f64::from(rate)).ceil() as u64;
         let col = board.trim_sticks[3];
@@ -395,9 +422,7 @@ impl BoardSimLink {
                 -g * phi.sin() * theta.cos(),
                 -g * phi.cos() * theta.cos(),
             ];
-            board
-                .emulator()
-                .set_truth(rates.map(|v| v as f32), force.map(|v| v as f32));
+            board.set_truth(rates.map(|v| v as f32), force.map(|v| v as f32));
             let mut rc = board.transmitter(&Controls::from_array(board.trim_sticks), false);
             rc.sticks.lat = (phi / f64::from(max_angle)) as f32;
             rc.sticks.lon = (theta / f64::from(max_angle)) as f32;
@@ -415,7 +440,7 @@ impl BoardSimLink {
         let mut reading = sim.step(board.dt, trim.controls);
         let rc = board.transmitter(&Controls::from_array(board.trim_sticks), false);
         for _ in 0..ticks_in(GIMBAL_HOVER_S) {
-            board.emulator().set_truth(
+            board.set_truth(
                 [reading.p, reading.q, reading.r].map(|v| v as f32),
                 [reading.ax, reading.ay, reading.az].map(|v| v as f32),
             );
@@ -480,9 +505,7 @@ impl FlightControllerLink for BoardSimLink {
             board.transmitting = t < at;
         }
         let m = &input.meas;
-        board
-            .emulator()
-            .set_truth([m.p, m.q, m.r], [m.ax, m.ay, m.az]);
+        board.set_truth([m.p, m.q, m.r], [m.ax, m.ay, m.az]);
         let rc = board.transmitter(&input.pilot.sticks, input.pilot.test_switch);
         let out = board.tick(&rc, telemetry);
         board.record_ticks += 1;

@@ -30,8 +30,9 @@
 //! and counted in the notes.
 //!
 //! The steps are submodules: `prepare` (join a group, choose its band, grid, windows
-//! and channels), `responses` (spectra, MISO solves and composites of one group) and
-//! `cross_coherence` (coherence between the controls of a group).
+//! and channels), `responses` (spectra, MISO solves and composites of one group),
+//! `filter_removal` (a measurement filter the flight controller announced, divided out
+//! of the responses) and `cross_coherence` (coherence between the controls of a group).
 //!
 //! [`ResponseInputs`]: super::ResponseInputs
 
@@ -42,11 +43,13 @@ use super::options::{FrfOptions, RangeSource, ResponseEstimator};
 use super::FrfError;
 
 mod cross_coherence;
+mod filter_removal;
 mod prepare;
 mod responses;
 
 pub use cross_coherence::{cross_control_coherence, CoherenceCurve};
 
+use filter_removal::remove_measurement_filter;
 use prepare::prepare_group;
 use responses::analyse_group;
 
@@ -158,7 +161,26 @@ pub fn analyse(groups: &[RecordGroup], opts: &FrfOptions) -> Result<FrfAnalysis,
             analysis.document.notes.extend(record.notes.iter().cloned());
         }
         let prepared = prepare_group(group, opts, true)?;
+        let (pairs_before, siso_before) =
+            (analysis.document.pairs.len(), analysis.document.siso.len());
         analyse_group(&prepared, opts, &mut analysis);
+        if let Some(filter) = group.measurement_filter() {
+            let document = &mut analysis.document;
+            let mut notes = Vec::new();
+            remove_measurement_filter(
+                &mut document.pairs[pairs_before..],
+                filter,
+                group.primary(),
+                &mut notes,
+            );
+            remove_measurement_filter(
+                &mut document.siso[siso_before..],
+                filter,
+                group.primary(),
+                &mut Vec::new(),
+            );
+            document.notes.extend(notes);
+        }
     }
     keep_one_estimate_per_pair(&mut analysis);
     Ok(analysis)

@@ -12,7 +12,7 @@
 //! span a join see the same slow gain on both sides of the input/output relation.
 
 use super::FrfError;
-use crate::records::{remove_line, Channel, Record};
+use crate::records::{remove_line, Channel, MeasurementFilter, Record};
 
 /// The records of one swept axis, analysed as one joined record.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +44,8 @@ impl RecordGroup {
                 || names(&record.references) != names(&first.references)
             {
                 Some("has other channels".to_string())
+            } else if record.measurement_filter != first.measurement_filter {
+                Some("went through another measurement filter".to_string())
             } else {
                 None
             };
@@ -76,6 +78,12 @@ impl RecordGroup {
     /// Sample rate \[Hz\].
     pub fn sample_rate_hz(&self) -> f64 {
         self.records[0].sample_rate_hz
+    }
+
+    /// The filter the flight controller ran on the records' outputs (the same for every
+    /// record of the group), if any.
+    pub fn measurement_filter(&self) -> Option<&MeasurementFilter> {
+        self.records[0].measurement_filter.as_ref()
     }
 
     /// Total samples over all records.

@@ -210,6 +210,7 @@ pub fn record(
         references: Vec::new(),
         notes: vec![],
         trim_samples: 0,
+        measurement_filter: None,
     }
 }
 

@@ -287,6 +287,7 @@ pub fn parse_csv_records(
                 Vec::new()
             },
             trim_samples: 0,
+            measurement_filter: None,
         };
         record.validate()?;
         records.push(record);

@@ -19,6 +19,7 @@ use sweephold_protocol::{tick_step, Header, Phase, Sample, TickStep};
 #[cfg(test)]
 use super::dump_tests::TestEnd;
 use super::dump_tests::{is_excitation, split_tests, TestRecord};
+use super::measurement_filter::MeasurementFilter;
 use super::origin::DumpOrigin;
 use super::record::{Channel, Record};
 use super::RecordError;
@@ -126,8 +127,12 @@ fn load_dump_bytes_with(
     let Some(test) = chosen else {
         return Err(split.no_record_error(source));
     };
-    let record =
+    let mut record =
         record_from_samples_at(&test.header, &test.samples, test.offset, source, excitation)?;
+    record.measurement_filter = test
+        .measurement_filter
+        .as_ref()
+        .map(MeasurementFilter::of_imu);
     Ok((record, test.header))
 }
 
@@ -164,7 +169,14 @@ pub fn load_dump_tests(
                 test.offset,
                 &source,
                 Excitation::Sweep,
-            );
+            )
+            .map(|mut record| {
+                record.measurement_filter = test
+                    .measurement_filter
+                    .as_ref()
+                    .map(MeasurementFilter::of_imu);
+                record
+            });
             TestRecord { test, record }
         })
         .collect();
@@ -336,6 +348,7 @@ fn record_from_samples_at(
             .collect(),
         notes,
         trim_samples,
+        measurement_filter: None,
     };
     record.validate()?;
     Ok(record)

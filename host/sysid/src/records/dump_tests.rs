@@ -112,6 +112,9 @@ pub struct DumpTest {
     pub offset: usize,
     /// Its Samples' phases and its Events, seen.
     pub progress: TestProgress,
+    /// The filter its IMU outputs went through, when the flight controller announced one
+    /// (a board application, after the Header).
+    pub measurement_filter: Option<sweephold_protocol::MeasurementFilter>,
 }
 
 impl DumpTest {
@@ -211,7 +214,13 @@ pub fn split_tests(bytes: &[u8], source: &str) -> Result<SplitDump, RecordError>
                 samples: Vec::new(),
                 offset: seen,
                 progress: TestProgress::default(),
+                measurement_filter: None,
             }),
+            Ok(Frame::MeasurementFilter(filter)) => {
+                if let Some(test) = tests.last_mut() {
+                    test.measurement_filter = Some(filter);
+                }
+            }
             Ok(Frame::Sample(sample)) => {
                 seen += 1;
                 match tests.last_mut() {
@@ -341,5 +350,30 @@ mod tests {
         let line = split.tests[0].describe();
         assert!(line.starts_with("test 1: "), "{line}");
         assert!(line.ends_with(", completed"), "{line}");
+    }
+
+    #[test]
+    fn a_measurement_filter_after_a_header_belongs_to_its_test() {
+        use sweephold_protocol::MeasurementFilter;
+        let filter = MeasurementFilter {
+            sample_rate_hz: 1000.0,
+            sections: [
+                [0.5, 0.5, 0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0, 0.0, 0.0],
+            ],
+        };
+        let (h, _) = header_and_sample();
+        let mut bytes = test_bytes(true, &[Phase::Sweep], 10);
+        bytes.extend(encoded(&[
+            Frame::Header(h),
+            Frame::MeasurementFilter(filter),
+        ]));
+        bytes.extend(test_bytes(false, &[Phase::Sweep], 20));
+        let split = split_tests(&bytes, "spec").unwrap();
+        assert_eq!(split.tests.len(), 2);
+        assert_eq!(split.tests[0].measurement_filter, None);
+        assert_eq!(split.tests[1].measurement_filter, Some(filter));
     }
 }

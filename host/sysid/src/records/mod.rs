@@ -5,7 +5,8 @@
 //!   channels of one excitation);
 //! * [`dump`] — the project's telemetry dumps (the firmware's frames, decoded), with
 //!   [`dump_tests`]: a dump split into its tests at its Headers, and [`origin`]: what a
-//!   dump's Header says of where it was flown;
+//!   dump's Header says of where it was flown, and [`measurement_filter`]: the filter a
+//!   board ran on its IMU outputs before logging them;
 //! * [`csv`] — other loggers' CSV files, with their time and unit rules;
 //! * [`ulog`] — PX4 ULog files (`.ulg`);
 //! * [`dataflash`] — ArduPilot DataFlash binary logs (`.bin`, `.BIN`);
@@ -42,6 +43,7 @@ pub mod dump;
 pub mod dump_tests;
 mod error;
 pub mod log;
+pub mod measurement_filter;
 pub mod origin;
 pub mod record;
 pub mod select;
@@ -60,6 +62,7 @@ pub use dump_tests::{
 pub use error::RecordError;
 pub(crate) use log::median_rate_hz;
 pub use log::{Field, Log, LogError, LogFormat, Topic, Values};
+pub use measurement_filter::MeasurementFilter;
 pub use origin::{check_one_origin, DumpOrigin};
 pub(crate) use record::{remove_line, rms};
 pub use record::{Channel, Record};

@@ -4,6 +4,7 @@
 //! The frequency-response analysis (`crate::frf`) and the time-domain verification
 //! (`crate::fit::verify`) read records; the readers beside this module make them.
 
+use super::measurement_filter::MeasurementFilter;
 use super::RecordError;
 
 /// One named channel of samples.
@@ -60,6 +61,11 @@ pub struct Record {
     /// the source does not say (CSV records). Time-domain verification takes each
     /// channel's trim (the bias of its perturbations) as its mean over these samples.
     pub trim_samples: usize,
+    /// The digital filter the flight controller ran on some outputs before logging them
+    /// (a board's IMU filter bank, announced in its telemetry), or `None`: the outputs
+    /// are what the sensors gave. The frequency responses divide it out; the
+    /// verification passes the model's outputs through it.
+    pub measurement_filter: Option<MeasurementFilter>,
 }
 
 impl Record {
@@ -222,6 +228,7 @@ pub(crate) mod tests {
             references: Vec::new(),
             notes: vec![],
             trim_samples: 0,
+            measurement_filter: None,
         }
     }
 

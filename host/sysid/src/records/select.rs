@@ -444,6 +444,7 @@ pub fn record_from_log(log: &Log, channels: &LogChannels) -> Result<Record, LogE
         references: Vec::new(),
         notes,
         trim_samples: 0,
+        measurement_filter: None,
     };
     record.validate().map_err(|e| fail(e.to_string()))?;
     Ok(record)

@@ -352,6 +352,25 @@ pub fn verify_record_in_segments(
         }
         Err(other) => return Err(other),
     };
+    // The logged outputs went through the flight controller's filter: so do the model's
+    // before they are compared (its rate divides the filter's for every board dump; a
+    // record where it does not is compared unfiltered).
+    let simulated: Vec<Vec<f64>> = match &record.measurement_filter {
+        Some(filter) => simulated
+            .into_iter()
+            .zip(&model.outputs)
+            .map(|(series, name)| {
+                if filter.acts_on(name) {
+                    filter
+                        .apply(&series, record.sample_rate_hz)
+                        .unwrap_or(series)
+                } else {
+                    series
+                }
+            })
+            .collect(),
+        None => simulated,
+    };
     let mut outputs = Vec::with_capacity(compared.len());
     let mut measured = Vec::with_capacity(compared.len());
     let mut predicted = Vec::with_capacity(compared.len());

@@ -158,6 +158,7 @@ fn record_of(model: &Model, noise: f64) -> Record {
         references: Vec::new(),
         notes: Vec::new(),
         trim_samples: 0,
+        measurement_filter: None,
     }
 }
 
@@ -368,6 +369,7 @@ fn record_with_trim(
         references: Vec::new(),
         notes: Vec::new(),
         trim_samples: TRIM,
+        measurement_filter: None,
     };
     (record, perturbations)
 }

@@ -918,3 +918,99 @@ fn reference_ranges_keep_the_cross_spectral_responses() {
     .to_string();
     assert!(error.contains("sweep-reference estimator needs"), "{error}");
 }
+
+/// A board's IMU filter bank as the firmware designs it (the RBJ cookbook): a 60 Hz
+/// Butterworth low-pass and notches of Q 3 at 30, 60 and 135 Hz (1/rev, 2/rev and the
+/// tail rotor of an 1800 rpm helicopter), at 1 kHz, on the IMU outputs.
+fn board_filter_bank() -> crate::records::MeasurementFilter {
+    use std::f64::consts::PI;
+    let fs = 1000.0;
+    let low_pass = |f0: f64, q: f64| {
+        let w0 = 2.0 * PI * f0 / fs;
+        let (alpha, cos) = (w0.sin() / (2.0 * q), w0.cos());
+        let a0 = 1.0 + alpha;
+        let b = (1.0 - cos) / 2.0 / a0;
+        [b, 2.0 * b, b, -2.0 * cos / a0, (1.0 - alpha) / a0]
+    };
+    let notch = |f0: f64, q: f64| {
+        let w0 = 2.0 * PI * f0 / fs;
+        let (alpha, cos) = (w0.sin() / (2.0 * q), w0.cos());
+        let a0 = 1.0 + alpha;
+        [
+            1.0 / a0,
+            -2.0 * cos / a0,
+            1.0 / a0,
+            -2.0 * cos / a0,
+            (1.0 - alpha) / a0,
+        ]
+    };
+    crate::records::MeasurementFilter {
+        sample_rate_hz: fs,
+        sections: vec![
+            low_pass(60.0, std::f64::consts::FRAC_1_SQRT_2),
+            notch(30.0, 3.0),
+            notch(60.0, 3.0),
+            notch(135.0, 3.0),
+        ],
+        outputs: crate::records::measurement_filter::IMU_OUTPUTS
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+    }
+}
+
+#[test]
+fn a_measurement_filter_announced_by_the_record_is_divided_out() {
+    // A flap-like second order (ω_n 40 rad/s, ζ 0.6) swept to 62.8 rad/s; its output
+    // sampled at 1 kHz, filtered there by the board's bank, and logged at 200 Hz (the
+    // newest filtered sample at each tick), as a board logs its gyro.
+    let block = Block::second_order(1.0, 40.0, 0.6, 0.0);
+    let sweep = Sweep {
+        omega_min: 0.5,
+        omega_max: 62.8,
+        duration: 60.0,
+        amplitude: 0.05,
+    };
+    let fast = 1000.0;
+    let len = ((sweep.duration + 2.0 * TRIM_S) * RATE) as usize;
+    let signal = move |t: f64| sweep.value(t - TRIM_S);
+    let output_fast = block.simulate(&signal, fast, 5 * len, 4);
+    let filter = board_filter_bank();
+    let filtered = filter.apply(&output_fast, fast).unwrap();
+    let input: Vec<f64> = sample(&signal, RATE, len);
+    let output: Vec<f64> = (0..len).map(|k| filtered[5 * k]).collect();
+    let logged = |announced: bool| {
+        let mut r = record(
+            RATE,
+            [0.5, 62.8],
+            vec![("lat", input.clone())],
+            vec![("p", output.clone())],
+        );
+        r.measurement_filter = announced.then(|| filter.clone());
+        RecordGroup::new(vec![r]).unwrap()
+    };
+    let truth = |w: f64| block.response(w);
+
+    let corrected = compute_frequency_responses(&[logged(true)], &FrfOptions::default()).unwrap();
+    let (db, deg, count) = errors_against(corrected.pair("lat", "p").unwrap(), &truth, 0.9);
+    assert!(count > 100, "{count} points");
+    eprintln!("divided out: {db:.3} dB, {deg:.2}°");
+    assert!(
+        db <= 0.3 && deg <= 2.0,
+        "divided out: {db:.3} dB, {deg:.2}°"
+    );
+    assert!(
+        corrected
+            .notes
+            .iter()
+            .any(|n| n.contains("measurement filter")),
+        "{:?}",
+        corrected.notes
+    );
+
+    // Left in, the bank's ≈ 6 ms lag is there for the fit to take for the aircraft's.
+    let raw = compute_frequency_responses(&[logged(false)], &FrfOptions::default()).unwrap();
+    let (_, deg, _) = errors_against(raw.pair("lat", "p").unwrap(), &truth, 0.9);
+    eprintln!("left in: {deg:.2}°");
+    assert!(deg > 15.0, "left in: {deg:.2}°");
+}
