@@ -47,7 +47,7 @@ pub fn load_test_dump(path: impl AsRef<Path>) -> Result<Record, RecordError> {
 
 /// Which tests a loader accepts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Excitation {
+pub enum Excitation {
     /// Frequency sweeps only (frequency responses need one).
     Sweep,
     /// Any input the firmware flies.
@@ -131,11 +131,11 @@ fn load_dump_bytes_with(
     Ok((record, test.header))
 }
 
-/// Every test of the dump file `path` ([`split_tests`]), each with its sweep record, and
-/// where the file says it came from (its first Header). A file with no valid frame or no
-/// Header is an error, as for [`load_dump`].
+/// Every test of the dump file `path` ([`split_tests`]) with its record of an `excitation`
+/// test, and its first Header's origin; no valid frame or Header is an error ([`load_dump`]).
 pub fn load_dump_tests(
     path: impl AsRef<Path>,
+    excitation: Excitation,
 ) -> Result<(Vec<TestRecord>, DumpOrigin), RecordError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|error| RecordError::Io {
@@ -163,7 +163,7 @@ pub fn load_dump_tests(
                 &test.samples,
                 test.offset,
                 &source,
-                Excitation::Sweep,
+                excitation,
             );
             TestRecord { test, record }
         })
@@ -359,7 +359,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let both = dir.join("both.dump");
         std::fs::write(&both, [dump_bytes(&lat), dump_bytes(&lon)].concat()).unwrap();
-        let (tests, origin) = load_dump_tests(&both).unwrap();
+        let (tests, origin) = load_dump_tests(&both, Excitation::Sweep).unwrap();
         assert_eq!(
             origin,
             DumpOrigin::of(&both.display().to_string(), &tests[0].test.header)
@@ -382,7 +382,7 @@ mod tests {
         // A file of one test names its record by the file alone.
         let one = dir.join("one.dump");
         std::fs::write(&one, dump_bytes(&lat)).unwrap();
-        let (one_test, _) = load_dump_tests(&one).unwrap();
+        let (one_test, _) = load_dump_tests(&one, Excitation::Sweep).unwrap();
         let record = one_test[0].record.as_ref().unwrap();
         assert_eq!(record.source, one.display().to_string());
         std::fs::remove_dir_all(&dir).unwrap();
