@@ -79,6 +79,8 @@ pub fn sweep_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpS
 
 /// One test of a dump that [`excitation_records`] uses.
 pub struct UsedTest {
+    /// Its number in the file (1-based, at its Header).
+    pub number: usize,
     /// Its record (any excitation), named `FILE` or `FILE test N`.
     pub record: Record,
     /// Where its Header says it was flown.
@@ -151,6 +153,7 @@ pub fn excitation_records(
             (_, Ok(record)) => {
                 let origin = DumpOrigin::of(&record.source, &test.header);
                 used.push(UsedTest {
+                    number: test.number,
                     record,
                     origin,
                     is_sweep: test.header.test.input.is_sweep(),
