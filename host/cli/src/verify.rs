@@ -55,8 +55,9 @@ pub struct VerifyArgs {
     #[arg(long, value_enum, default_value_t = BiasArg::Trim)]
     pub bias: BiasArg,
     /// Also replay the tests that aborted. Every test of a dump (a file per power-up
-    /// holds several) is listed on stderr with what became of it; tests cut off by the
-    /// end of the file are replayed, aborted ones left out by default.
+    /// holds several) is replayed and, when the file holds several or one is left out,
+    /// listed on stderr with what became of it; tests cut off by the end of the file are
+    /// replayed, aborted ones left out by default.
     #[arg(long)]
     pub include_aborted: bool,
     /// How to read CSV logs.
@@ -155,13 +156,16 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
             records.extend(read.into_iter().map(|record| (file, record)));
         } else {
             // Every test of the file (a logger's file per power-up holds several), each
-            // listed on stderr with what became of it.
+            // listed on stderr with what became of it when the file holds several or one
+            // was left out (a dump of one test used says nothing, as before).
             // A test cut off by the end of the file is still a record of the inputs
             // and outputs, and is replayed; an aborted one (the pilot took over) only
             // with --include-aborted.
             let tests = crate::dump_tests::excitation_records(file, args.include_aborted, true)?;
             records.extend(tests.used.into_iter().map(|test| (file, test.record)));
-            test_lines.extend(tests.listing.iter().map(TestListing::line));
+            if tests.listing.len() > 1 || tests.listing.iter().any(|t| t.verdict != "used") {
+                test_lines.extend(tests.listing.iter().map(TestListing::line));
+            }
         }
     }
     for line in &test_lines {
