@@ -6,11 +6,18 @@ when A's text names `crate::B...` (in a `use` or in a path) or, inside the same 
 `super::B`. Tests (`tests.rs`, `*_tests.rs`, `#[cfg(test)] mod tests` bodies after the
 marker) are left out: a test may reach anywhere. Exit 1 when any circle is found.
 
+It also checks the workspace crates some folders must not name (`SEPARATED`): the code
+of `sweephold identify` (host/cli/src/identify/) runs on logs alone and names neither the
+simulator (`rotorsim`) nor its truth (`truth`). Exit 1 when one does.
+
     python3 docs/import_cycles.py [--crate DIR ...]
 """
 import os
 import re
 import sys
+
+# (folder, crates its non-test code must not name).
+SEPARATED = [("host/cli/src/identify", ["rotorsim", "truth"])]
 
 CRATES = ["shared", "firmware", "firmware/board", "host/rotorsim", "host/sysid", "host/cli", "host/truth"]
 
@@ -140,11 +147,32 @@ def main():
             found += 1
             names = ["::".join(c) or "crate" for c in comp]
             print(f"{crate}: " + " <-> ".join(names))
+    named = separated_named(root)
+    for line in named:
+        print(line)
     if found:
         print(f"{found} import circle(s)")
+    if found or named:
         return 1
-    print("no import circles")
+    print("no import circles; no folder names a crate it must not")
     return 0
+
+
+def separated_named(root):
+    """`FILE: names CRATE` for each file of a `SEPARATED` folder naming a crate it must not."""
+    out = []
+    for folder, banned in SEPARATED:
+        for base, _, files in os.walk(os.path.join(root, folder)):
+            for f in sorted(files):
+                if not f.endswith(".rs") or f == "tests.rs" or f.endswith("_tests.rs"):
+                    continue
+                path = os.path.join(base, f)
+                with open(path, encoding="utf-8") as h:
+                    text = strip_comments(strip_tests(h.read()))
+                for crate in banned:
+                    if re.search(r"(\b|::)" + crate + r"\s*::|\buse\s+" + crate + r"\b", text):
+                        out.append(f"{os.path.relpath(path, root)}: names `{crate}`, which it must not")
+    return out
 
 
 if __name__ == "__main__":

@@ -1,12 +1,13 @@
 //! Which tests of a telemetry dump `frf` analyses: a dump (a logger's file per power-up,
 //! or records concatenated) holds one test per Header (split by
 //! [`sysid::records::load_dump_tests`]); every completed sweep is used, and every test is
-//! listed with how it ended and what became of it.
+//! listed with how it ended and what became of it. `verify` and `identify` take every
+//! test with an excitation of any kind ([`excitation_records`]).
 
 use std::path::Path;
 
 use anyhow::anyhow;
-use sysid::records::{load_dump_tests, DumpOrigin, Record, TestEnd, TestRecord};
+use sysid::records::{load_dump_tests, DumpOrigin, Excitation, Record, TestEnd, TestRecord};
 
 /// What `frf` takes from one dump.
 pub struct DumpSweeps {
@@ -23,7 +24,7 @@ pub struct DumpSweeps {
 /// error, and so is a dump none of whose tests is used (the first test's reason: its
 /// record's error when it has one, else why it was left out).
 pub fn sweep_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpSweeps> {
-    let (tests, _) = load_dump_tests(path)?;
+    let (tests, _) = load_dump_tests(path, Excitation::Sweep)?;
     let file = path.display().to_string();
     let mut used = Vec::new();
     let mut lines = Vec::new();
@@ -74,4 +75,110 @@ pub fn sweep_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpS
         records: used,
         lines,
     })
+}
+
+/// One test of a dump that [`excitation_records`] uses.
+pub struct UsedTest {
+    /// Its number in the file (1-based, at its Header).
+    pub number: usize,
+    /// Its record (any excitation), named `FILE` or `FILE test N`.
+    pub record: Record,
+    /// Where its Header says it was flown.
+    pub origin: DumpOrigin,
+    /// Whether it is a frequency sweep (else a doublet, 3-2-1-1…: a verification record).
+    pub is_sweep: bool,
+}
+
+/// One test of a dump as listed: the file, its line (`test N: axis Input, Mode, s, end`)
+/// and what became of it.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct TestListing {
+    /// The dump file, as given.
+    pub file: String,
+    /// The test's line ([`sysid::records::test_line`]).
+    pub test: String,
+    /// `used`, or why it was left out.
+    pub verdict: String,
+}
+
+/// What [`excitation_records`] takes from one dump.
+pub struct DumpTests {
+    /// The tests used, in file order.
+    pub used: Vec<UsedTest>,
+    /// Every test with what became of it.
+    pub listing: Vec<TestListing>,
+}
+
+/// Every test of the dump `path` with an excitation of any kind (sweep, doublet,
+/// 3-2-1-1), for the verbs that replay records in time (`verify`) or take both sweeps
+/// and verification records from one log (`identify`). Aborted tests are left out unless
+/// `include_aborted`, partial ones (cut off by the end of the file) unless
+/// `include_partial` or `include_aborted`, tests that never started always; a test that
+/// would be used but gives no record is an error, and so is a dump none of whose tests is
+/// used.
+pub fn excitation_records(
+    path: &Path,
+    include_aborted: bool,
+    include_partial: bool,
+) -> anyhow::Result<DumpTests> {
+    let (tests, _) = load_dump_tests(path, Excitation::Any)?;
+    let file = path.display().to_string();
+    let mut used = Vec::new();
+    let mut listing = Vec::new();
+    let mut refusal: Option<String> = None;
+    for TestRecord { test, record } in tests {
+        let end = test.end();
+        let verdict = match (end, record) {
+            (TestEnd::NotStarted, record) => {
+                if let Err(error) = record {
+                    refusal.get_or_insert(error.to_string());
+                }
+                "left out: no excitation".to_string()
+            }
+            (TestEnd::Aborted | TestEnd::Partial, record)
+                if !include_aborted && (end == TestEnd::Aborted || !include_partial) =>
+            {
+                let why = match record {
+                    Err(error) => error.to_string(),
+                    Ok(_) => format!(
+                        "{file}: test {} {}: left out (--include-aborted uses it)",
+                        test.number,
+                        end.name()
+                    ),
+                };
+                refusal.get_or_insert(why);
+                "left out (--include-aborted uses it)".to_string()
+            }
+            (_, Err(error)) => return Err(anyhow!("{error}")),
+            (_, Ok(record)) => {
+                let origin = DumpOrigin::of(&record.source, &test.header);
+                used.push(UsedTest {
+                    number: test.number,
+                    record,
+                    origin,
+                    is_sweep: test.header.test.input.is_sweep(),
+                });
+                "used".to_string()
+            }
+        };
+        listing.push(TestListing {
+            file: file.clone(),
+            test: test.describe(),
+            verdict,
+        });
+    }
+    if used.is_empty() {
+        return Err(anyhow!(
+            "{}",
+            refusal.unwrap_or_else(|| format!("{file}: no test with an excitation"))
+        ));
+    }
+    Ok(DumpTests { used, listing })
+}
+
+impl TestListing {
+    /// `FILE: test N: …: verdict`, as `frf` lists its tests.
+    pub fn line(&self) -> String {
+        format!("{}: {}: {}", self.file, self.test, self.verdict)
+    }
 }

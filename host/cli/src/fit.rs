@@ -127,6 +127,14 @@ impl TrimBalanceArg {
         }
     }
 
+    /// The aircraft file's `identification.trim_balance`.
+    pub fn of_vehicle(vehicle: &crate::vehicle::Vehicle) -> TrimBalanceArg {
+        match vehicle.trim_balance() {
+            aircraft::TrimBalance::Hold => TrimBalanceArg::Hold,
+            aircraft::TrimBalance::Joint => TrimBalanceArg::Joint,
+        }
+    }
+
     /// The value as written on the command line.
     pub fn as_arg(self) -> &'static str {
         match self {

@@ -26,6 +26,7 @@ pub mod fit;
 pub mod fit_tables;
 pub mod fly;
 pub mod frf;
+pub mod identify;
 pub mod interrupt;
 pub mod logs;
 pub mod margins;
@@ -73,6 +74,9 @@ pub enum Command {
     Fly(fly::FlyArgs),
     /// Frequency responses (Chirp-Z, multi-window, MISO, composite) from dumps or CSV.
     Frf(frf::FrfArgs),
+    /// From logs to a model with no simulator: frequency responses, 6-DOF and 9-DOF fits,
+    /// verification on the held-out tests.
+    Identify(identify::IdentifyArgs),
     /// Loop margins and handling qualities of the board's pilot-mode loops on an identified model.
     Margins(margins::MarginsArgs),
     /// Regenerate report.html of a campaign folder from its files.
@@ -105,6 +109,7 @@ fn run_verb(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(args) => fit::run(&args),
         Command::Fly(args) => fly::run(&args),
         Command::Frf(args) => frf::run(&args),
+        Command::Identify(args) => identify::run(&args),
         Command::Margins(args) => margins::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Sim(args) => sim::run(&args),

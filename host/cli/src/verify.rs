@@ -8,12 +8,13 @@ use std::fs;
 use std::path::PathBuf;
 
 use crate::csv_args::CsvArgs;
+use crate::dump_tests::TestListing;
 use crate::output::{check_input_file, check_output_folder, write_files_into};
 use anyhow::{anyhow, Context};
 use clap::Args;
 use sysid::fit::verify::{verify_record_in_segments, BiasMode, Verification, VerifyError};
 use sysid::fit::ModelDocument;
-use sysid::records::{load_csv_records, load_test_dump, Record};
+use sysid::records::{load_csv_records, Record};
 
 /// Arguments of `sweephold verify`.
 #[derive(Args, Debug)]
@@ -34,8 +35,8 @@ pub struct VerifyArgs {
     /// The identified model (`model.json` as `sweephold fit --out` writes it).
     #[arg(long, value_name = "model.json")]
     pub model: PathBuf,
-    /// Telemetry dumps or CSV logs to verify against (ideally records not used in the
-    /// fit): any test the firmware flies — doublet, 3-2-1-1 or sweep (`sweephold fly
+    /// Telemetry dumps (every test of each) or CSV logs to verify against (ideally
+    /// records not used in the fit): any test the firmware flies — doublet, 3-2-1-1 or sweep (`sweephold fly
     /// --input doublet`).
     #[arg(value_name = "DUMP|CSV", required = true)]
     pub dumps: Vec<PathBuf>,
@@ -53,6 +54,12 @@ pub struct VerifyArgs {
     /// excitation (`trim`), or least squares over the record (`fitted`).
     #[arg(long, value_enum, default_value_t = BiasArg::Trim)]
     pub bias: BiasArg,
+    /// Also replay the tests that aborted. Every test of a dump (a file per power-up
+    /// holds several) is replayed and, when the file holds several or one is left out,
+    /// listed on stderr with what became of it; tests cut off by the end of the file are
+    /// replayed, aborted ones left out by default.
+    #[arg(long)]
+    pub include_aborted: bool,
     /// How to read CSV logs.
     #[command(flatten)]
     pub csv: CsvArgs,
@@ -138,6 +145,7 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
     let columns = args.csv.columns(None)?;
     let mut records: Vec<(&PathBuf, Record)> = Vec::new();
     let mut columns_read = false;
+    let mut test_lines = Vec::new();
     for file in &args.dumps {
         let is_csv = file
             .extension()
@@ -147,8 +155,21 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
             let read = load_csv_records(file, &columns).map_err(|e| anyhow!("{e}"))?;
             records.extend(read.into_iter().map(|record| (file, record)));
         } else {
-            records.push((file, load_test_dump(file).map_err(|e| anyhow!("{e}"))?));
+            // Every test of the file (a logger's file per power-up holds several), each
+            // listed on stderr with what became of it when the file holds several or one
+            // was left out (a dump of one test used says nothing, as before).
+            // A test cut off by the end of the file is still a record of the inputs
+            // and outputs, and is replayed; an aborted one (the pilot took over) only
+            // with --include-aborted.
+            let tests = crate::dump_tests::excitation_records(file, args.include_aborted, true)?;
+            records.extend(tests.used.into_iter().map(|test| (file, test.record)));
+            if tests.listing.len() > 1 || tests.listing.iter().any(|t| t.verdict != "used") {
+                test_lines.extend(tests.listing.iter().map(TestListing::line));
+            }
         }
+    }
+    for line in &test_lines {
+        crate::note!("{line}");
     }
     for (dump, record) in &records {
         let verification =
@@ -184,7 +205,7 @@ fn report(args: &VerifyArgs) -> anyhow::Result<String> {
         }
     }
     if records.len() > 1 && !all_theil.is_empty() {
-        // Dumps give one record each; CSV logs may give several (split at long gaps).
+        // A dump gives one record per test, a CSV log one per part (split at long gaps).
         let what = if records.len() == args.dumps.len() && !columns_read {
             "dumps"
         } else {
@@ -272,6 +293,7 @@ mod tests {
             plots: None,
             segment: None,
             bias: BiasArg::Trim,
+            include_aborted: false,
             csv: CsvArgs::default(),
         }
     }

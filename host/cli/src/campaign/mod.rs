@@ -15,12 +15,9 @@ pub mod fits;
 pub mod flights;
 pub mod margins;
 pub mod progress;
-pub mod responses;
 pub mod scoring;
-pub mod verification;
 
 use std::collections::BTreeMap;
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -40,7 +37,6 @@ use crate::fly::plan::PAPER_T_REC_S;
 use crate::fly::{AmplitudeArg, ModeArg};
 use crate::output::{write_json, StagedFolder};
 use crate::vehicle::Vehicle;
-use aircraft::TrimBalance;
 use error::CampaignError;
 use flights::FlownMode;
 use progress::StageProgress;
@@ -260,10 +256,7 @@ impl CampaignTrimBalance {
         match self {
             CampaignTrimBalance::Hold => TrimBalanceArg::Hold,
             CampaignTrimBalance::Joint => TrimBalanceArg::Joint,
-            CampaignTrimBalance::Default => match vehicle.trim_balance() {
-                TrimBalance::Hold => TrimBalanceArg::Hold,
-                TrimBalance::Joint => TrimBalanceArg::Joint,
-            },
+            CampaignTrimBalance::Default => TrimBalanceArg::of_vehicle(vehicle),
         }
     }
 }
@@ -368,17 +361,7 @@ impl<'a> Campaign<'a> {
     }
 }
 
-/// The arguments of the verb `verb` from the command line `argv` (without the verb): its
-/// own parser, so its own defaults and checks.
-pub fn verb_args<T: clap::Args + clap::FromArgMatches>(
-    verb: &'static str,
-    argv: impl IntoIterator<Item = OsString>,
-) -> anyhow::Result<T> {
-    let matches = T::augment_args(clap::Command::new(verb).no_binary_name(true))
-        .try_get_matches_from(argv)
-        .map_err(|e| anyhow!("`{verb}` arguments: {}", e.render().to_string().trim()))?;
-    Ok(T::from_arg_matches(&matches)?)
-}
+pub use crate::identify::stages::verb_args;
 
 /// Run the whole campaign of `args` (see the module documentation).
 pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {

@@ -6,11 +6,11 @@ use crate::mode_text::hover_summary;
 use sysid::fit::report::ScoredModelDocument;
 use sysid::fit::FitResult;
 
-use super::fits::speed_derivatives;
 use super::Campaign;
 use crate::artifacts::aircraft_constants::write_model;
 use crate::artifacts::files;
 use crate::artifacts::truth_model::TruthModelDocument;
+use crate::identify::stages::speed_derivatives;
 use crate::output::write_json;
 
 impl Campaign<'_> {

@@ -54,7 +54,7 @@ pub use csv::units::{TimeUnit, Unit};
 pub use csv::{load_csv, load_csv_records, parse_csv_records, CsvColumns};
 pub use dump::{
     load_dump, load_dump_bytes, load_dump_tests, load_dump_with_origin, load_test_dump,
-    record_from_samples, test_record_from_samples,
+    record_from_samples, test_record_from_samples, Excitation,
 };
 pub use dump_tests::{
     split_tests, test_line, DumpTest, SplitDump, TestEnd, TestProgress, TestRecord,

@@ -1,0 +1,45 @@
+//! `summary.json` of `sweephold identify` (layout in docs/formats.md, "Identify
+//! summary.json"): the tests read and what became of each, where the trim and the trim
+//! points came from, and the fit and verification sections the campaign writes too,
+//! without truth (identify has none: the truth fields of `fit` are null).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::artifacts::summary::{FitSummary, StageFailure, VerifySummary};
+use crate::dump_tests::TestListing;
+
+/// The whole `summary.json` of `identify`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IdentifySummary {
+    /// Vehicle name: the aircraft file's `name`.
+    pub vehicle: String,
+    /// The fits' seed.
+    pub seed: u64,
+    /// Every test of every file read, in the order read, with what became of it.
+    pub tests: Vec<TestListing>,
+    /// The sweep tests the frequency responses were computed from (`FILE` or
+    /// `FILE test N`), in the order analysed.
+    pub sweeps: Vec<String>,
+    /// The held-out tests (doublets, 3-2-1-1…) the model was verified on.
+    pub held_out: Vec<String>,
+    /// The trim attitude φ0, θ0 \[rad\] the structure is written about: the mean of the
+    /// flight controller's captured trims over the sweep tests; null when none captured
+    /// one (then the structure file's own).
+    pub captured_trim_rad: Option<[f64; 2]>,
+    /// The trim points file the hybrid's `trim_derived` parameters came from; null when
+    /// none was given (then they are fitted like the others).
+    pub trim_points: Option<String>,
+    /// What the run could not do and how it went on instead (no trim points, no
+    /// held-out test…), one sentence each.
+    pub notes: Vec<String>,
+    /// The final (9-DOF hybrid, reduced) fit; its truth fields are null. Null until fitted.
+    pub fit: Option<FitSummary>,
+    /// The verification on the held-out tests; null without them or until verified.
+    pub verify: Option<VerifySummary>,
+    /// Wall time per completed stage \[s\], plus `total`.
+    pub timings_s: BTreeMap<String, f64>,
+    /// Null when every stage completed.
+    pub error: Option<StageFailure>,
+}
