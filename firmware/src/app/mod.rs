@@ -12,6 +12,7 @@
 //! * [`arming`]: pre-arm and test-entry checks, switch edges;
 //! * [`airborne`]: the airborne and landed rule (no test on the ground, a landing
 //!   aborts);
+//! * [`test_list`]: the tests a flight can fly, chosen by the selector channel;
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
 //! * [`throttle`]: the ESC channel and its soft start;
 //! * [`inputs`]: the input types;
@@ -60,6 +61,7 @@ pub mod modes;
 pub mod outputs;
 pub mod pilot_mode;
 pub mod reporting;
+pub mod test_list;
 pub mod throttle;
 
 #[cfg(test)]
@@ -81,6 +83,7 @@ use arming::{CheckInput, SwitchEdge};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
 use reporting::{BoardTap, Reporter};
+use test_list::{TestList, TestListError};
 use throttle::{Throttle, ThrottleSettings};
 
 pub use arming::{CheckFailure, Refusal};
@@ -114,11 +117,14 @@ pub struct AppConfig {
     pub failsafe: FailsafeSettings,
     /// The airborne and landed rule.
     pub airborne: AirborneSettings,
+    /// The test list the selector channel chooses from (unused without one).
+    pub tests: TestList,
 }
 
 impl AppConfig {
     /// TREX 700L: [`Config::trex700l_default`], [`PilotModeGains::trex700l`], standard
-    /// throttle and failsafe settings, [`AirborneSettings::trex700l`].
+    /// throttle and failsafe settings, [`AirborneSettings::trex700l`], the preset's
+    /// campaign as the test list ([`TestList::campaign`]).
     pub const fn trex700l(primary: Axis) -> Self {
         AppConfig {
             flight: Config::trex700l_default(primary),
@@ -126,6 +132,7 @@ impl AppConfig {
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
             airborne: AirborneSettings::trex700l(),
+            tests: TestList::campaign(VehicleId::Trex700l),
         }
     }
 
@@ -138,7 +145,8 @@ impl AppConfig {
     }
 
     /// Bo-105 (simulator): [`Config::bo105_default`], [`PilotModeGains::bo105`],
-    /// standard throttle and failsafe settings, [`AirborneSettings::bo105`].
+    /// standard throttle and failsafe settings, [`AirborneSettings::bo105`], the
+    /// preset's campaign as the test list.
     pub const fn bo105(primary: Axis) -> Self {
         AppConfig {
             flight: Config::bo105_default(primary),
@@ -146,6 +154,7 @@ impl AppConfig {
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
             airborne: AirborneSettings::bo105(),
+            tests: TestList::campaign(VehicleId::Bo105),
         }
     }
 
@@ -164,7 +173,11 @@ impl AppConfig {
         if !self.airborne.is_valid() {
             return Err(AppConfigError::AirborneInvalid);
         }
-        Ok(())
+        // The entries are checked as tests of this configuration: it must be valid first.
+        self.flight.validate().map_err(AppConfigError::Flight)?;
+        self.tests
+            .validate(&self.flight)
+            .map_err(AppConfigError::TestList)
     }
 }
 
@@ -182,6 +195,8 @@ pub enum AppConfigError {
     FailsafeInvalid,
     /// An airborne-rule setting is out of range.
     AirborneInvalid,
+    /// The test list's slices are out of range or an entry makes a refused test.
+    TestList(TestListError),
 }
 
 impl AppConfigError {
@@ -193,6 +208,7 @@ impl AppConfigError {
             AppConfigError::ThrottleInvalid => "throttle settings invalid",
             AppConfigError::FailsafeInvalid => "failsafe settings invalid",
             AppConfigError::AirborneInvalid => "airborne settings invalid",
+            AppConfigError::TestList(error) => error.message(),
         }
     }
 }

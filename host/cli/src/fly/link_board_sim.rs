@@ -232,6 +232,7 @@ impl Board {
             arm: true,
             test_switch,
             mode: ModeSwitch::Middle,
+            selector: None,
         }
     }
 }
@@ -343,6 +344,7 @@ impl BoardSimLink {
             arm,
             test_switch: false,
             mode: ModeSwitch::Middle,
+            selector: None,
         };
 
         // 1. Ground, rotor stopped: calibration.
