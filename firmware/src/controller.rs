@@ -250,6 +250,7 @@ impl FlightController {
                 vehicle: config.vehicle,
                 rate_hz: config.rate_hz,
                 test: config.test,
+                selection: None,
             },
             excitation: Excitation::from_test(&config.test).ticker(config.rate_hz),
             shaper: (config.test.input == InputKind::AdaptiveSweep).then(|| {
