@@ -68,7 +68,8 @@ pub mod throttle;
 mod tests;
 
 use sweephold_protocol::{
-    Axis, Controls, Header, Measurements, Phase, PilotInput, ProtocolVersion, SensorIn, VehicleId,
+    Axis, Controls, Header, Measurements, Phase, PilotInput, ProtocolVersion, SensorIn,
+    TestSelection, VehicleId,
 };
 
 use crate::attitude_hold::clamp_finite;
@@ -282,6 +283,8 @@ pub struct BoardApp {
     reporter: Reporter,
     /// A valid parameter set is in use ([`BoardApp::set_params_valid`]).
     params_valid: bool,
+    /// Tests engaged since power-up (the Header's engagement number).
+    engagements: u16,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -331,6 +334,7 @@ impl BoardApp {
             imu_trim: [0.0; 3],
             reporter: Reporter::default(),
             params_valid: true,
+            engagements: 0,
             fc,
             config,
         })
@@ -422,6 +426,7 @@ impl BoardApp {
             params_valid: self.params_valid,
         };
         let soft_start_done = rc.is_some_and(|frame| self.throttle.settled(frame.throttle));
+        let selection = self.selection(rc.as_ref());
         // The throttle output of the last tick: this tick's follows the transition.
         let air = self.airborne.observe(
             &self.config.airborne,
@@ -452,10 +457,15 @@ impl BoardApp {
                 soft_start_done,
                 air.airborne,
                 self.fc.phase() == Phase::Idle,
+                selection.is_some(),
             ),
         };
         let transition = modes::next(self.mode, &conditions);
+        let engaging = transition.to == Mode::Test && self.mode != Mode::Test;
         self.enter(transition.to);
+        if let Some(entry) = selection.filter(|_| engaging) {
+            self.engage(entry);
+        }
         if let Some(reason) = transition.abort {
             self.fc.abort(reason, &mut sink);
         }
@@ -522,6 +532,39 @@ impl BoardApp {
             abort: sink.reason,
             refused: transition.refused,
         }
+    }
+
+    /// The test the selector chooses in this tick's frame: its entry of the test list
+    /// (1 … 12) if not empty, entry 0 (the single configured test) without a selector
+    /// channel; `None` without a valid frame or on an empty entry.
+    fn selection(&self, rc: Option<&RcInput>) -> Option<u8> {
+        let tests = &self.config.tests;
+        match rc?.selector {
+            None => Some(0),
+            Some(position) => tests
+                .entry_at(position)
+                .filter(|entry| tests.get(*entry).is_some()),
+        }
+    }
+
+    /// A test engages on `entry`: the sequencer flies that entry's test (the single
+    /// configured one for entry 0) and its Header names the entry and the engagement.
+    /// Read once, here: a selector moved during the test changes nothing.
+    fn engage(&mut self, entry: u8) {
+        self.engagements = self.engagements.saturating_add(1);
+        let base = &self.config.flight.test;
+        let test = self
+            .config
+            .tests
+            .get(entry)
+            .map_or(*base, |chosen| chosen.apply(base));
+        let selection = TestSelection {
+            entry,
+            engagement: self.engagements,
+        };
+        // Every entry was validated with the configuration (`AppConfig::validate`) and the
+        // sequencer is idle (a test-entry check), so this is never refused.
+        let _ = self.fc.set_test(test, Some(selection));
     }
 
     /// Start, count and end the receiver-loss hold (armed only).
