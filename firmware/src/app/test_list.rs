@@ -70,6 +70,21 @@ impl TestEntry {
         self.axis.is_none() || self.t_rec_s <= 0.0
     }
 
+    /// The entry of `test`: its axis, input, band, pulse width, record length and sweep
+    /// amplitude (the inverse of [`TestEntry::apply`] where sweep and pulse amplitudes
+    /// agree).
+    pub const fn of(test: &TestConfig) -> TestEntry {
+        TestEntry {
+            axis: Some(test.primary),
+            input: test.input,
+            omega_min: test.sweep.omega_min,
+            omega_max: test.sweep.omega_max,
+            pulse_width_s: test.pulse.width_s,
+            t_rec_s: test.sweep.t_rec_s,
+            amplitude: test.sweep.amplitude,
+        }
+    }
+
     /// `base` with this entry's axis, input, band, pulse width, record length and
     /// amplitude (sweep and pulse); `base` itself for an empty entry.
     pub fn apply(&self, base: &TestConfig) -> TestConfig {
