@@ -78,7 +78,7 @@ mod tests {
     use super::*;
     use crate::fly::plan::plan_records;
     use crate::fly::record_config;
-    use sweephold_protocol::ExcitationMode;
+    use sweephold_protocol::{ExcitationMode, Header};
 
     /// Every record of a campaign is an entry of its list, on each preset; its slice
     /// centre selects that entry on the board.
@@ -109,6 +109,87 @@ mod tests {
             }
             assert_eq!(chosen, (1..=12).collect::<Vec<u8>>(), "{name}");
         }
+    }
+
+    /// A record chosen from the list by the selector flies exactly as the same record
+    /// configured as the board's single test (the path of a record outside the list):
+    /// every frame of the dumps the same but the Header's selection (entry 1 or 2 against
+    /// entry 0).
+    #[test]
+    fn a_test_chosen_by_the_selector_flies_as_the_same_test_configured() {
+        use crate::fly::link_board_sim::BoardSimLink;
+        use crate::fly::{board_sim_settings, fly, FlyArgs};
+        use sweephold_protocol::{Decoder, Frame};
+
+        let dir =
+            std::env::temp_dir().join(format!("sweephold-selector-same-{}", std::process::id()));
+        let fly_with = |unlisted: bool, folder: &str| {
+            let out = dir.join(folder);
+            let argv = [
+                "--vehicle",
+                "trex700l",
+                "--fc",
+                "board-sim",
+                "--axes",
+                "lat",
+                "--t-rec",
+                "6",
+                "--seed",
+                "3",
+                "--quiet",
+                "--out",
+            ]
+            .map(std::ffi::OsString::from)
+            .into_iter()
+            .chain([out.clone().into_os_string()]);
+            let args: FlyArgs = crate::campaign::verb_args("fly", argv).unwrap();
+            let mut settings = board_sim_settings(&args).unwrap();
+            if unlisted {
+                // No entry has the records' length: each flies as the single test.
+                for entry in settings.test_list.entries.iter_mut() {
+                    entry.t_rec_s = 7.0;
+                }
+            }
+            fly(&args, &|| Box::new(BoardSimLink::new(settings.clone()))).unwrap();
+            out
+        };
+        let frames = |path: std::path::PathBuf| -> Vec<Frame> {
+            let bytes = std::fs::read(path).unwrap();
+            Decoder::new().feed(&bytes).map(|f| f.unwrap()).collect()
+        };
+        let listed = fly_with(false, "listed");
+        let single = fly_with(true, "single");
+        for (file, entry) in [("lat-1.bin", 1), ("lat-2.bin", 2)] {
+            let (a, b) = (frames(listed.join(file)), frames(single.join(file)));
+            assert_eq!(a.len(), b.len(), "{file}");
+            assert!(a.len() > 1000, "{file}: a whole record");
+            let mut headers = 0;
+            for (x, y) in a.iter().zip(&b) {
+                match (x, y) {
+                    (Frame::Header(x), Frame::Header(y)) => {
+                        headers += 1;
+                        assert_eq!(
+                            x.selection.map(|s| (s.entry, s.engagement)),
+                            Some((entry, 1))
+                        );
+                        assert_eq!(y.selection.map(|s| (s.entry, s.engagement)), Some((0, 1)));
+                        assert_eq!(
+                            Header {
+                                selection: None,
+                                ..*x
+                            },
+                            Header {
+                                selection: None,
+                                ..*y
+                            }
+                        );
+                    }
+                    _ => assert_eq!(x, y, "{file}"),
+                }
+            }
+            assert_eq!(headers, 1, "{file}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// A record outside the list (another length, a 3-2-1-1) has no entry.
