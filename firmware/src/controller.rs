@@ -53,6 +53,7 @@
 use sweephold_protocol::{
     AbortReason, ActuatorOut, Axis, Controls, Event, ExcitationMode, FirmwareVersion, Frame,
     Header, HoldState, InputKind, Measurements, Phase, ProtocolVersion, Sample, SensorIn,
+    TestConfig, TestSelection,
 };
 
 use crate::amplitude::{AmplitudeShaper, AxisEnvelope};
@@ -250,6 +251,7 @@ impl FlightController {
                 vehicle: config.vehicle,
                 rate_hz: config.rate_hz,
                 test: config.test,
+                selection: None,
             },
             excitation: Excitation::from_test(&config.test).ticker(config.rate_hz),
             shaper: (config.test.input == InputKind::AdaptiveSweep).then(|| {
@@ -288,6 +290,35 @@ impl FlightController {
     /// The Header sent at test start (vehicle, rate, test, warnings).
     pub fn header(&self) -> Header {
         self.header
+    }
+
+    /// Fly `test` from the next test on, announced with `selection` in its Header (the
+    /// board application's test list). Only in Idle: in another phase nothing changes
+    /// and it returns `Ok(false)`. The test is validated with the rest of the
+    /// configuration as [`FlightController::new`] does; a refused one changes nothing.
+    /// The sequencer's running state (tick, staleness, switch, last commands, trim)
+    /// carries over.
+    pub fn set_test(
+        &mut self,
+        test: TestConfig,
+        selection: Option<TestSelection>,
+    ) -> Result<bool, ConfigError> {
+        if self.phase != Phase::Idle {
+            return Ok(false);
+        }
+        let mut next = FlightController::new(Config {
+            test,
+            ..self.config
+        })?;
+        next.header.selection = selection;
+        next.tick = self.tick;
+        next.stale = self.stale;
+        next.switch_was_on = self.switch_was_on;
+        next.last_finite_pilot = self.last_finite_pilot;
+        next.last_command = self.last_command;
+        next.trim = self.trim;
+        *self = next;
+        Ok(true)
     }
 
     /// The current sequencer phase.

@@ -126,6 +126,8 @@ pub enum RefusedCheck {
     /// The aircraft is not airborne by the board application's rule (a test request on
     /// the ground). Since 1.6.
     NotAirborne,
+    /// The test selector points at an empty entry of the test list. Since 1.7.
+    NoTestSelected,
 }
 
 impl RefusedCheck {
@@ -143,6 +145,7 @@ impl RefusedCheck {
             RefusedCheck::ParamsInvalid => "params_invalid",
             RefusedCheck::NotLevel => "not_level",
             RefusedCheck::NotAirborne => "not_airborne",
+            RefusedCheck::NoTestSelected => "no_test_selected",
         }
     }
 }

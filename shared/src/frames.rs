@@ -37,8 +37,9 @@ pub struct ProtocolVersion {
 /// [`Event::Refused`], [`Event::HostLinkIgnored`]); 1.5 the parameter frames
 /// ([`Frame::ParamRequest`], [`Frame::ParamReply`]), [`Event::ParamStore`] and the
 /// refusals [`RefusedCheck::ParamsInvalid`] and [`RefusedCheck::NotLevel`]; 1.6 the
-/// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`]; 1.7
-/// [`Frame::MeasurementFilter`].
+/// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`];
+/// 1.7 the Header's [`Header::selection`] (the test list entry and the engagement count),
+/// the refusal [`RefusedCheck::NoTestSelected`] and [`Frame::MeasurementFilter`].
 pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 7 };
 
 impl ProtocolVersion {
@@ -60,10 +61,9 @@ impl ProtocolVersion {
 
 impl ProtocolVersion {
     /// The version the board application's Headers announce: its streams carry the
-    /// events added in 1.4. What later minor versions appended (the 1.5 and 1.6 events,
-    /// the 1.7 [`Frame::MeasurementFilter`]) an older host reads as corrupt frames and
-    /// skips, so the announcement, and with it every Header's bytes, stays 1.4.
-    pub const BOARD_APPLICATION: ProtocolVersion = ProtocolVersion { major: 1, minor: 4 };
+    /// events added in 1.4 and its Headers the [`Header::selection`] of 1.7 (and after
+    /// each Header the 1.7 [`Frame::MeasurementFilter`]).
+    pub const BOARD_APPLICATION: ProtocolVersion = ProtocolVersion { major: 1, minor: 7 };
 
     /// The later of `self` and `other`.
     pub const fn max(self, other: ProtocolVersion) -> ProtocolVersion {
@@ -430,6 +430,38 @@ pub struct Header {
     pub rate_hz: u16,
     /// The active test.
     pub test: TestConfig,
+    /// Which test of the board's test list this is and how many tests the board engaged
+    /// since power-up (board application, since 1.7). `None` in the Headers of a flight
+    /// controller without a test list and of streams before 1.7: it then takes no bytes
+    /// on the wire, so their Headers are byte for byte what they were and a 1.7 decoder
+    /// reads the older ones whole.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "absent_at_end"
+    )]
+    pub selection: Option<TestSelection>,
+}
+
+/// The test list entry a Header's test came from and its engagement number (since 1.7).
+#[derive(Serialize, Deserialize, MaxSize, Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TestSelection {
+    /// The entry of the test list, 1 … 12; 0: the single configured test (no selector
+    /// channel).
+    pub entry: u8,
+    /// This test's number among the tests engaged since power-up, from 1.
+    pub engagement: u16,
+}
+
+/// A trailing optional field: `None` where the frame ends before it (the layout before
+/// the field existed), else the value postcard reads.
+fn absent_at_end<'de, D, T>(deserializer: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    Ok(Option::<T>::deserialize(deserializer).unwrap_or(None))
 }
 
 /// One firmware tick: what was commanded, why, and what the sensors saw.

@@ -77,6 +77,7 @@ pub fn header() -> Header {
             freeze_in_band: false,
             warnings: 0,
         },
+        selection: None,
     }
 }
 

@@ -1,4 +1,4 @@
-//! Protocol 1.5's parameter frames (and 1.6's additions): round trips, their place at the end of every
+//! Protocol 1.5's parameter frames (and 1.6's and 1.7's additions): round trips, their place at the end of every
 //! enum (so the older encodings stay as they were), and parameter names.
 
 mod strategies;
@@ -76,11 +76,6 @@ fn parameter_frames_are_appended_and_keep_the_older_encodings() {
     assert_eq!(postcard_bytes(&RefusedCheck::SequencerBusy), [6]);
     assert_eq!(postcard_bytes(&RefusedCheck::ParamsInvalid), [7]);
     assert_eq!(postcard_bytes(&RefusedCheck::NotLevel), [8]);
-    // Board streams without the new events still announce 1.4.
-    assert_eq!(
-        ProtocolVersion::BOARD_APPLICATION,
-        ProtocolVersion { major: 1, minor: 4 }
-    );
 }
 
 #[test]
@@ -137,12 +132,48 @@ fn protocol_1_6_appends_landed_and_not_airborne() {
     assert_eq!(postcard_bytes(&RefusedCheck::NotLevel), [8]);
     assert_eq!(postcard_bytes(&RefusedCheck::NotAirborne), [9]);
     assert_eq!(RefusedCheck::NotAirborne.name(), "not_airborne");
-    // Board streams still announce 1.4: an older host reads a 1.6 abort or refusal as
-    // a corrupt frame and skips it.
+}
+
+#[test]
+fn protocol_1_7_appends_the_selection_and_no_test_selected() {
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 7 });
     assert_eq!(
         ProtocolVersion::BOARD_APPLICATION,
-        ProtocolVersion { major: 1, minor: 4 }
+        ProtocolVersion { major: 1, minor: 7 }
     );
+    assert_eq!(postcard_bytes(&RefusedCheck::NoTestSelected), [10]);
+    assert_eq!(RefusedCheck::NoTestSelected.name(), "no_test_selected");
+
+    // A Header without a selection is the 1.6 layout, byte for byte: the fields up to
+    // `test`, nothing after them.
+    let old = synthetic::header();
+    assert_eq!(old.selection, None);
+    let fields = (
+        old.protocol,
+        old.firmware,
+        old.vehicle,
+        old.rate_hz,
+        old.test,
+    );
+    let mut tagged = vec![0u8]; // Frame::Header's variant
+    tagged.extend(postcard_bytes(&fields));
+    assert_eq!(postcard_bytes(&Frame::Header(old)), tagged);
+    assert_eq!(round_trip(&Frame::Header(old)), Frame::Header(old));
+
+    // With one, the entry and the count follow as an Option: tag 1, u8, varint u16.
+    let new = Header {
+        selection: Some(TestSelection {
+            entry: 7,
+            engagement: 300,
+        }),
+        ..old
+    };
+    let mut expected = tagged.clone();
+    expected.extend([1, 7, 0xAC, 0x02]);
+    assert_eq!(postcard_bytes(&Frame::Header(new)), expected);
+    assert_eq!(round_trip(&Frame::Header(new)), Frame::Header(new));
+    // The frame's largest size counts the selection.
+    assert!(Header::POSTCARD_MAX_SIZE >= postcard_bytes(&new).len());
 }
 
 #[test]
@@ -160,9 +191,4 @@ fn protocol_1_7_appends_the_measurement_filter_frame() {
     assert_eq!(bytes.len(), 1 + 4 + 4 * 5 * 4);
     // It does not raise the largest frame.
     assert!(bytes.len() + 4 + 2 <= sweephold_protocol::MAX_FRAME_LEN);
-    // Board streams still announce 1.4.
-    assert_eq!(
-        ProtocolVersion::BOARD_APPLICATION,
-        ProtocolVersion { major: 1, minor: 4 }
-    );
 }

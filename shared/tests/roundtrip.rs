@@ -139,10 +139,6 @@ fn board_events_are_appended_after_abort() {
         frame: HostFrame::Configure,
     };
     assert_eq!(encoded(ignored), [8, 5, 1]);
-    assert_eq!(
-        ProtocolVersion::BOARD_APPLICATION,
-        ProtocolVersion { major: 1, minor: 4 }
-    );
     let v = |minor| ProtocolVersion { major: 1, minor };
     assert_eq!(v(2).max(v(4)), v(4));
     assert_eq!(v(4).max(v(3)), v(4));

@@ -18,7 +18,8 @@
 //! Test-entry checks (armed, in the pilot mode): IMU healthy, attitude valid, receiver
 //! valid, the soft start finished (a sweep on a rotor still spooling up would measure a
 //! changing aircraft), airborne by the rule of [`super::airborne`] (a test engaged on
-//! the skids would excite an aircraft the ground holds), the sequencer idle.
+//! the skids would excite an aircraft the ground holds), the sequencer idle, and a test
+//! selected (with a selector channel, its slice's entry of the test list is not empty).
 
 use super::failsafe::ImuProblem;
 use super::inputs::RcInput;
@@ -48,6 +49,8 @@ pub enum CheckFailure {
     NotLevel,
     /// Not airborne by the rule of [`super::airborne`] (a test request on the ground).
     NotAirborne,
+    /// The test selector points at an empty entry of the test list.
+    NoTestSelected,
 }
 
 /// A request that was refused, and why.
@@ -131,12 +134,14 @@ pub fn pre_arm(input: &CheckInput<'_>, arm_max: f32) -> Result<(), CheckFailure>
 
 /// The test-entry checks: `soft_start_done` whether the throttle has reached its stick,
 /// `airborne` the airborne rule's verdict, `sequencer_idle` whether the sequencer is in
-/// Idle.
+/// Idle, `selected` whether there is a test to fly (the selector's entry, or the single
+/// test without a selector).
 pub fn test_entry(
     input: &CheckInput<'_>,
     soft_start_done: bool,
     airborne: bool,
     sequencer_idle: bool,
+    selected: bool,
 ) -> Result<(), CheckFailure> {
     healthy(input)?;
     if input.rc.is_none() {
@@ -150,6 +155,9 @@ pub fn test_entry(
     }
     if !sequencer_idle {
         return Err(CheckFailure::SequencerBusy);
+    }
+    if !selected {
+        return Err(CheckFailure::NoTestSelected);
     }
     Ok(())
 }

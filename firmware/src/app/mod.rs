@@ -12,6 +12,7 @@
 //! * [`arming`]: pre-arm and test-entry checks, switch edges;
 //! * [`airborne`]: the airborne and landed rule (no test on the ground, a landing
 //!   aborts);
+//! * [`test_list`]: the tests a flight can fly, chosen by the selector channel;
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
 //! * [`throttle`]: the ESC channel and its soft start;
 //! * [`inputs`]: the input types;
@@ -60,6 +61,7 @@ pub mod modes;
 pub mod outputs;
 pub mod pilot_mode;
 pub mod reporting;
+pub mod test_list;
 pub mod throttle;
 
 #[cfg(test)]
@@ -67,7 +69,7 @@ mod tests;
 
 use sweephold_protocol::{
     Axis, Controls, Header, MeasurementFilter, Measurements, Phase, PilotInput, ProtocolVersion,
-    SensorIn, VehicleId,
+    SensorIn, TestSelection, VehicleId,
 };
 
 use crate::attitude_hold::clamp_finite;
@@ -82,6 +84,7 @@ use arming::{CheckInput, SwitchEdge};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
 use reporting::{BoardTap, Reporter};
+use test_list::{TestList, TestListError};
 use throttle::{Throttle, ThrottleSettings};
 
 pub use arming::{CheckFailure, Refusal};
@@ -115,11 +118,14 @@ pub struct AppConfig {
     pub failsafe: FailsafeSettings,
     /// The airborne and landed rule.
     pub airborne: AirborneSettings,
+    /// The test list the selector channel chooses from (unused without one).
+    pub tests: TestList,
 }
 
 impl AppConfig {
     /// TREX 700L: [`Config::trex700l_default`], [`PilotModeGains::trex700l`], standard
-    /// throttle and failsafe settings, [`AirborneSettings::trex700l`].
+    /// throttle and failsafe settings, [`AirborneSettings::trex700l`], the preset's
+    /// campaign as the test list ([`TestList::campaign`]).
     pub const fn trex700l(primary: Axis) -> Self {
         AppConfig {
             flight: Config::trex700l_default(primary),
@@ -127,6 +133,7 @@ impl AppConfig {
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
             airborne: AirborneSettings::trex700l(),
+            tests: TestList::campaign(VehicleId::Trex700l),
         }
     }
 
@@ -139,7 +146,8 @@ impl AppConfig {
     }
 
     /// Bo-105 (simulator): [`Config::bo105_default`], [`PilotModeGains::bo105`],
-    /// standard throttle and failsafe settings, [`AirborneSettings::bo105`].
+    /// standard throttle and failsafe settings, [`AirborneSettings::bo105`], the
+    /// preset's campaign as the test list.
     pub const fn bo105(primary: Axis) -> Self {
         AppConfig {
             flight: Config::bo105_default(primary),
@@ -147,6 +155,7 @@ impl AppConfig {
             throttle: ThrottleSettings::standard(),
             failsafe: FailsafeSettings::standard(),
             airborne: AirborneSettings::bo105(),
+            tests: TestList::campaign(VehicleId::Bo105),
         }
     }
 
@@ -165,7 +174,11 @@ impl AppConfig {
         if !self.airborne.is_valid() {
             return Err(AppConfigError::AirborneInvalid);
         }
-        Ok(())
+        // The entries are checked as tests of this configuration: it must be valid first.
+        self.flight.validate().map_err(AppConfigError::Flight)?;
+        self.tests
+            .validate(&self.flight)
+            .map_err(AppConfigError::TestList)
     }
 }
 
@@ -183,6 +196,8 @@ pub enum AppConfigError {
     FailsafeInvalid,
     /// An airborne-rule setting is out of range.
     AirborneInvalid,
+    /// The test list's slices are out of range or an entry makes a refused test.
+    TestList(TestListError),
 }
 
 impl AppConfigError {
@@ -194,6 +209,7 @@ impl AppConfigError {
             AppConfigError::ThrottleInvalid => "throttle settings invalid",
             AppConfigError::FailsafeInvalid => "failsafe settings invalid",
             AppConfigError::AirborneInvalid => "airborne settings invalid",
+            AppConfigError::TestList(error) => error.message(),
         }
     }
 }
@@ -270,6 +286,8 @@ pub struct BoardApp {
     /// The filter the IMU measurements go through before the tick reads them, announced
     /// after each Header ([`BoardApp::set_measurement_filter`]).
     measurement_filter: Option<MeasurementFilter>,
+    /// Tests engaged since power-up (the Header's engagement number).
+    engagements: u16,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -320,6 +338,7 @@ impl BoardApp {
             reporter: Reporter::default(),
             params_valid: true,
             measurement_filter: None,
+            engagements: 0,
             fc,
             config,
         })
@@ -420,6 +439,7 @@ impl BoardApp {
             params_valid: self.params_valid,
         };
         let soft_start_done = rc.is_some_and(|frame| self.throttle.settled(frame.throttle));
+        let selection = self.selection(rc.as_ref());
         // The throttle output of the last tick: this tick's follows the transition.
         let air = self.airborne.observe(
             &self.config.airborne,
@@ -450,10 +470,15 @@ impl BoardApp {
                 soft_start_done,
                 air.airborne,
                 self.fc.phase() == Phase::Idle,
+                selection.is_some(),
             ),
         };
         let transition = modes::next(self.mode, &conditions);
+        let engaging = transition.to == Mode::Test && self.mode != Mode::Test;
         self.enter(transition.to);
+        if let Some(entry) = selection.filter(|_| engaging) {
+            self.engage(entry);
+        }
         if let Some(reason) = transition.abort {
             self.fc.abort(reason, &mut sink);
         }
@@ -522,6 +547,39 @@ impl BoardApp {
             abort: sink.reason,
             refused: transition.refused,
         }
+    }
+
+    /// The test the selector chooses in this tick's frame: its entry of the test list
+    /// (1 … 12) if not empty, entry 0 (the single configured test) without a selector
+    /// channel; `None` without a valid frame or on an empty entry.
+    fn selection(&self, rc: Option<&RcInput>) -> Option<u8> {
+        let tests = &self.config.tests;
+        match rc?.selector {
+            None => Some(0),
+            Some(position) => tests
+                .entry_at(position)
+                .filter(|entry| tests.get(*entry).is_some()),
+        }
+    }
+
+    /// A test engages on `entry`: the sequencer flies that entry's test (the single
+    /// configured one for entry 0) and its Header names the entry and the engagement.
+    /// Read once, here: a selector moved during the test changes nothing.
+    fn engage(&mut self, entry: u8) {
+        self.engagements = self.engagements.saturating_add(1);
+        let base = &self.config.flight.test;
+        let test = self
+            .config
+            .tests
+            .get(entry)
+            .map_or(*base, |chosen| chosen.apply(base));
+        let selection = TestSelection {
+            entry,
+            engagement: self.engagements,
+        };
+        // Every entry was validated with the configuration (`AppConfig::validate`) and the
+        // sequencer is idle (a test-entry check), so this is never refused.
+        let _ = self.fc.set_test(test, Some(selection));
     }
 
     /// Start, count and end the receiver-loss hold (armed only).

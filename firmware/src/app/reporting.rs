@@ -58,6 +58,7 @@ pub const fn refused_check(check: CheckFailure) -> RefusedCheck {
         CheckFailure::ParamsInvalid => RefusedCheck::ParamsInvalid,
         CheckFailure::NotLevel => RefusedCheck::NotLevel,
         CheckFailure::NotAirborne => RefusedCheck::NotAirborne,
+        CheckFailure::NoTestSelected => RefusedCheck::NoTestSelected,
     }
 }
 

@@ -13,6 +13,7 @@ use proptest::prelude::*;
 use sweephold_protocol::{AbortReason, Decoder, Event, Frame};
 
 mod airborne;
+mod test_list;
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 const STICKS: [f32; 4] = [0.05, -0.1, 0.02, 0.3];
@@ -1329,7 +1330,7 @@ fn arming_is_refused_for_each_failed_check() {
     assert!(is_level(0.0, -24f32.to_radians()));
     assert!(!is_level(24f32.to_radians(), 24f32.to_radians()));
     assert_eq!(
-        test_entry(&imu_ok, true, true, true),
+        test_entry(&imu_ok, true, true, true, true),
         Err(CheckFailure::ReceiverInvalid)
     );
     let mut rig = Rig::in_mode(Mode::Disarmed);

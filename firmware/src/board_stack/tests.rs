@@ -35,6 +35,7 @@ fn pilot(arm: bool, throttle: f32) -> RcInput {
         arm,
         test_switch: false,
         mode: ModeSwitch::Middle,
+        selector: None,
     }
 }
 

@@ -32,6 +32,8 @@ pub mod ram_flash;
 pub mod store;
 pub mod table;
 #[cfg(test)]
+mod test_list_tests;
+#[cfg(test)]
 mod tests;
 pub mod typed;
 

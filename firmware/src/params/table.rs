@@ -37,9 +37,10 @@ pub const MAX_NAME_LEN: usize = 16;
 /// version is not loaded (its values could mean other things). Version 2 appended
 /// `FRAME`, version 3 the excitation scales, slew limits and the holds' reference,
 /// integrator limits, time constants and directions, version 4 the test's collective
-/// source and the airborne rule: a record of an older version holds no base preset or
-/// none of those and boots the defaults.
-pub const TABLE_VERSION: u16 = 4;
+/// source and the airborne rule, version 5 the test list (`TEST_SEL_CH`, `TEST_SEL_N`,
+/// `TEST1_*` … `TEST12_*`): a record of an older version holds no base preset or none
+/// of those and boots the defaults.
+pub const TABLE_VERSION: u16 = 5;
 
 /// Swash type codes: H1, 120°, 135°, 140°.
 const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
@@ -58,8 +59,8 @@ const PULSE_MIN: f32 = 500.0;
 const PULSE_MAX: f32 = 2500.0;
 
 /// A parameter's doc line: the text on the host; empty in the flight-controller image
-/// (`target_os = "none"`), which never shows it and would spend 3.6 KiB of its flash
-/// budget on the 81 lines. The host reads the same table, so `sweephold fc` and the
+/// (`target_os = "none"`), which never shows it and would spend about 9 KiB of its
+/// flash budget on the lines. The host reads the same table, so `sweephold fc` and the
 /// README check keep the text.
 #[cfg(not(target_os = "none"))]
 macro_rules! doc_text {
@@ -211,6 +212,92 @@ params! {
     TestColSrc = "TEST_COL_SRC", "", 0.0, 1.0, Integer, "Collective during a test: 0 the captured trim, 1 the pilot's stick (plus the sweep on col tests).";
     AirColMin = "AIR_COL_MIN", "", -1.0, 1.0, Real, "Airborne: collective stick at or above this for AIR_TIME; landed: below it for AIR_TIME.";
     AirTime = "AIR_TIME", "s", 0.0, 10.0, Real, "Time the collective must stay above (airborne) or below (landed) AIR_COL_MIN.";
+    TestSelCh = "TEST_SEL_CH", "", 0.0, 16.0, Integer, "Receiver channel of the test selector (knob or switch) choosing a TESTn entry; 0: none, the test switch flies the TEST_* test.";
+    TestSelN = "TEST_SEL_N", "", 1.0, 12.0, Integer, "Equal slices of the selector channel's travel, selecting entries 1 to TEST_SEL_N (3 for a 3-position switch).";
+    Test1Axis = "TEST1_AXIS", "", 0.0, 4.0, Integer, "Test list entry 1: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test1Input = "TEST1_INPUT", "", 0.0, 3.0, Integer, "Test list entry 1: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test1Wmin = "TEST1_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 1: sweep start frequency.";
+    Test1Wmax = "TEST1_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 1: sweep end frequency.";
+    Test1Width = "TEST1_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 1: doublet / 3-2-1-1 unit pulse width.";
+    Test1Trec = "TEST1_TREC", "s", 0.0, 3600.0, Real, "Test list entry 1: record length; 0: empty entry.";
+    Test1Amp = "TEST1_AMP", "", 0.001, 0.5, Real, "Test list entry 1: sweep or pulse amplitude, fraction of stick travel.";
+    Test2Axis = "TEST2_AXIS", "", 0.0, 4.0, Integer, "Test list entry 2: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test2Input = "TEST2_INPUT", "", 0.0, 3.0, Integer, "Test list entry 2: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test2Wmin = "TEST2_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 2: sweep start frequency.";
+    Test2Wmax = "TEST2_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 2: sweep end frequency.";
+    Test2Width = "TEST2_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 2: doublet / 3-2-1-1 unit pulse width.";
+    Test2Trec = "TEST2_TREC", "s", 0.0, 3600.0, Real, "Test list entry 2: record length; 0: empty entry.";
+    Test2Amp = "TEST2_AMP", "", 0.001, 0.5, Real, "Test list entry 2: sweep or pulse amplitude, fraction of stick travel.";
+    Test3Axis = "TEST3_AXIS", "", 0.0, 4.0, Integer, "Test list entry 3: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test3Input = "TEST3_INPUT", "", 0.0, 3.0, Integer, "Test list entry 3: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test3Wmin = "TEST3_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 3: sweep start frequency.";
+    Test3Wmax = "TEST3_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 3: sweep end frequency.";
+    Test3Width = "TEST3_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 3: doublet / 3-2-1-1 unit pulse width.";
+    Test3Trec = "TEST3_TREC", "s", 0.0, 3600.0, Real, "Test list entry 3: record length; 0: empty entry.";
+    Test3Amp = "TEST3_AMP", "", 0.001, 0.5, Real, "Test list entry 3: sweep or pulse amplitude, fraction of stick travel.";
+    Test4Axis = "TEST4_AXIS", "", 0.0, 4.0, Integer, "Test list entry 4: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test4Input = "TEST4_INPUT", "", 0.0, 3.0, Integer, "Test list entry 4: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test4Wmin = "TEST4_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 4: sweep start frequency.";
+    Test4Wmax = "TEST4_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 4: sweep end frequency.";
+    Test4Width = "TEST4_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 4: doublet / 3-2-1-1 unit pulse width.";
+    Test4Trec = "TEST4_TREC", "s", 0.0, 3600.0, Real, "Test list entry 4: record length; 0: empty entry.";
+    Test4Amp = "TEST4_AMP", "", 0.001, 0.5, Real, "Test list entry 4: sweep or pulse amplitude, fraction of stick travel.";
+    Test5Axis = "TEST5_AXIS", "", 0.0, 4.0, Integer, "Test list entry 5: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test5Input = "TEST5_INPUT", "", 0.0, 3.0, Integer, "Test list entry 5: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test5Wmin = "TEST5_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 5: sweep start frequency.";
+    Test5Wmax = "TEST5_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 5: sweep end frequency.";
+    Test5Width = "TEST5_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 5: doublet / 3-2-1-1 unit pulse width.";
+    Test5Trec = "TEST5_TREC", "s", 0.0, 3600.0, Real, "Test list entry 5: record length; 0: empty entry.";
+    Test5Amp = "TEST5_AMP", "", 0.001, 0.5, Real, "Test list entry 5: sweep or pulse amplitude, fraction of stick travel.";
+    Test6Axis = "TEST6_AXIS", "", 0.0, 4.0, Integer, "Test list entry 6: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test6Input = "TEST6_INPUT", "", 0.0, 3.0, Integer, "Test list entry 6: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test6Wmin = "TEST6_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 6: sweep start frequency.";
+    Test6Wmax = "TEST6_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 6: sweep end frequency.";
+    Test6Width = "TEST6_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 6: doublet / 3-2-1-1 unit pulse width.";
+    Test6Trec = "TEST6_TREC", "s", 0.0, 3600.0, Real, "Test list entry 6: record length; 0: empty entry.";
+    Test6Amp = "TEST6_AMP", "", 0.001, 0.5, Real, "Test list entry 6: sweep or pulse amplitude, fraction of stick travel.";
+    Test7Axis = "TEST7_AXIS", "", 0.0, 4.0, Integer, "Test list entry 7: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test7Input = "TEST7_INPUT", "", 0.0, 3.0, Integer, "Test list entry 7: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test7Wmin = "TEST7_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 7: sweep start frequency.";
+    Test7Wmax = "TEST7_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 7: sweep end frequency.";
+    Test7Width = "TEST7_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 7: doublet / 3-2-1-1 unit pulse width.";
+    Test7Trec = "TEST7_TREC", "s", 0.0, 3600.0, Real, "Test list entry 7: record length; 0: empty entry.";
+    Test7Amp = "TEST7_AMP", "", 0.001, 0.5, Real, "Test list entry 7: sweep or pulse amplitude, fraction of stick travel.";
+    Test8Axis = "TEST8_AXIS", "", 0.0, 4.0, Integer, "Test list entry 8: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test8Input = "TEST8_INPUT", "", 0.0, 3.0, Integer, "Test list entry 8: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test8Wmin = "TEST8_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 8: sweep start frequency.";
+    Test8Wmax = "TEST8_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 8: sweep end frequency.";
+    Test8Width = "TEST8_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 8: doublet / 3-2-1-1 unit pulse width.";
+    Test8Trec = "TEST8_TREC", "s", 0.0, 3600.0, Real, "Test list entry 8: record length; 0: empty entry.";
+    Test8Amp = "TEST8_AMP", "", 0.001, 0.5, Real, "Test list entry 8: sweep or pulse amplitude, fraction of stick travel.";
+    Test9Axis = "TEST9_AXIS", "", 0.0, 4.0, Integer, "Test list entry 9: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test9Input = "TEST9_INPUT", "", 0.0, 3.0, Integer, "Test list entry 9: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test9Wmin = "TEST9_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 9: sweep start frequency.";
+    Test9Wmax = "TEST9_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 9: sweep end frequency.";
+    Test9Width = "TEST9_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 9: doublet / 3-2-1-1 unit pulse width.";
+    Test9Trec = "TEST9_TREC", "s", 0.0, 3600.0, Real, "Test list entry 9: record length; 0: empty entry.";
+    Test9Amp = "TEST9_AMP", "", 0.001, 0.5, Real, "Test list entry 9: sweep or pulse amplitude, fraction of stick travel.";
+    Test10Axis = "TEST10_AXIS", "", 0.0, 4.0, Integer, "Test list entry 10: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test10Input = "TEST10_INPUT", "", 0.0, 3.0, Integer, "Test list entry 10: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test10Wmin = "TEST10_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 10: sweep start frequency.";
+    Test10Wmax = "TEST10_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 10: sweep end frequency.";
+    Test10Width = "TEST10_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 10: doublet / 3-2-1-1 unit pulse width.";
+    Test10Trec = "TEST10_TREC", "s", 0.0, 3600.0, Real, "Test list entry 10: record length; 0: empty entry.";
+    Test10Amp = "TEST10_AMP", "", 0.001, 0.5, Real, "Test list entry 10: sweep or pulse amplitude, fraction of stick travel.";
+    Test11Axis = "TEST11_AXIS", "", 0.0, 4.0, Integer, "Test list entry 11: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test11Input = "TEST11_INPUT", "", 0.0, 3.0, Integer, "Test list entry 11: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test11Wmin = "TEST11_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 11: sweep start frequency.";
+    Test11Wmax = "TEST11_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 11: sweep end frequency.";
+    Test11Width = "TEST11_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 11: doublet / 3-2-1-1 unit pulse width.";
+    Test11Trec = "TEST11_TREC", "s", 0.0, 3600.0, Real, "Test list entry 11: record length; 0: empty entry.";
+    Test11Amp = "TEST11_AMP", "", 0.001, 0.5, Real, "Test list entry 11: sweep or pulse amplitude, fraction of stick travel.";
+    Test12Axis = "TEST12_AXIS", "", 0.0, 4.0, Integer, "Test list entry 12: axis, 0 none (empty entry), 1 lat, 2 lon, 3 ped, 4 col.";
+    Test12Input = "TEST12_INPUT", "", 0.0, 3.0, Integer, "Test list entry 12: input, 0 sweep, 1 doublet, 2 3-2-1-1, 3 adaptive sweep.";
+    Test12Wmin = "TEST12_WMIN", "rad/s", 0.01, 100.0, Real, "Test list entry 12: sweep start frequency.";
+    Test12Wmax = "TEST12_WMAX", "rad/s", 0.01, 400.0, Real, "Test list entry 12: sweep end frequency.";
+    Test12Width = "TEST12_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 12: doublet / 3-2-1-1 unit pulse width.";
+    Test12Trec = "TEST12_TREC", "s", 0.0, 3600.0, Real, "Test list entry 12: record length; 0: empty entry.";
+    Test12Amp = "TEST12_AMP", "", 0.001, 0.5, Real, "Test list entry 12: sweep or pulse amplitude, fraction of stick travel.";
 }
 
 /// The vehicle whose preset a `FRAME` value names (ArduPilot's `FRAME_CLASS` idea: one

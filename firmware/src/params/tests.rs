@@ -301,11 +301,17 @@ fn frame_names_the_preset_under_the_table() {
     assert_eq!(ParamId::ALL[80], ParamId::Frame);
     // Version 4 appended the collective source and the airborne rule after version 3's
     // last parameter.
-    assert_eq!(TABLE_VERSION, 4);
     assert_eq!(
-        ParamId::ALL[ParamId::HoldPedRev.index() + 1..],
+        ParamId::ALL[ParamId::HoldPedRev.index() + 1..ParamId::AirTime.index() + 1],
         [ParamId::TestColSrc, ParamId::AirColMin, ParamId::AirTime]
     );
+    // Version 5 appended the test list after them.
+    assert_eq!(TABLE_VERSION, 5);
+    assert_eq!(
+        ParamId::ALL[ParamId::AirTime.index() + 1],
+        ParamId::TestSelCh
+    );
+    assert_eq!(ParamId::ALL.last(), Some(&ParamId::Test12Amp));
     for vehicle in VEHICLES {
         let table = ParamTable::defaults(vehicle);
         assert_eq!(table.get(ParamId::Frame), frame_code(vehicle));

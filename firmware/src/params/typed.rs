@@ -10,6 +10,7 @@
 use sweephold_protocol::{Axis, ExcitationMode, InputKind, VehicleId};
 
 use super::table::{frame_code, frame_vehicle, ParamId, COUNT};
+use crate::app::test_list::{TestEntry, TEST_LIST_LEN};
 use crate::app::{AppConfig, AppConfigError};
 use crate::board_stack::StackConfig;
 use crate::config::{CollectiveSource, ConfigError, HoldReference};
@@ -93,6 +94,55 @@ const SLEW_IDS: [ParamId; 4] = [
 ];
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
+
+/// Parameters per test list entry: `TESTn_AXIS`, `_INPUT`, `_WMIN`, `_WMAX`, `_WIDTH`,
+/// `_TREC`, `_AMP`, in this order, entry after entry from `TEST1_AXIS` on.
+const ENTRY_FIELDS: usize = 7;
+
+/// The parameter of field `field` of test list entry `entry` (0-based both).
+fn entry_param(entry: usize, field: usize) -> ParamId {
+    ParamId::ALL
+        .get(ParamId::Test1Axis.index() + entry * ENTRY_FIELDS + field)
+        .copied()
+        .unwrap_or(ParamId::Test1Axis)
+}
+
+/// The entry the seven values (in [`ENTRY_FIELDS`] order) describe; `None` for an
+/// input number outside the table's.
+fn entry_from(
+    [axis, input, wmin, wmax, width, trec, amp]: [f32; ENTRY_FIELDS],
+) -> Option<TestEntry> {
+    Some(TestEntry {
+        axis: match axis as usize {
+            0 => None,
+            n => Some(*Axis::ALL.get(n - 1)?),
+        },
+        input: *INPUTS.get(input as usize)?,
+        omega_min: wmin,
+        omega_max: wmax,
+        pulse_width_s: width,
+        t_rec_s: trec,
+        amplitude: amp,
+    })
+}
+
+/// The seven values of `entry`, in [`ENTRY_FIELDS`] order.
+fn entry_values(entry: &TestEntry) -> [f32; ENTRY_FIELDS] {
+    let axis = entry
+        .axis
+        .and_then(|a| Axis::ALL.iter().position(|x| *x == a))
+        .map_or(0.0, |i| i as f32 + 1.0);
+    let input = INPUTS.iter().position(|i| *i == entry.input).unwrap_or(0);
+    [
+        axis,
+        input as f32,
+        entry.omega_min,
+        entry.omega_max,
+        entry.pulse_width_s,
+        entry.t_rec_s,
+        entry.amplitude,
+    ]
+}
 
 /// The default swash servo frame rate \[Hz\]: 333, the fastest the table allows. A
 /// flybarless head is flown with digital servos, which take 333 Hz frames; at the 50 Hz
@@ -347,6 +397,20 @@ impl Params {
         };
         stack.app.airborne.col_min = v(ParamId::AirColMin);
         stack.app.airborne.time_s = v(ParamId::AirTime);
+        stack.channel_map.selector = ChannelSource {
+            channel: v(ParamId::TestSelCh) as u8,
+            reversed: false,
+        };
+        stack
+            .channel_map
+            .validate()
+            .map_err(ParamsError::ChannelMap)?;
+        let list = &mut stack.app.tests;
+        list.slices = v(ParamId::TestSelN) as u8;
+        for (k, entry) in list.entries.iter_mut().enumerate() {
+            let values = core::array::from_fn(|f| v(entry_param(k, f)));
+            *entry = entry_from(values).ok_or(ParamsError::Value(entry_param(k, 1)))?;
+        }
         let flight = &mut stack.app.flight;
         flight.test.warnings = flight.validate().map_err(ParamsError::Flight)?;
         stack.app.validate().map_err(ParamsError::App)?;
@@ -561,5 +625,13 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
     );
     put(ParamId::AirColMin, stack.app.airborne.col_min);
     put(ParamId::AirTime, stack.app.airborne.time_s);
+    put(ParamId::TestSelCh, f32::from(map.selector.channel));
+    let list = &stack.app.tests;
+    put(ParamId::TestSelN, f32::from(list.slices));
+    for (k, entry) in list.entries.iter().enumerate().take(TEST_LIST_LEN) {
+        for (f, value) in entry_values(entry).into_iter().enumerate() {
+            put(entry_param(k, f), value);
+        }
+    }
     values
 }

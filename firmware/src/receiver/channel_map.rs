@@ -13,6 +13,13 @@
 //! | ch6     | collective (pitch)                | `sticks.col` in [−1, 1]        | stick     |
 //! | ch7     | test switch                       | `test_switch`                  | 2-position|
 //! | ch8     | mode switch                       | `mode`: Low / Middle / High    | 3-position|
+//! | none    | test selector (knob or switch)    | `selector` in [−1, 1] or None  | stick     |
+//!
+//! The test selector ([`ChannelMap::selector`], parameter `TEST_SEL_CH`) has no channel
+//! by default (channel 0): `selector` is then `None` and the test switch engages the
+//! single configured test. With a channel it reads like a stick; the board application
+//! cuts its travel into slices that select an entry of the test list
+//! ([`crate::app::test_list`]).
 //!
 //! Each function has its own channel (1 … 16, distinct) and a `reversed` flag;
 //! [`ChannelMap::validate`] checks both. Positive stick outputs follow the sign
@@ -177,6 +184,8 @@ pub struct RcInput {
     pub test_switch: bool,
     /// The mode switch position.
     pub mode: ModeSwitch,
+    /// The test selector's position in [−1, 1]; `None` without a selector channel.
+    pub selector: Option<f32>,
 }
 
 impl RcInput {
@@ -192,6 +201,7 @@ impl RcInput {
         arm: false,
         test_switch: false,
         mode: ModeSwitch::Low,
+        selector: None,
     };
 
     /// The part of the input the flight logic's sensor frame carries.
@@ -248,6 +258,8 @@ pub struct ChannelMap {
     pub test: ChannelSource,
     /// Mode switch (three positions).
     pub mode: ChannelSource,
+    /// Test selector (a knob or a multi-position switch): channel 0 for none.
+    pub selector: ChannelSource,
     /// Raw calibration shared by all channels.
     pub range: RawRange,
     /// Switch threshold τ as a fraction of half travel.
@@ -273,6 +285,7 @@ impl ChannelMap {
             collective: ChannelSource::normal(6),
             test: ChannelSource::normal(7),
             mode: ChannelSource::normal(8),
+            selector: ChannelSource::normal(0),
             range: RawRange::SBUS,
             switch_threshold: 0.5,
         }
@@ -292,7 +305,8 @@ impl ChannelMap {
         ]
     }
 
-    /// Check channel numbers (1 … 16, all distinct), the raw range and the threshold.
+    /// Check channel numbers (1 … 16, all distinct; the selector's 0 or one of the
+    /// others' not), the raw range and the threshold.
     pub fn validate(&self) -> Result<(), ChannelMapError> {
         let sources = self.sources();
         let mut seen: u32 = 0;
@@ -305,6 +319,15 @@ impl ChannelMap {
                 return Err(ChannelMapError::DuplicateChannel);
             }
             seen |= bit;
+        }
+        let selector = self.selector.channel;
+        if selector != 0 {
+            if usize::from(selector) > CHANNELS {
+                return Err(ChannelMapError::ChannelOutOfRange);
+            }
+            if seen & (1u32 << selector) != 0 {
+                return Err(ChannelMapError::DuplicateChannel);
+            }
         }
         if !self.range.is_valid() {
             return Err(ChannelMapError::RangeInvalid);
@@ -331,6 +354,10 @@ impl ChannelMap {
             arm: self.two_position(&self.arm, frame),
             test_switch: self.two_position(&self.test, frame),
             mode: self.three_position(&self.mode, frame),
+            selector: self
+                .selector
+                .raw(frame)
+                .map(|_| self.stick(&self.selector, frame)),
         }
     }
 
@@ -396,6 +423,10 @@ impl ChannelMap {
             ),
             (self.test, stick_raw(&self.test, switch(input.test_switch))),
             (self.mode, stick_raw(&self.mode, mode)),
+            (
+                self.selector,
+                stick_raw(&self.selector, input.selector.unwrap_or(0.0)),
+            ),
         ];
         for (source, raw) in writes {
             let slot = usize::from(source.channel)

@@ -822,6 +822,7 @@ proptest! {
             arm,
             test_switch,
             mode,
+            selector: None,
         };
         let frame = map.encode(&input);
         prop_assert!(frame.is_intact());
@@ -851,6 +852,7 @@ fn encode_writes_the_centre_for_non_finite_sticks_and_the_minimum_throttle() {
         arm: false,
         test_switch: false,
         mode: ModeSwitch::Middle,
+        selector: None,
     };
     let frame = map.encode(&input);
     assert_eq!(&frame.channels[..4], &[992, 992, 172, 992]);
@@ -862,4 +864,37 @@ fn encode_writes_the_centre_for_non_finite_sticks_and_the_minimum_throttle() {
     );
     assert_eq!(frame.channels[7], 992, "mode Middle: centre");
     assert_eq!(frame.channels[8..], [992; 8]);
+}
+
+#[test]
+fn the_test_selector_reads_its_channel_only_when_it_has_one() {
+    let mut map = ChannelMap::flybarless_default();
+    let mut frame = SbusFrame {
+        channels: [992; 16],
+        ..SbusFrame::default()
+    };
+    frame.channels[8] = 172;
+    // No channel (the default): no selector, whatever the frame holds.
+    assert_eq!(map.selector.channel, 0);
+    assert_eq!(map.map(&frame).selector, None);
+    // Channel 9: read like a stick, both ends and the centre exact.
+    map.selector = ChannelSource::normal(9);
+    assert_eq!(map.validate(), Ok(()));
+    assert_eq!(map.map(&frame).selector, Some(-1.0));
+    frame.channels[8] = 1811;
+    assert_eq!(map.map(&frame).selector, Some(1.0));
+    frame.channels[8] = 992;
+    assert_eq!(map.map(&frame).selector, Some(0.0));
+    // The transmitter's side writes it back.
+    let input = RcInput {
+        selector: Some(0.5),
+        ..RcInput::NEUTRAL
+    };
+    let back = map.map(&map.encode(&input)).selector.unwrap();
+    assert!((back - 0.5).abs() <= 0.5 / 819.0 + 1e-6, "{back}");
+    // A channel another function reads, or beyond 16, is refused.
+    map.selector = ChannelSource::normal(7);
+    assert_eq!(map.validate(), Err(ChannelMapError::DuplicateChannel));
+    map.selector = ChannelSource::normal(17);
+    assert_eq!(map.validate(), Err(ChannelMapError::ChannelOutOfRange));
 }

@@ -211,16 +211,22 @@ fn handle_frame<W: Write>(
     Ok(())
 }
 
-/// A Header as a JSON object.
+/// A Header as a JSON object; a board application's (protocol 1.7) with its test list
+/// `entry` and `engagement` number.
 pub fn header_json(h: &Header) -> serde_json::Value {
-    serde_json::json!({
+    let mut json = serde_json::json!({
         "type": "header",
         "protocol": h.protocol.to_string(),
         "firmware": h.firmware.to_string(),
         "vehicle": h.vehicle.name(),
         "rate_hz": h.rate_hz,
         "test": serde_json::to_value(h.test).unwrap_or(serde_json::Value::Null),
-    })
+    });
+    if let (Some(selection), Some(object)) = (h.selection, json.as_object_mut()) {
+        object.insert("entry".into(), selection.entry.into());
+        object.insert("engagement".into(), selection.engagement.into());
+    }
+    json
 }
 
 /// A MeasurementFilter frame as a JSON object: the rate and each biquad section's

@@ -426,6 +426,7 @@ mod tests {
                 freeze_in_band: false,
                 warnings: 0,
             },
+            selection: None,
         };
         let mut bytes = Vec::new();
         let mut push = |frame: Frame| {

@@ -78,7 +78,7 @@ fn dumps_of_two_vehicles_protocol_versions_or_rates_are_not_joined() {
         ),
         (
             fly(&dir, "board", &["--vehicle", "bo105", "--fc", "board-sim"]),
-            "protocol version 1.2 vs 1.4",
+            "protocol version 1.2 vs 1.7",
         ),
         (
             fly(&dir, "slow", &["--vehicle", "bo105", "--rate", "100"]),

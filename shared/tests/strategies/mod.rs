@@ -152,8 +152,9 @@ pub fn header() -> impl Strategy<Value = Header> {
         any::<bool>(),
         any::<u16>(),
         test_config(),
+        proptest::option::of((any::<u8>(), any::<u16>())),
     )
-        .prop_map(|(minor, fw, bo, rate_hz, test)| Header {
+        .prop_map(|(minor, fw, bo, rate_hz, test, selection)| Header {
             protocol: ProtocolVersion {
                 major: PROTOCOL_VERSION.major,
                 minor,
@@ -170,6 +171,7 @@ pub fn header() -> impl Strategy<Value = Header> {
             },
             rate_hz,
             test,
+            selection: selection.map(|(entry, engagement)| TestSelection { entry, engagement }),
         })
 }
 

@@ -26,9 +26,17 @@
 //! With `--fc board-sim` the board is set up from the aircraft file in memory: the
 //! record's configuration (the preset with the file's `[flight_controller]` settings),
 //! its mixer and servo frame rates those of the file's `[swash]` table, as `fc params
-//! push` would set them. With `--fc board-sim:FLASH` it boots the set saved in FLASH
-//! ([`BoardSetup::Stored`]) and only the record's test (axis, input, mode, seed, band,
-//! length, amplitude) and rate are the campaign's.
+//! push` would set them, and the file's campaign as its test list on a selector channel
+//! ([`super::board_test_list`]). A record whose test is an entry of the list is chosen
+//! in the air: the simulated transmitter's selector sits at that entry's slice when the
+//! test switch engages, and the board's own single test stays the preset's (the
+//! record's mode, noise seed and the other shared settings are the board's, one record
+//! per power-up). A record outside the list (another band, length or input) is the
+//! board's single test, selector off, as before the list. With `--fc board-sim:FLASH`
+//! it boots the set saved in FLASH ([`BoardSetup::Stored`]) and only the record's test
+//! (axis, input, mode, seed, band, length, amplitude), the test list (the same as above:
+//! the aircraft's campaign at the flight's record length), the selector channel and the
+//! rate are the campaign's; its own single test is the stored one's.
 //!
 //! # The simulated pilot and transmitter
 //!
@@ -80,14 +88,16 @@
 
 use embedded_hal::delay::DelayNs;
 use rotorsim::{Helicopter, Sim, SimOptions, Trim};
+use sweephold_firmware::app::test_list::TestList;
 use sweephold_firmware::app::{AppConfig, Mode, TickOutput};
 use sweephold_firmware::board_stack::{BoardStack, BootState, StackConfig};
 use sweephold_firmware::imu::emulator::{Icm42688Emulator, Imperfections};
 use sweephold_firmware::imu::GRAVITY_M_S2;
-use sweephold_firmware::receiver::{ChannelMap, ModeSwitch, RcInput};
+use sweephold_firmware::receiver::{ChannelMap, ChannelSource, ModeSwitch, RcInput};
 use sweephold_firmware::{Config, FrameSink};
 use sweephold_protocol::{ActuatorOut, Controls, SensorIn};
 
+use super::board_test_list::{self, SELECTOR_CHANNEL};
 pub use super::imu_fault::{ImuFaultKind, ImuFaultPlan, ImuFaultPlanError};
 use super::link::FlightControllerLink;
 use super::servo_plant::{self, FrameHold, ServoGeometry};
@@ -125,6 +135,8 @@ pub struct BoardSimSettings {
     pub imu_fault: Option<ImuFaultPlan>,
     /// The aircraft's servo geometry: the board's pulses reach the rotor through it.
     pub swash: aircraft::Swash,
+    /// The test list the board is set up with (`FromAircraft`): the aircraft's campaign.
+    pub test_list: TestList,
     /// How the board is set up.
     pub setup: BoardSetup,
 }
@@ -189,6 +201,10 @@ struct Board {
     /// The IMU's truth (rates, specific force) at the end of the last tick and at the
     /// end of this one: the chip samples in between lie on the line joining them.
     truth: Option<[Truth; 2]>,
+    /// The transmitter's channel map: the board's default one, with its selector channel.
+    map: ChannelMap,
+    /// The selector's position (the record's entry), if the board has a selector.
+    selector: Option<f32>,
 }
 
 /// Body rates \[rad/s\] and specific force \[m/s²\] the emulated chip senses.
@@ -213,7 +229,7 @@ impl Board {
     /// One control tick with the transmitter sending `rc` (if transmitting): the
     /// samples and frames that fall due, then the stack's control tick.
     fn tick(&mut self, rc: &RcInput, sink: &mut impl FrameSink) -> TickOutput {
-        let map = ChannelMap::flybarless_default();
+        let map = self.map;
         for sample in 1..=self.samples_per_tick {
             if let Some([(rates_0, force_0), (rates_1, force_1)]) = self.truth {
                 let s = sample as f32 / self.samples_per_tick as f32;
@@ -258,6 +274,7 @@ impl Board {
             arm: true,
             test_switch,
             mode: ModeSwitch::Middle,
+            selector: self.selector,
         }
     }
 }
@@ -287,7 +304,7 @@ impl BoardSimLink {
                 "--fc board-sim needs a rate that divides the IMU's 1000 Hz, not {rate} Hz"
             );
         }
-        let (stack_config, [swash_hz, tail_hz]) = match &settings.setup {
+        let (mut stack_config, [swash_hz, tail_hz]) = match &settings.setup {
             BoardSetup::FromAircraft => {
                 let preset = AppConfig::preset(config.vehicle, config.test.primary);
                 let mut flight = *config;
@@ -303,6 +320,34 @@ impl BoardSimLink {
                 [params.swash_frame_hz, params.tail_frame_hz],
             ),
         };
+        // The record's test from the list, chosen by the selector: the board's single
+        // test is then the preset's (the stored one's with a stored set).
+        let own_test = match &settings.setup {
+            BoardSetup::FromAircraft => {
+                AppConfig::preset(config.vehicle, config.test.primary)
+                    .flight
+                    .test
+            }
+            BoardSetup::Stored(params) => params.stack.app.flight.test,
+        };
+        let record_test = stack_config.app.flight.test;
+        let single = board_test_list::single_test(&own_test, &record_test);
+        let mut listed = stack_config;
+        listed.app.tests = settings.test_list;
+        listed.app.flight.test = single;
+        listed.channel_map.selector = ChannelSource::normal(SELECTOR_CHANNEL);
+        let mut selector = None;
+        stack_config.channel_map.selector = ChannelSource::normal(0);
+        if let Some((_, position)) =
+            board_test_list::selection(&listed.app.tests, &single, &record_test)
+        {
+            if listed.channel_map.validate().is_ok() && listed.app.validate().is_ok() {
+                stack_config = listed;
+                selector = Some(position);
+            }
+        }
+        let mut map = ChannelMap::flybarless_default();
+        map.selector = stack_config.channel_map.selector;
         let app = stack_config.app;
         let seed = 0xB0A2_D51A_u64 ^ u64::from(config.test.seed).rotate_left(23);
         let (rotor_stopped, rotor_running) = if settings.vibration {
@@ -356,6 +401,8 @@ impl BoardSimLink {
             geometry: ServoGeometry::new(&settings.swash),
             flown: [0.0; 4],
             truth: None,
+            map,
+            selector,
         };
         let ticks_in = |seconds: f64| (seconds * f64::from(rate)).ceil() as u64;
         let col = board.trim_sticks[3];
@@ -370,6 +417,7 @@ impl BoardSimLink {
             arm,
             test_switch: false,
             mode: ModeSwitch::Middle,
+            selector: None,
         };
 
         // 1. Ground, rotor stopped: calibration.
@@ -532,7 +580,8 @@ impl FlightControllerLink for BoardSimLink {
     }
 }
 
-/// The stored set with the record's test and rate: what the campaign chooses per record.
+/// The stored set with the record's test and rate: what the campaign chooses per record
+/// (the test then moves into the campaign's test list, chosen by the selector).
 fn stored_with_record(
     params: &sweephold_firmware::params::Params,
     config: &Config,

@@ -2,6 +2,7 @@
 //! controller in the loop and the nonlinear simulator as the aircraft.
 
 pub mod board_flash;
+pub mod board_test_list;
 pub mod defmt_log;
 pub mod frame_channel;
 pub mod imu_fault;
@@ -614,6 +615,7 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
         rc_loss_at_s: args.rc_loss_at_s,
         imu_fault: args.imu_fault,
         swash: args.vehicle.aircraft().swash,
+        test_list: board_test_list::campaign_list(&args.vehicle, args.t_rec_s),
         setup: match &args.fc {
             FcArg::BoardSim(Some(flash)) => link_board_sim::BoardSetup::Stored(Box::new(
                 board_flash::load_params(flash, args.vehicle.preset())?,

@@ -290,6 +290,7 @@ fn header(spec: &DumpSpec) -> Header {
             freeze_in_band: false,
             warnings: 0,
         },
+        selection: None,
     }
 }
 
