@@ -8,27 +8,45 @@ use clap::Parser;
 use sweephold::fly::{FlyArgs, FlyOutcome};
 use sweephold::{Cli, Command};
 
-/// A scratch folder removed on drop.
-pub struct Scratch(PathBuf);
+/// A test's own folder, removed on drop with everything beside it.
+///
+/// The path is `TMP/sweephold-it-NAME-XXXXXX/NAME`: the outer folder's name is made unique
+/// by the `tempfile` crate (the tests of a binary run in parallel in one process, so the
+/// process id cannot tell them apart) and it is the test's alone, so what a run puts beside
+/// its `--out` (the `OUT.failed` folder a failed run keeps by design, a staging folder, a
+/// lock) goes with it. A test that panics keeps it, and says where.
+pub struct Scratch {
+    /// The unique folder holding `path` and its siblings.
+    root: PathBuf,
+    path: PathBuf,
+}
 
 impl Scratch {
-    /// A fresh folder named after `name` and the process.
+    /// A fresh empty folder named after `name`.
     pub fn new(name: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("sweephold-it-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create scratch folder");
-        Scratch(dir)
+        let root = tempfile::Builder::new()
+            .prefix(&format!("sweephold-it-{name}-"))
+            .tempdir()
+            .expect("create scratch folder")
+            .keep();
+        let path = root.join(name);
+        std::fs::create_dir(&path).expect("create scratch folder");
+        Scratch { root, path }
     }
 
     /// The folder.
     pub fn path(&self) -> &Path {
-        &self.0
+        &self.path
     }
 }
 
 impl Drop for Scratch {
     fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
+        if std::thread::panicking() {
+            eprintln!("kept for a look: {}", self.root.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.root);
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 """Write two_input.csv: two correlated inputs driving one output through known transfer
 functions, simulated by scipy (an outside simulator for the MISO frequency responses of
 `sweephold frf`; the tests in host/sysid/tests/two_input_csv.rs and
-host/cli/tests/frf_inputs_cli.rs read the CSV and compare with the exact responses).
+host/cli/tests/cli/frf_inputs.rs read the CSV and compare with the exact responses).
 
 Run: python3 make_two_input_csv.py  (needs numpy and scipy; the CSV is committed, so the
 tests do not need Python). Written with numpy 2.4.6 and scipy 1.17.1 (Python 3.11); same versions,

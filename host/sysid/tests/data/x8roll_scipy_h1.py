@@ -2,7 +2,7 @@
 """Write x8roll_scipy_h1.json: an independent H1 estimate of the x8 roll response (`rout` →
 roll rate) from x8roll.csv, by scipy's Welch cross- and auto-spectra, for the tests that
 read x8roll.csv as it is with `sweephold frf` (host/sysid/tests/x8roll_csv.rs,
-host/cli/tests/frf_csv_cli.rs).
+host/cli/tests/cli/frf_csv.rs).
 
 Run: python3 x8roll_scipy_h1.py  (needs numpy and scipy; the JSON is committed, so the
 tests do not need Python). Written with numpy 2.4.6 and scipy 1.17.1 (Python 3.11).

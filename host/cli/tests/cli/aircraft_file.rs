@@ -5,10 +5,11 @@
 //! `--vehicle FILE`. What reaches the simulator, the flight controller's Header and the
 //! fit's priors is the file's.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use serde_json::Value;
+
+use crate::support::Scratch;
 
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
@@ -17,11 +18,8 @@ fn sweephold(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-aircraft-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch() -> Scratch {
+    Scratch::new("aircraft")
 }
 
 fn json(path: &std::path::Path) -> Value {

@@ -3,25 +3,15 @@
 //! says which fault ended the record before it began (and the board's mode change), not
 //! that the dump lacks a Header; the run fails (exit 1) and `--out` is not created.
 
-use std::path::PathBuf;
 use std::process::Command;
 
-struct TempDir(PathBuf);
+use crate::support::Scratch;
+
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!(
-            "sweephold-fault-at-start-{name}-{}",
-            std::process::id()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
+        TempDir(Scratch::new(&format!("fault-at-start-{name}")))
     }
 }
 

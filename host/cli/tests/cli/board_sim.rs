@@ -3,10 +3,12 @@
 //! application's bars (estimator error, attitude after the test, abort reasons and latency); the values
 //! measured are in docs/board-application.md.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use serde_json::Value;
+
+use crate::support::Scratch;
 
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
@@ -15,11 +17,8 @@ fn sweephold(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("sweephold-board-sim-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::unmade(&format!("board-sim-{name}"))
 }
 
 /// Fly `args` (plus `--fc board-sim --axes lat --t-rec 30 -q --out DIR`) and return the

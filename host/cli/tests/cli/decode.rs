@@ -5,6 +5,8 @@ use std::process::{Command, Output};
 
 use sweephold_protocol::{codec, synthetic, Event, Frame, ProtocolVersion, PROTOCOL_VERSION};
 
+use crate::support::Scratch;
+
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
         .args(args)
@@ -12,14 +14,11 @@ fn sweephold(args: &[&str]) -> Output {
         .expect("run sweephold")
 }
 
-struct TempDir(PathBuf);
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("sweephold-test-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        TempDir(Scratch::new(&format!("test-{name}")))
     }
     fn file(&self, name: &str, bytes: &[u8]) -> String {
         let path = self.0.join(name);
@@ -28,12 +27,6 @@ impl TempDir {
     }
     fn path(&self, name: &str) -> PathBuf {
         self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
     }
 }
 

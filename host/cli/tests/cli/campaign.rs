@@ -2,11 +2,13 @@
 //! keys and types, one <svg> per plot section of report.html, `sweephold report DIR`
 //! regenerating the same structure, and one-line stage errors with a non-zero exit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use serde_json::Value;
 use sweephold::artifacts::stage::Stage;
+
+use crate::support::Scratch;
 
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
@@ -15,12 +17,8 @@ fn sweephold(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("sweephold-campaign-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("campaign-{name}"))
 }
 
 fn number(value: &Value, what: &str) -> f64 {

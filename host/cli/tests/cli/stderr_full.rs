@@ -4,8 +4,10 @@
 //! Linux only (`/dev/full`); skipped where it does not exist.
 
 use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
+
+use crate::support::Scratch;
 
 fn full() -> Option<File> {
     File::options().write(true).open("/dev/full").ok()
@@ -23,11 +25,8 @@ fn with_full_stderr(dir: &Path, args: &[&str]) -> Option<i32> {
     status.code()
 }
 
-fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-stderr-full-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch() -> Scratch {
+    Scratch::new("stderr-full")
 }
 
 #[test]

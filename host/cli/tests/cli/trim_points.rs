@@ -7,26 +7,18 @@ use std::process::{Command, Output};
 
 use sysid::fit::trim::TrimPoints;
 
-struct TempDir(PathBuf);
+use crate::support::Scratch;
+
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("sweephold-trim-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        TempDir(Scratch::new(&format!("trim-{name}")))
     }
     fn file(&self, name: &str, bytes: &[u8]) -> PathBuf {
         let path = self.0.join(name);
         std::fs::write(&path, bytes).unwrap();
         path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
     }
 }
 
@@ -269,7 +261,7 @@ fn degenerate_fits_and_points_that_cannot_inform_are_never_a_success() {
 fn structure_files_that_would_overflow_run_forever_or_answer_zero_are_refused() {
     let dir = TempDir::new("structures");
     let (frf, _) = quick_campaign_and_trim_points(&dir);
-    let six_dof = include_str!("../../sysid/models/bo105-6dof.toml");
+    let six_dof = include_str!("../../../sysid/models/bo105-6dof.toml");
     let nested = format!("{}Yv{}", "(".repeat(20_000), ")".repeat(20_000));
     let many_states: Vec<String> = (0..1_000).map(|i| format!("\"x{i}\"")).collect();
     let cases = [

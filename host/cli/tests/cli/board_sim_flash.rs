@@ -3,10 +3,12 @@
 //! and flies the aircraft through its real servo geometry (fbl700: 140° plate, servo 2
 //! reversed, 760 µs tail servo).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use serde_json::Value;
+
+use crate::support;
 
 const FBL700: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -41,27 +43,15 @@ fn refused(args: &[&str]) -> String {
     stderr
 }
 
-struct Scratch(PathBuf);
+struct Scratch(support::Scratch);
 
 impl Scratch {
     fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!(
-            "sweephold-board-sim-flash-{name}-{}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
+        Scratch(support::Scratch::new(&format!("board-sim-flash-{name}")))
     }
 
     fn path(&self, name: &str) -> String {
         self.0.join(name).to_str().unwrap().to_string()
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
 

@@ -3,20 +3,16 @@
 //! or `.tmp` is left, the exit status is non-zero. The run is stopped at an exact place
 //! by the documented test hook `SWEEPHOLD_TEST_PAUSE_AT` (see `sweephold::interrupt`).
 
-#![cfg(unix)]
-
 use std::path::{Path, PathBuf};
 
 use nix::sys::signal::Signal;
 
-mod support;
-use support::signals::{interrupted_by, run_ok, snapshot};
+use crate::support::signals::{interrupted_by, run_ok, snapshot};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-signals-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+use crate::support::Scratch;
+
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("signals-{name}"))
 }
 
 /// Run `args` paused at `point`, send `signal` there; the exit code and stderr.

@@ -4,28 +4,18 @@
 //! vary what `Nr` multiplies") now run again with those parameters held and give a model
 //! inside the physical ranges; where that fails, one line names the worst parameters.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use sysid::fit::plausible::implausible_parameters;
 
-struct TempDir(PathBuf);
+use crate::support::Scratch;
+
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!(
-            "sweephold-degenerate-{name}-{}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
+        TempDir(Scratch::new(&format!("degenerate-{name}")))
     }
 }
 

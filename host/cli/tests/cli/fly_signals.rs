@@ -10,23 +10,16 @@
 //! its next safe point (exit 1, its files kept as `OUT.failed`); a second one, sent while
 //! the run is held at the point (`POINT!`), ends it at once (exit 130, nothing kept).
 
-#![cfg(unix)]
-
 use std::path::{Path, PathBuf};
 
 use nix::sys::signal::Signal;
 
-mod support;
-use support::signals::{interrupted_by, run_ok, snapshot};
+use crate::support::signals::{interrupted_by, run_ok, snapshot};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "sweephold-fly-signals-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.canonicalize().unwrap()
+use crate::support::Scratch;
+
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("fly-signals-{name}"))
 }
 
 /// The `fly` command line on `fc` with `seed` into `o`.

@@ -8,6 +8,8 @@ use std::process::{Command, Output};
 
 use sysid::document::{FrfDocument, PairResponse};
 
+use crate::support::Scratch;
+
 const TWO_INPUT_CSV: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../sysid/tests/data/two_input.csv"
@@ -24,22 +26,14 @@ fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
-struct TempDir(PathBuf);
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("sweephold-frf-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        TempDir(Scratch::new(&format!("frf-{name}")))
     }
     fn path(&self, name: &str) -> PathBuf {
         self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
     }
 }
 

@@ -10,6 +10,8 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
+use crate::support::Scratch;
+
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
         .args(args)
@@ -17,14 +19,8 @@ fn sweephold(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "sweephold-board-sim-air-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    let _ = std::fs::remove_dir_all(dir.with_extension("failed"));
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::unmade(&format!("board-sim-air-{name}"))
 }
 
 /// The shipped Bo-105 with the collective the pilot's during a test (the file of the

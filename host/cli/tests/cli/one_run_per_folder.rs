@@ -3,11 +3,11 @@
 //! result is whole (every file from its seed). A lock file left by a killed run does
 //! not block the next one.
 
-#![cfg(unix)]
-
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
+
+use crate::support::Scratch;
 
 fn command(dir: &Path, args: &[&str]) -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_sweephold"));
@@ -27,11 +27,8 @@ fn start(dir: &Path, args: &[&str]) -> Child {
         .expect("the binary starts")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-lock-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("lock-{name}"))
 }
 
 /// Wait until `path` exists (the first run holds its lock), at most 60 s.

@@ -7,6 +7,8 @@ use std::process::{Command, Output};
 
 use sysid::document::FrfDocument;
 
+use crate::support::Scratch;
+
 fn fixture(name: &str) -> String {
     format!(
         "{}/../sysid/tests/fixtures/logs/{name}",
@@ -25,23 +27,14 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-struct TempDir(PathBuf);
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("sweephold-logs-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        TempDir(Scratch::new(&format!("logs-{name}")))
     }
     fn path(&self, name: &str) -> PathBuf {
         self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
 

@@ -11,26 +11,18 @@ use sysid::document::FrfDocument;
 use sysid::fit::synthetic::{exact_frf_document, SyntheticGrid};
 use sysid::fit::PairBand;
 
-struct TempDir(PathBuf);
+use crate::support::Scratch;
+
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("sweephold-issue19-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        TempDir(Scratch::new(&format!("issue19-{name}")))
     }
     fn file(&self, name: &str, bytes: &[u8]) -> PathBuf {
         let path = self.0.join(name);
         std::fs::write(&path, bytes).unwrap();
         path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
     }
 }
 

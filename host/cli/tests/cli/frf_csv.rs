@@ -9,11 +9,13 @@ use std::process::{Command, Output};
 
 use sysid::document::{FrfDocument, PairResponse};
 
+use crate::support::Scratch;
+
 const X8ROLL: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../sysid/tests/data/x8roll.csv"
 );
-const SCIPY_H1: &str = include_str!("../../sysid/tests/data/x8roll_scipy_h1.json");
+const SCIPY_H1: &str = include_str!("../../../sysid/tests/data/x8roll_scipy_h1.json");
 
 /// The documented way to read x8roll.csv: columns by position (with [`DEG_PER_S`], the
 /// gyro's unit).
@@ -43,23 +45,14 @@ fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
-struct TempDir(PathBuf);
+struct TempDir(Scratch);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("sweephold-frfcsv-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
+        TempDir(Scratch::new(&format!("frfcsv-{name}")))
     }
     fn path(&self, name: &str) -> PathBuf {
         self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.0).ok();
     }
 }
 

@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use crate::support::Scratch;
+
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
         .args(args)
@@ -20,14 +22,8 @@ fn ok(args: &[&str]) -> (String, String) {
     (String::from_utf8_lossy(&output.stdout).to_string(), stderr)
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "sweephold-board-logs-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("board-logs-{name}"))
 }
 
 /// `fly --fc board-sim --seed 1 -q --out DIR` plus `args`.

@@ -3,11 +3,11 @@
 //! panic (exit 101) and never exit 0; `--help` and `--version` too. A reader that went
 //! away (`| head`) is not a failure.
 
-#![cfg(target_os = "linux")]
-
 use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
+
+use crate::support::Scratch;
 
 fn sweephold(dir: &Path, args: &[&str], stdout: Stdio) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
@@ -18,11 +18,8 @@ fn sweephold(dir: &Path, args: &[&str], stdout: Stdio) -> Output {
         .expect("the binary runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-stdout-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("stdout-{name}"))
 }
 
 fn full() -> Stdio {

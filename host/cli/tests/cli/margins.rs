@@ -4,6 +4,8 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+use crate::support::Scratch;
+
 fn sweephold(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
         .args(args)
@@ -15,17 +17,12 @@ fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../control/tests/fixtures/{name}"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-margins-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
 #[test]
 fn margins_writes_the_table_and_the_same_json_twice() {
     let model = fixture("trex700l-quick-seed1-model9.json");
     let before = std::fs::read(&model).unwrap();
-    let (a, b) = (scratch("a.json"), scratch("b.json"));
+    let dir = Scratch::new("margins-twice");
+    let (a, b) = (dir.join("a.json"), dir.join("b.json"));
     for out in [&a, &b] {
         let output = sweephold(&[
             "margins",
@@ -61,7 +58,8 @@ fn margins_writes_the_table_and_the_same_json_twice() {
 
 #[test]
 fn bad_inputs_end_in_one_error_line() {
-    let not_json = scratch("not-a-model.json");
+    let dir = Scratch::new("margins-bad");
+    let not_json = dir.join("not-a-model.json");
     std::fs::write(&not_json, "{\"version\": 1}").unwrap();
     let model = fixture("bo105-quick-seed1-model9.json");
     let cases: Vec<Vec<String>> = vec![

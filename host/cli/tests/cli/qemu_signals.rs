@@ -4,20 +4,15 @@
 //! `qemu-system-arm` or a board image (`cargo fw`, or `SWEEPHOLD_FC_ELF`); with
 //! `SWEEPHOLD_REQUIRE_QEMU` set (CI) a skip is a failure.
 
-#![cfg(target_os = "linux")]
-
-// Each test binary uses part of the shared support.
-#[allow(dead_code)]
-mod support;
-
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::support::signals::{run_ok, snapshot};
+use crate::support::Scratch;
 use nix::sys::signal::{kill, Signal};
 use nix::unistd::Pid;
-use support::signals::{run_ok, snapshot};
 use sweephold::fly::link_qemu;
 
 /// The board image, or `None` (after saying why) when QEMU or the image is missing.
@@ -107,9 +102,7 @@ fn qemu_processes_end_with_an_interrupted_fly_and_the_earlier_result_stays() {
     let Some(image) = image_or_skip() else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("sweephold-qemu-signals-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("qemu-signals");
     // The earlier result (flown in-process: quicker, and any earlier run will do).
     run_ok(
         &dir,

@@ -9,8 +9,6 @@
 //! status 1 or 2, an end within 60 s, and no input file changed (checked over the whole
 //! battery). The count of cases and of exit statuses is printed (`--nocapture`).
 
-#![cfg(unix)]
-
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -18,11 +16,10 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-battery-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+use crate::support::Scratch;
+
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("battery-{name}"))
 }
 
 /// The bytes of every file below `dir`, by path.

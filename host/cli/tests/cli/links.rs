@@ -3,11 +3,11 @@
 //! `frf --plots`, `report DIR`'s report.html) as for paths on the command line. A link
 //! inside an output folder that leads elsewhere is replaced, its target left alone.
 
-#![cfg(unix)]
-
 use std::os::unix::fs::symlink;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
+
+use crate::support::Scratch;
 
 fn sweephold(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sweephold"))
@@ -17,11 +17,8 @@ fn sweephold(dir: &Path, args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sweephold-links-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("links-{name}"))
 }
 
 /// A quick campaign in `dir/c`.

@@ -1,3 +1,0 @@
-//! What more than one CLI test binary needs.
-
-pub mod signals;
