@@ -29,6 +29,7 @@ mod fly_signals;
 mod frf_csv;
 mod frf_dump_origin;
 mod frf_inputs;
+mod identify;
 mod inputs;
 #[cfg(unix)]
 mod links;
@@ -43,4 +44,5 @@ mod stderr_full;
 #[cfg(target_os = "linux")]
 mod stdout;
 mod structures_ticks;
+mod test_list;
 mod trim_points;
