@@ -73,6 +73,34 @@ pub fn selection(list: &TestList, single: &TestConfig, record: &TestConfig) -> O
         .map(|k| (k, -1.0 + (2.0 * f32::from(k) - 1.0) / f32::from(n)))
 }
 
+/// The stored set with the record's test and rate: what the campaign chooses per record
+/// (the test then moves into the campaign's test list, chosen by the selector).
+pub(super) fn stored_with_record(
+    params: &sweephold_firmware::params::Params,
+    config: &sweephold_firmware::Config,
+) -> anyhow::Result<sweephold_firmware::board_stack::StackConfig> {
+    let mut stack = params.stack;
+    let flight = &mut stack.app.flight;
+    flight.rate_hz = config.rate_hz;
+    let (mine, record) = (&mut flight.test, &config.test);
+    mine.primary = record.primary;
+    mine.input = record.input;
+    mine.mode = record.mode;
+    mine.seed = record.seed;
+    mine.sweep.omega_min = record.sweep.omega_min;
+    mine.sweep.omega_max = record.sweep.omega_max;
+    mine.sweep.t_rec_s = record.sweep.t_rec_s;
+    mine.sweep.amplitude = record.sweep.amplitude;
+    mine.pulse.amplitude = record.pulse.amplitude;
+    flight.test.warnings = flight.validate().map_err(|e| {
+        anyhow::anyhow!(
+            "the board's stored set refuses this record's test: {}",
+            e.message()
+        )
+    })?;
+    Ok(stack)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

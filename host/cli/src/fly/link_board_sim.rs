@@ -316,7 +316,7 @@ impl BoardSimLink {
                 )
             }
             BoardSetup::Stored(params) => (
-                stored_with_record(params, config)?,
+                board_test_list::stored_with_record(params, config)?,
                 [params.swash_frame_hz, params.tail_frame_hz],
             ),
         };
@@ -578,32 +578,4 @@ impl FlightControllerLink for BoardSimLink {
             .and_then(|board| board.last)
             .map(|out| out.mode.name())
     }
-}
-
-/// The stored set with the record's test and rate: what the campaign chooses per record
-/// (the test then moves into the campaign's test list, chosen by the selector).
-fn stored_with_record(
-    params: &sweephold_firmware::params::Params,
-    config: &Config,
-) -> anyhow::Result<StackConfig> {
-    let mut stack = params.stack;
-    let flight = &mut stack.app.flight;
-    flight.rate_hz = config.rate_hz;
-    let (mine, record) = (&mut flight.test, &config.test);
-    mine.primary = record.primary;
-    mine.input = record.input;
-    mine.mode = record.mode;
-    mine.seed = record.seed;
-    mine.sweep.omega_min = record.sweep.omega_min;
-    mine.sweep.omega_max = record.sweep.omega_max;
-    mine.sweep.t_rec_s = record.sweep.t_rec_s;
-    mine.sweep.amplitude = record.sweep.amplitude;
-    mine.pulse.amplitude = record.pulse.amplitude;
-    flight.test.warnings = flight.validate().map_err(|e| {
-        anyhow::anyhow!(
-            "the board's stored set refuses this record's test: {}",
-            e.message()
-        )
-    })?;
-    Ok(stack)
 }
