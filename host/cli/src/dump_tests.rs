@@ -24,56 +24,14 @@ pub struct DumpSweeps {
 /// error, and so is a dump none of whose tests is used (the first test's reason: its
 /// record's error when it has one, else why it was left out).
 pub fn sweep_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpSweeps> {
-    let (tests, _) = load_dump_tests(path, Excitation::Sweep)?;
-    let file = path.display().to_string();
-    let mut used = Vec::new();
-    let mut lines = Vec::new();
-    let mut refusal: Option<String> = None;
-    for TestRecord { test, record } in tests {
-        let end = test.end();
-        let is_sweep = test.header.test.input.is_sweep();
-        let verdict = match (end, record) {
-            (TestEnd::NotStarted, record) => {
-                if let Err(error) = record {
-                    refusal.get_or_insert(error.to_string());
-                }
-                "left out: no excitation".to_string()
-            }
-            (_, Err(error)) if !is_sweep => {
-                refusal.get_or_insert(error.to_string());
-                "left out: not a sweep".to_string()
-            }
-            (TestEnd::Aborted | TestEnd::Partial, record) if !include_aborted => {
-                // A record that cannot be read says more than its test's end.
-                let why = match record {
-                    Err(error) => error.to_string(),
-                    Ok(_) => format!(
-                        "{file}: test {} {}: left out (--include-aborted uses it)",
-                        test.number,
-                        end.name()
-                    ),
-                };
-                refusal.get_or_insert(why);
-                "left out (--include-aborted uses it)".to_string()
-            }
-            (_, Err(error)) => return Err(anyhow!("{error}")),
-            (_, Ok(record)) => {
-                let origin = DumpOrigin::of(&record.source, &test.header);
-                used.push((record, origin));
-                "used".to_string()
-            }
-        };
-        lines.push(format!("{file}: {}: {verdict}", test.describe()));
-    }
-    if used.is_empty() {
-        return Err(anyhow!(
-            "{}",
-            refusal.unwrap_or_else(|| format!("{file}: no test with a sweep"))
-        ));
-    }
+    let tests = chosen_tests(path, Excitation::Sweep, include_aborted, include_aborted)?;
     Ok(DumpSweeps {
-        records: used,
-        lines,
+        lines: tests.listing.iter().map(TestListing::line).collect(),
+        records: tests
+            .used
+            .into_iter()
+            .map(|test| (test.record, test.origin))
+            .collect(),
     })
 }
 
@@ -121,13 +79,25 @@ pub fn excitation_records(
     include_aborted: bool,
     include_partial: bool,
 ) -> anyhow::Result<DumpTests> {
-    let (tests, _) = load_dump_tests(path, Excitation::Any)?;
+    chosen_tests(path, Excitation::Any, include_aborted, include_partial)
+}
+
+/// The tests of the dump `path` whose records of `excitation` are used, and every test
+/// with what became of it (the rules of [`sweep_records`] and [`excitation_records`]).
+fn chosen_tests(
+    path: &Path,
+    excitation: Excitation,
+    include_aborted: bool,
+    include_partial: bool,
+) -> anyhow::Result<DumpTests> {
+    let (tests, _) = load_dump_tests(path, excitation)?;
     let file = path.display().to_string();
     let mut used = Vec::new();
     let mut listing = Vec::new();
     let mut refusal: Option<String> = None;
     for TestRecord { test, record } in tests {
         let end = test.end();
+        let is_sweep = test.header.test.input.is_sweep();
         let verdict = match (end, record) {
             (TestEnd::NotStarted, record) => {
                 if let Err(error) = record {
@@ -135,9 +105,14 @@ pub fn excitation_records(
                 }
                 "left out: no excitation".to_string()
             }
+            (_, Err(error)) if excitation == Excitation::Sweep && !is_sweep => {
+                refusal.get_or_insert(error.to_string());
+                "left out: not a sweep".to_string()
+            }
             (TestEnd::Aborted | TestEnd::Partial, record)
                 if !include_aborted && (end == TestEnd::Aborted || !include_partial) =>
             {
+                // A record that cannot be read says more than its test's end.
                 let why = match record {
                     Err(error) => error.to_string(),
                     Ok(_) => format!(
@@ -156,7 +131,7 @@ pub fn excitation_records(
                     number: test.number,
                     record,
                     origin,
-                    is_sweep: test.header.test.input.is_sweep(),
+                    is_sweep,
                 });
                 "used".to_string()
             }
@@ -168,9 +143,13 @@ pub fn excitation_records(
         });
     }
     if used.is_empty() {
+        let what = match excitation {
+            Excitation::Sweep => "a sweep",
+            Excitation::Any => "an excitation",
+        };
         return Err(anyhow!(
             "{}",
-            refusal.unwrap_or_else(|| format!("{file}: no test with an excitation"))
+            refusal.unwrap_or_else(|| format!("{file}: no test with {what}"))
         ));
     }
     Ok(DumpTests { used, listing })
