@@ -7,7 +7,7 @@
 //! `std::vec::Vec<u8>`. The host loop implements the trait for its own types.
 
 use sweephold_protocol::codec::EncodeError;
-use sweephold_protocol::{encode, Frame, MAX_FRAME_LEN};
+use sweephold_protocol::{encode, Controls, Frame, MAX_FRAME_LEN};
 
 /// Receiver of encoded frames.
 pub trait FrameSink {
@@ -26,6 +26,14 @@ pub trait FrameSink {
         self.write_frame(buffer.get(..length).unwrap_or(&[]));
         Ok(())
     }
+
+    /// The command a Sample logs for the tick's `command`. The default logs it as it is;
+    /// the board application's tap logs what its servo pulses express
+    /// ([`crate::mixer::PulseInverse`]): the rotor flies the pulses, not the unrounded
+    /// command.
+    fn logged_command(&self, command: &Controls) -> Controls {
+        *command
+    }
 }
 
 impl<S: FrameSink + ?Sized> FrameSink for &mut S {
@@ -35,6 +43,10 @@ impl<S: FrameSink + ?Sized> FrameSink for &mut S {
 
     fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {
         (**self).send_frame(frame)
+    }
+
+    fn logged_command(&self, command: &Controls) -> Controls {
+        (**self).logged_command(command)
     }
 }
 

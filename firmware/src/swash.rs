@@ -221,6 +221,50 @@ impl SwashGeometry {
     }
 }
 
+impl SwashGeometry {
+    /// The inverse of [`heights`](Self::heights) at unit cyclic scale: the cyclic heights
+    /// (lat', lon') and the collective height that give the three outputs `heights`, or
+    /// `None` for a plate whose outputs do not determine them (never for a geometry
+    /// [`new`](Self::new) accepts).
+    ///
+    /// A CCPM plate's outputs are `hᵢ = C + lon'·cᵢ − lat'·sᵢ` ((cᵢ, sᵢ) its factors): three
+    /// equations in (C, lon', lat'), solved by Cramer's rule. With the outputs at
+    /// azimuths 0, ±A (less the phase, which turns all three alike) the determinant's
+    /// magnitude is `4·sin A·sin²(A/2)`: 2.60 at 120°, 2.41 at 135°, 2.27 at 140°. An H1
+    /// head's outputs are lat', lon' turned by the phase angle, and C: turned back.
+    pub fn unmix(&self, heights: [f32; 3]) -> Option<(f32, f32, f32)> {
+        match self.kind {
+            SwashType::H1 => {
+                let (c, s) = self.turn;
+                let [lat_turned, lon_turned, collective] = heights;
+                Some((
+                    lat_turned * c + lon_turned * s,
+                    lon_turned * c - lat_turned * s,
+                    collective,
+                ))
+            }
+            SwashType::H3_120 | SwashType::H3_135 | SwashType::H3_140 => {
+                // Rows (1, cᵢ, −sᵢ) · (C, lon', lat') = hᵢ.
+                let [(c1, s1), (c2, s2), (c3, s3)] = self.factors;
+                let det3 = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
+                    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                        + a[2] * (b[0] * c[1] - b[1] * c[0])
+                };
+                let columns = [[1.0, 1.0, 1.0], [c1, c2, c3], [-s1, -s2, -s3]];
+                let det = det3(columns[0], columns[1], columns[2]);
+                // A NaN determinant (a corrupt geometry) is refused too.
+                if det.abs() <= 1e-3 || det.is_nan() {
+                    return None;
+                }
+                let collective = det3(heights, columns[1], columns[2]) / det;
+                let lon = det3(columns[0], heights, columns[2]) / det;
+                let lat = det3(columns[0], columns[1], heights) / det;
+                Some((lat, lon, collective))
+            }
+        }
+    }
+}
+
 /// The cyclic command limited to the ring of radius `ring`: (lat, lon) unchanged when
 /// inside, otherwise scaled onto the ring. A ring that is not positive and finite
 /// leaves the command unchanged (the configuration check refuses it).

@@ -199,3 +199,30 @@ fn the_ring_limits_the_cyclic_vector_and_keeps_its_direction() {
     // The default ring, 1.5, never touches commands within ±1.
     assert_eq!(limit_to_ring(-1.0, 1.0, 1.5), (-1.0, 1.0));
 }
+
+/// `unmix` inverts `heights` on every plate, phase and lead servo.
+#[test]
+fn unmix_returns_the_cyclic_and_collective_heights() {
+    for kind in [
+        SwashType::H3_120,
+        SwashType::H3_135,
+        SwashType::H3_140,
+        SwashType::H1,
+    ] {
+        for phase_deg in [-30.0, 0.0, 12.5, 90.0] {
+            for lead in 1..=3 {
+                let geometry = SwashGeometry::new(kind, phase_deg, lead).unwrap();
+                for (lat, lon, collective) in [(0.3, -0.2, 0.1), (-0.45, 0.0, -0.25)] {
+                    let heights = geometry.heights(lat, lon, 1.0, collective);
+                    let (l, o, c) = geometry.unmix(heights).unwrap();
+                    let close = |a: f32, b: f32| (a - b).abs() < 1e-5;
+                    assert!(
+                        close(l, lat) && close(o, lon) && close(c, collective),
+                        "{kind:?} {phase_deg}° lead {lead}: {:?}",
+                        (l, o, c)
+                    );
+                }
+            }
+        }
+    }
+}

@@ -75,7 +75,7 @@ use sweephold_protocol::{
 use crate::attitude_hold::clamp_finite;
 use crate::config::{Config, ConfigError};
 use crate::controller::FlightController;
-use crate::mixer::mix;
+use crate::mixer::{mix, PulseInverse};
 use crate::sink::FrameSink;
 use crate::trim::Trim;
 
@@ -288,6 +288,9 @@ pub struct BoardApp {
     measurement_filter: Option<MeasurementFilter>,
     /// Tests engaged since power-up (the Header's engagement number).
     engagements: u16,
+    /// The mixer turned around: the command each tick's pulses express, which its Sample
+    /// logs.
+    pulse_inverse: PulseInverse,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -339,6 +342,7 @@ impl BoardApp {
             params_valid: true,
             measurement_filter: None,
             engagements: 0,
+            pulse_inverse: PulseInverse::new(&config.flight.mixer),
             fc,
             config,
         })
@@ -418,6 +422,7 @@ impl BoardApp {
             inner: sink,
             reason: None,
             measurement_filter: None,
+            outputs: None,
         };
         // The tick this step's Sample and Events carry.
         let tick = self.fc.tick();
@@ -517,6 +522,7 @@ impl BoardApp {
         );
         // Only the sequencer's step sends Headers.
         sink.measurement_filter = self.measurement_filter.as_ref();
+        sink.outputs = Some((&self.config.flight.mixer, &self.pulse_inverse));
         let out = self.fc.step(&sensor, &mut sink);
         let reported_mode = self.mode;
         let command = if self.mode == Mode::Test {

@@ -10,7 +10,7 @@
 
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{
-    AbortReason, Event, FlightMode, Frame, ImuHealth, MeasurementFilter, ProtocolVersion,
+    AbortReason, Controls, Event, FlightMode, Frame, ImuHealth, MeasurementFilter, ProtocolVersion,
     RefusedCheck, Request,
 };
 
@@ -18,6 +18,7 @@ use super::arming::{CheckFailure, Refusal};
 use super::failsafe::ImuProblem;
 use super::inputs::ImuFaultKind;
 use super::modes::Mode;
+use crate::mixer::{mix, MixerConfig, PulseInverse};
 use crate::sink::FrameSink;
 
 /// The application's mode as it goes on the wire.
@@ -131,7 +132,9 @@ impl Reporter {
 
 /// Passes the sequencer's frames on: notes the reason of an Abort Event among them,
 /// raises each Header's protocol version to the board application's and follows it with
-/// the measurement filter.
+/// the measurement filter, and has the Samples log the command as the servo pulses
+/// express it ([`FrameSink::logged_command`]; the rotor flies the pulses, not the
+/// unrounded command).
 pub struct BoardTap<'a, S: FrameSink> {
     /// Where the frames go.
     pub inner: &'a mut S,
@@ -139,11 +142,20 @@ pub struct BoardTap<'a, S: FrameSink> {
     pub reason: Option<AbortReason>,
     /// Sent after each Header, when there is one.
     pub measurement_filter: Option<&'a MeasurementFilter>,
+    /// The mixer and its inverse the logged commands go through, when there is one.
+    pub outputs: Option<(&'a MixerConfig, &'a PulseInverse)>,
 }
 
 impl<S: FrameSink> FrameSink for BoardTap<'_, S> {
     fn write_frame(&mut self, bytes: &[u8]) {
         self.inner.write_frame(bytes);
+    }
+
+    fn logged_command(&self, command: &Controls) -> Controls {
+        match self.outputs {
+            Some((mixer, inverse)) => inverse.command(mix(mixer, command), command),
+            None => *command,
+        }
     }
 
     fn send_frame(&mut self, frame: &Frame) -> Result<(), EncodeError> {

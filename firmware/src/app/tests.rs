@@ -9,6 +9,7 @@ use super::failsafe::{FailsafeSettings, RcLossHold};
 use super::modes::{next, Conditions, Transition};
 use super::pilot_mode::{Drive, LoopFactors, RateAxisGains, RateLoop};
 use super::*;
+use crate::mixer::expressed;
 use proptest::prelude::*;
 use sweephold_protocol::{AbortReason, Decoder, Event, Frame};
 
@@ -82,8 +83,9 @@ impl Rig {
             panic!("the last frame of a tick must be its Sample");
         };
         assert_eq!(
-            sample.command, out.command,
-            "the Sample logs the command sent"
+            sample.command,
+            expressed(&self.app.config().flight.mixer, &out.command),
+            "the Sample logs the command the servos' pulses express"
         );
         assert_eq!(sample.phase, out.phase);
         assert_eq!(

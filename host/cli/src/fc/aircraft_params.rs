@@ -11,11 +11,15 @@
 //! slew and the test's collective source (`TEST_COL_SRC`: the board's table defaults to
 //! `pilot`, an aircraft file that states no `collective` has its preset's `trim`, so
 //! that a board set up from a file flies as `--fc board-sim` flies that file) — each the
-//! file's value or, where the file states none, its preset's. Not pushed: the board's installation (receiver map and ranges, IMU mounting), the head and
-//! tail rotor speeds of the notches (the presets' filter bank, as `fly` flies it), the
-//! airborne rule (`AIR_COL_MIN`, `AIR_TIME`: the pilot's collective habits) and the test
-//! (chosen per record).
+//! file's value or, where the file states none, its preset's — and the head and tail
+//! rotor speeds that place the vibration notches (`HEAD_RPM`, `TAIL_RPM`), from the
+//! file's `main_rotor.head_speed` and `tail_rotor` speed when both lie in the table's
+//! ranges ([`servo_plant::board_rotor_rpm`]; a full-size rotor such as the Bo-105's 424 rpm does not, and
+//! keeps its preset's notches). Not pushed: the board's installation (receiver map and
+//! ranges, IMU mounting), the airborne rule (`AIR_COL_MIN`, `AIR_TIME`: the pilot's
+//! collective habits) and the test (chosen per record).
 
+use sweephold_firmware::filters::FilterBankConfig;
 use sweephold_firmware::params::{typed, ParamId, ParamTable, Params};
 use sweephold_protocol::Axis;
 
@@ -24,11 +28,9 @@ use crate::fly::servo_plant;
 use crate::vehicle::Vehicle;
 
 /// The parameters an aircraft file does not set.
-const NOT_FROM_THE_AIRCRAFT: [&str; 9] = [
+const NOT_FROM_THE_AIRCRAFT: [&str; 7] = [
     "RC_",
     "IMU_ROT",
-    "HEAD_RPM",
-    "TAIL_RPM",
     "TEST_",
     "SWP_",
     "PULSE_AMP",
@@ -37,7 +39,10 @@ const NOT_FROM_THE_AIRCRAFT: [&str; 9] = [
 ];
 
 /// Whether `id` is one the aircraft file determines.
-fn from_the_aircraft(id: ParamId) -> bool {
+fn from_the_aircraft(id: ParamId, vehicle: &Vehicle) -> bool {
+    if matches!(id, ParamId::HeadRpm | ParamId::TailRpm) {
+        return servo_plant::board_rotor_rpm(vehicle.aircraft()).is_some();
+    }
     if id == ParamId::TestColSrc {
         // A `TEST_` parameter, but the flight logic's, not the test's.
         return true;
@@ -56,6 +61,10 @@ pub fn params(vehicle: &Vehicle) -> anyhow::Result<Params> {
     let mut params = Params::preset(flight.vehicle);
     params.stack.app.flight = flight;
     [params.swash_frame_hz, params.tail_frame_hz] = servo_plant::board_frame_rates(swash);
+    if let Some([head, tail]) = servo_plant::board_rotor_rpm(vehicle.aircraft()) {
+        let filters = &mut params.stack.filters;
+        *filters = FilterBankConfig::helicopter(filters.sample_rate_hz, head / 60.0, tail / 60.0);
+    }
     // The table's own check: every value in range and the set consistent.
     let values = typed::values_of(&params);
     let table = ParamTable::from_values(values).map_err(|(id, error)| {
@@ -81,7 +90,7 @@ pub fn values(vehicle: &Vehicle) -> anyhow::Result<Vec<BoardValue>> {
     let values = typed::values_of(&params(vehicle)?);
     Ok(ParamId::ALL
         .iter()
-        .filter(|id| from_the_aircraft(**id))
+        .filter(|id| from_the_aircraft(**id, vehicle))
         .map(|id| BoardValue {
             name: id.def().name.to_string(),
             value: values[id.index()],
@@ -168,10 +177,11 @@ mod tests {
             [get("HOLD_LAT_P"), get("HOLD_LON_D"), get("HOLD_PED_I")],
             [2.12, 0.22, 0.045]
         );
+        // 1800 rpm, the tail 4.5 times as fast: 30, 60 and 135 Hz notches.
+        assert_eq!([get("HEAD_RPM"), get("TAIL_RPM")], [1800.0, 8100.0]);
         for name in [
             "RC_LAT",
             "IMU_ROT",
-            "HEAD_RPM",
             "TEST_AXIS",
             "SWP_AMP",
             "NOISE_RMS",
@@ -185,7 +195,24 @@ mod tests {
         let mut expected = vehicle.firmware_config(Axis::Lat);
         expected.mixer = servo_plant::board_mixer(&vehicle.aircraft().swash);
         assert_eq!(params.stack.app.flight, expected);
+        let notches = params.stack.filters.notches.map(|n| n.map(|n| n.centre_hz));
+        assert_eq!(notches, [Some(30.0), Some(60.0), Some(135.0)]);
         assert_eq!(get("TEST_COL_SRC"), 0.0, "the preset's trim collective");
+    }
+
+    #[test]
+    fn a_full_size_rotor_keeps_the_presets_notches_and_a_model_s_gets_its_own() {
+        // The Bo-105 turns at 424 rpm, below HEAD_RPM's range.
+        let bo105 = Vehicle::shipped("bo105");
+        assert_eq!(servo_plant::board_rotor_rpm(bo105.aircraft()), None);
+        assert!(values(&bo105)
+            .unwrap()
+            .iter()
+            .all(|v| !v.name.ends_with("_RPM")));
+        // The TREX 700L file says 1900 rpm and 8930 rpm, not the firmware preset's 2100.
+        let trex = Vehicle::shipped("trex700l");
+        let [head, tail] = servo_plant::board_rotor_rpm(trex.aircraft()).unwrap();
+        assert!((head - 1900.0).abs() < 0.01 && (tail - 8930.0).abs() < 0.05);
     }
 
     #[test]

@@ -25,8 +25,8 @@
 //!
 //! With `--fc board-sim` the board is set up from the aircraft file in memory: the
 //! record's configuration (the preset with the file's `[flight_controller]` settings),
-//! its mixer and servo frame rates those of the file's `[swash]` table, as `fc params
-//! push` would set them, and the file's campaign as its test list on a selector channel
+//! its mixer and servo frame rates those of the file's `[swash]` table and its vibration
+//! notches at the file's rotor speeds, as `fc params push` would set them, and the file's campaign as its test list on a selector channel
 //! ([`super::board_test_list`]). A record whose test is an entry of the list is chosen
 //! in the air: the simulated transmitter's selector sits at that entry's slice when the
 //! test switch engages, and the board's own single test stays the preset's (the
@@ -66,7 +66,8 @@
 //!    or with `--vibration none` its white noise alone: an ideal chip's output at rest
 //!    is constant, which the IMU monitor rightly takes for a hung chip (stuck after
 //!    20 identical reads), so the board would never arm;
-//! 2. rotor running (the emulator's rotor vibration lines from now on, unless `none`):
+//! 2. rotor running (the emulator's rotor vibration lines, at the aircraft's 1/rev,
+//!    2/rev and tail rotor frequencies, from now on, unless `none`):
 //!    arm switch on with the throttle low, then throttle 0.8: the soft start (4 s);
 //! 3. lift-off: the IMU turns smoothly from level to the trim attitude in 2 s, the
 //!    Level sticks with it;
@@ -91,6 +92,7 @@ use rotorsim::{Helicopter, Sim, SimOptions, Trim};
 use sweephold_firmware::app::test_list::TestList;
 use sweephold_firmware::app::{AppConfig, Mode, TickOutput};
 use sweephold_firmware::board_stack::{BoardStack, BootState, StackConfig};
+use sweephold_firmware::filters::FilterBankConfig;
 use sweephold_firmware::imu::emulator::{Icm42688Emulator, Imperfections};
 use sweephold_firmware::imu::GRAVITY_M_S2;
 use sweephold_firmware::receiver::{ChannelMap, ChannelSource, ModeSwitch, RcInput};
@@ -135,6 +137,11 @@ pub struct BoardSimSettings {
     pub imu_fault: Option<ImuFaultPlan>,
     /// The aircraft's servo geometry: the board's pulses reach the rotor through it.
     pub swash: aircraft::Swash,
+    /// The aircraft's main and tail rotor speeds \[rpm\] when a board's notches can
+    /// follow them ([`servo_plant::board_rotor_rpm`]): the emulated IMU's rotor
+    /// lines, and the notches of a board set up from the file. `None` (a full-size
+    /// rotor): the board preset's 2100 rpm lines and notches.
+    pub rotor_rpm: Option<[f32; 2]>,
     /// The test list the board is set up with (`FromAircraft`): the aircraft's campaign.
     pub test_list: TestList,
     /// How the board is set up.
@@ -310,10 +317,15 @@ impl BoardSimLink {
                 let mut flight = *config;
                 flight.mixer = servo_plant::board_mixer(&settings.swash);
                 let app = AppConfig { flight, ..preset };
-                (
-                    StackConfig::with_app(app),
-                    servo_plant::board_frame_rates(&settings.swash),
-                )
+                let mut stack = StackConfig::with_app(app);
+                if let Some([head, tail]) = settings.rotor_rpm {
+                    stack.filters = FilterBankConfig::helicopter(
+                        stack.filters.sample_rate_hz,
+                        head / 60.0,
+                        tail / 60.0,
+                    );
+                }
+                (stack, servo_plant::board_frame_rates(&settings.swash))
             }
             BoardSetup::Stored(params) => (
                 board_test_list::stored_with_record(params, config)?,
@@ -350,6 +362,11 @@ impl BoardSimLink {
         map.selector = stack_config.channel_map.selector;
         let app = stack_config.app;
         let seed = 0xB0A2_D51A_u64 ^ u64::from(config.test.seed).rotate_left(23);
+        let rotor_lines = settings
+            .rotor_rpm
+            .map_or(Imperfections::TREX700L_ROTOR_RUNNING, |[head, tail]| {
+                Imperfections::rotor_running(head / 60.0, tail / 60.0)
+            });
         let (rotor_stopped, rotor_running) = if settings.vibration {
             (
                 Imperfections {
@@ -358,7 +375,7 @@ impl BoardSimLink {
                 },
                 Imperfections {
                     seed,
-                    ..Imperfections::TREX700L_ROTOR_RUNNING
+                    ..rotor_lines
                 },
             )
         } else {

@@ -221,3 +221,21 @@ pub fn board_frame_rates(swash: &Swash) -> [u16; 2] {
     let default = sweephold_firmware::params::typed::DEFAULT_FRAME_HZ;
     [swash.frame_rate, swash.tail_frame_rate].map(|rate| rate.map_or(default, |hz| hz as u16))
 }
+
+/// The main and tail rotor speeds \[rpm\] of `aircraft`, when both lie within the ranges
+/// of the board's `HEAD_RPM` and `TAIL_RPM`: the vibration notches a board set up for it
+/// gets (`sweephold fc params push`), and the rotor lines `--fc board-sim`'s emulated IMU
+/// senses. `None` for a full-size rotor (the Bo-105's 424 rpm).
+pub fn board_rotor_rpm(aircraft: &aircraft::Aircraft) -> Option<[f32; 2]> {
+    use sweephold_firmware::params::ParamId;
+    let rpm = |rad_s: f64| (rad_s * 60.0 / std::f64::consts::TAU) as f32;
+    let speeds = [
+        rpm(aircraft.main_rotor.head_speed.value),
+        rpm(aircraft.tail_rotor.speed.value),
+    ];
+    let within = |id: ParamId, value: f32| {
+        let def = id.def();
+        value.is_finite() && (def.min..=def.max).contains(&value)
+    };
+    (within(ParamId::HeadRpm, speeds[0]) && within(ParamId::TailRpm, speeds[1])).then_some(speeds)
+}

@@ -176,14 +176,16 @@ fn fit_and_verify_on_board_logs_leave_out_what_the_board_does_not_measure() {
     }
     ok(&frf_args.iter().map(String::as_str).collect::<Vec<_>>());
 
-    // The shipped 6-DOF structure fits without its u, v, w pairs, and says so.
+    // A shipped structure fits without its u, v, w pairs, and says so. (The 9-DOF
+    // hybrid: the 6-DOF structure's search on these responses stops in a degenerate
+    // minimum with some start budgets, which `fit` refuses — not what this test is about.)
     let model = dir.join("model.json");
     let fit = [
         "fit",
         "--frf",
         s(&frf),
         "--model",
-        "bo105-6dof",
+        "bo105-9dof-hybrid",
         "--max-starts",
         "2",
         "--out",

@@ -219,7 +219,13 @@ fn with_the_trim_collective_the_stick_does_not_reach_the_servos() {
         assert_eq!(run["aborted"], false, "{name}");
         let (before, after, _, _, phases) = around_the_step(&out.join(name));
         assert!(phases.iter().all(|p| p == "sweep"), "{name}: {phases:?}");
-        assert_eq!(before, after, "{name}: the trim collective");
+        // The log holds the collective the three swash pulses express: the lateral
+        // sweep's pulses round apart by up to half a µs each, 0.004 of collective at
+        // most (the plate's inverse); the step would be 0.05.
+        assert!(
+            (after - before).abs() < 0.004,
+            "{name}: the trim collective {before} → {after}"
+        );
     }
     let _ = std::fs::remove_dir_all(&out);
 }
