@@ -54,6 +54,7 @@
 //! entry's, so the first SensorIn does not send another).
 
 use embedded_hal::pwm::SetDutyCycle;
+use sweephold_firmware::app::cues::StatusLed;
 use sweephold_firmware::app::Mode as AppMode;
 use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_HZ};
 use sweephold_firmware::params::Params;
@@ -68,6 +69,7 @@ use crate::chip::clocks::{ClockSource, Clocks};
 use crate::chip::delay::BusyDelay;
 use crate::chip::devices::{self, Devices};
 use crate::chip::dividers;
+use crate::chip::gpio::GpioOutput;
 use crate::chip::imu_device::{self, ImuDevice};
 use crate::chip::logport;
 use crate::chip::nvic::{self, Irq};
@@ -164,6 +166,8 @@ pub struct Runner {
     params: HostParams,
     /// The clock tree (the servo timers' dividers).
     clocks: Clocks,
+    /// The status LED: the board application's pilot cue after every control tick.
+    led: Option<StatusLed<GpioOutput>>,
 }
 
 impl Runner {
@@ -218,6 +222,9 @@ impl Runner {
         // Infallible: the channels write compare registers.
         let _ = self.servos.apply(out.servo_us);
         let _ = self.esc.set_duty_cycle(out.esc_us);
+        if let Some(led) = &mut self.led {
+            led.show(self.stack.app().status_led());
+        }
         self.stats.steps = self.stats.steps.wrapping_add(1);
         if !out.mode.is_armed() {
             self.host_ignored_reported = false;
@@ -516,6 +523,7 @@ pub fn run() -> ! {
         watchdog,
         flash,
         tim5,
+        led,
     } = devices::bring_up(&BOARD);
     let clocks = boot.clocks;
 
@@ -580,6 +588,7 @@ pub fn run() -> ! {
         watchdog,
         params,
         clocks,
+        led,
     };
     runner.apply_frame_rates(&flown);
     runner.announce();
