@@ -7,13 +7,15 @@
 //!
 //! Its parts: [`client`] (the frames), [`params_file`] (the file format) and [`push`]
 //! (checking a file against the board, then writing it all or nothing). `fc watch`
-//! ([`watch`]) shows the board's telemetry live.
+//! ([`watch`]) shows the board's telemetry live; `fc servo` ([`servo`]) moves one servo
+//! on the bench.
 
 pub mod aircraft_params;
 pub mod board_sim;
 pub mod client;
 pub mod params_file;
 pub mod push;
+pub mod servo;
 pub mod watch;
 
 use std::path::{Path, PathBuf};
@@ -44,6 +46,36 @@ pub enum FcCommand {
     /// A live view of the board: mode, phase, test, attitude, rates, command, servo
     /// pulses and events, one line per update, until Ctrl-C (or --count / --seconds).
     Watch(WatchArgs),
+    /// Bench servo test: one servo to its centre, min, max or a pulse for --hold, while
+    /// disarmed; back to the disarmed output afterwards.
+    Servo(ServoArgs),
+}
+
+/// `sweephold fc servo`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "The board obeys only while disarmed and with a valid parameter set \
+saved; armed, the request is refused and nothing moves, and a test running when the board \
+arms ends at once. The pulse is clamped to the servo's own limits (SERVOn_MIN/MAX, \
+TAIL_MIN/MAX). The host repeats the request every 0.2 s with a 0.5 s hold: if it stops \
+asking (Ctrl-C, a pulled cable) the servo is back at the disarmed output within 0.5 s."
+)]
+pub struct ServoArgs {
+    /// The servo: 1, 2, 3 (swash servos) or 4 (tail).
+    #[arg(value_parser = clap::value_parser!(u8).range(1..=4))]
+    pub servo: u8,
+    /// Where to put it: centre, min, max, or a pulse such as 1600us.
+    #[arg(value_parser = servo::parse_target)]
+    pub target: sweephold_protocol::ServoTarget,
+    /// How long to hold it (2s, 500ms, 1.5).
+    #[arg(long, value_name = "DURATION", default_value = "2s", value_parser = servo::parse_duration)]
+    pub hold: std::time::Duration,
+    /// The flight controller: `qemu-usart` or `serial:PATH[@BAUD]` (as for `fc params`).
+    #[arg(long, value_name = "FC", value_parser = parse_fc)]
+    pub fc: Option<FcLink>,
+    /// Board image for `--fc qemu-usart` (as for `fc params`).
+    #[arg(long, value_name = "PATH")]
+    pub elf: Option<PathBuf>,
 }
 
 /// `sweephold fc watch`.
@@ -234,7 +266,26 @@ pub fn run(args: &FcArgs) -> anyhow::Result<()> {
     match &args.command {
         FcCommand::Params(params) => run_params(params),
         FcCommand::Watch(watch) => run_watch(watch),
+        FcCommand::Servo(args) => run_servo(args),
     }
+}
+
+fn run_servo(args: &ServoArgs) -> anyhow::Result<()> {
+    let Some(fc) = &args.fc else {
+        bail!("--fc is required (qemu-usart or serial:PATH[@BAUD])");
+    };
+    if let FcLink::BoardSim(_) = fc {
+        bail!("fc servo needs a board with servos: qemu-usart or serial:PATH");
+    }
+    let (client, _) = connect(fc, args.elf.as_deref())?;
+    let (mut channel, _) = client.into_channel();
+    let held = servo::hold_servo(&mut channel, args.servo, args.target, args.hold)?;
+    output::print(&format!(
+        "servo {} at {} us for {:.1} s, then back to the disarmed output\n",
+        args.servo,
+        held.pulse_us,
+        args.hold.as_secs_f64()
+    ))
 }
 
 fn run_watch(args: &WatchArgs) -> anyhow::Result<()> {
