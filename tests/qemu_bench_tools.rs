@@ -129,6 +129,17 @@ fn servo_replies(board: &Board, from: usize) -> Vec<ServoTestReply> {
         .collect()
 }
 
+/// Run `board` (on `rc`) until `count` servo test replies arrived from frame `from` on,
+/// at most 10 s (QEMU takes a host frame in slowly when the machine is loaded).
+fn run_for_replies(board: &mut Board, from: usize, count: usize, rc: Option<&RcInput>) {
+    for _ in 0..50 {
+        if servo_replies(board, from).len() >= count {
+            return;
+        }
+        board.run(0.2, rc);
+    }
+}
+
 /// A byte wire on the test board's link socket, for the host's own servo client.
 struct LinkWire<'a>(&'a mut std::net::TcpStream);
 
@@ -169,7 +180,7 @@ fn qemu_fc_servo_is_accepted_disarmed_and_times_out() {
         target: ServoTarget::PulseUs(1600),
         hold_ms: 500,
     }));
-    board.run(1.5, None);
+    run_for_replies(&mut board, from, 2, None);
     let after = &board.frames[from..];
     let moving = after
         .iter()
@@ -200,7 +211,7 @@ fn qemu_fc_servo_is_accepted_disarmed_and_times_out() {
         target: ServoTarget::PulseUs(2500),
         hold_ms: 100,
     }));
-    board.run(0.5, None);
+    run_for_replies(&mut board, from, 1, None);
     let defaults =
         sweephold_firmware::params::ParamTable::defaults(sweephold_protocol::VehicleId::Trex700l);
     let tail_max = defaults.get_by_name("TAIL_MAX").expect("TAIL_MAX") as u16;
@@ -231,7 +242,7 @@ fn qemu_fc_servo_is_accepted_disarmed_and_times_out() {
         target: ServoTarget::Centre,
         hold_ms: 100,
     }));
-    fresh.run(0.3, None);
+    run_for_replies(&mut fresh, 0, 1, None);
     assert_eq!(
         servo_replies(&fresh, 0)
             .iter()
@@ -279,11 +290,11 @@ fn qemu_fc_servo_is_refused_armed() {
     });
     let from = board.frames.len();
     board.send(&request);
-    board.run(0.3, Some(&rc));
+    run_for_replies(&mut board, from, 1, Some(&rc));
     rc.arm = true;
-    board.run(0.3, Some(&rc));
+    run_for_replies(&mut board, from, 2, Some(&rc));
     board.send(&request);
-    board.run(0.3, Some(&rc));
+    run_for_replies(&mut board, from, 3, Some(&rc));
     let statuses: Vec<ServoTestStatus> = servo_replies(&board, from)
         .iter()
         .map(|r| r.status)
@@ -300,7 +311,7 @@ fn qemu_fc_servo_is_refused_armed() {
     board.run(0.3, Some(&rc));
     let from = board.frames.len();
     board.send(&request);
-    board.run(0.3, Some(&rc));
+    run_for_replies(&mut board, from, 1, Some(&rc));
     assert_eq!(
         servo_replies(&board, from)
             .iter()

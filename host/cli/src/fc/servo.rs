@@ -148,3 +148,56 @@ pub fn hold_servo<W: ByteWire>(
     ask(channel, stop)?;
     Ok(held)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn targets_and_durations_parse() {
+        assert_eq!(parse_target("centre"), Ok(ServoTarget::Centre));
+        assert_eq!(parse_target("center"), Ok(ServoTarget::Centre));
+        assert_eq!(parse_target("min"), Ok(ServoTarget::Min));
+        assert_eq!(parse_target("max"), Ok(ServoTarget::Max));
+        assert_eq!(parse_target("1600us"), Ok(ServoTarget::PulseUs(1600)));
+        assert_eq!(parse_target("760"), Ok(ServoTarget::PulseUs(760)));
+        for bad in ["", "us", "-5us", "70000us", "mid", "1600 us"] {
+            assert!(parse_target(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_duration("2s"), Ok(Duration::from_secs(2)));
+        assert_eq!(parse_duration("500ms"), Ok(Duration::from_millis(500)));
+        assert_eq!(parse_duration("1.5"), Ok(Duration::from_millis(1500)));
+        for bad in ["", "s", "-1s", "NaNs", "inf", "2h"] {
+            assert!(parse_duration(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// A reply answers the request it names, never an earlier test's end.
+    #[test]
+    fn only_the_matching_reply_answers() {
+        let request = ServoTest {
+            servo: 2,
+            target: ServoTarget::Max,
+            hold_ms: 500,
+        };
+        let reply = |servo, status| ServoTestReply {
+            servo,
+            pulse_us: 0,
+            status,
+        };
+        assert!(answers(&reply(2, ServoTestStatus::Moving), &request));
+        assert!(!answers(&reply(1, ServoTestStatus::Moving), &request));
+        assert!(!answers(
+            &reply(2, ServoTestStatus::Ended(ServoTestEnd::TimedOut)),
+            &request
+        ));
+        let stop = ServoTest {
+            servo: 0,
+            ..request
+        };
+        assert!(answers(
+            &reply(0, ServoTestStatus::Ended(ServoTestEnd::Stopped)),
+            &stop
+        ));
+    }
+}

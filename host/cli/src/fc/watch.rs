@@ -231,3 +231,87 @@ pub fn watch<W: ByteWire>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sweephold_protocol::{Controls, HoldState, Measurements, TestSelection};
+
+    fn sample(tick: u32) -> Frame {
+        Frame::Sample(Sample {
+            tick,
+            phase: Phase::Sweep,
+            primary: sweephold_protocol::Axis::Lat,
+            sweep_omega: 1.0,
+            hold: [HoldState::Released, HoldState::Engaged, HoldState::Frozen],
+            command: Controls {
+                lat: 0.25,
+                lon: 0.0,
+                ped: 0.0,
+                col: 0.0,
+            },
+            sweep: Controls::default(),
+            noise: Controls::default(),
+            pilot: Controls::default(),
+            meas: Measurements {
+                phi: 10f32.to_radians(),
+                ..Measurements::default()
+            },
+        })
+    }
+
+    /// Status lines every `every` board seconds at the Header's rate; events at once;
+    /// the mode follows the ModeChange events; servo pulses through the mixer.
+    #[test]
+    fn lines_follow_the_telemetry() {
+        let mut header = sweephold_protocol::synthetic::header();
+        header.rate_hz = 100;
+        header.selection = Some(TestSelection {
+            entry: 3,
+            engagement: 2,
+        });
+        let mixer = MixerConfig::trex700l();
+        let mut watcher = Watcher::new(0.5, Some(mixer));
+        assert_eq!(watcher.feed(&Frame::Header(header)).1, false);
+        let change = Frame::Event(Event::ModeChange {
+            tick: 0,
+            from: FlightMode::Disarmed,
+            to: FlightMode::Test,
+        });
+        let (lines, status) = watcher.feed(&change);
+        assert_eq!(
+            (lines, status),
+            (
+                vec!["event tick 0: mode disarmed -> test".to_string()],
+                false
+            )
+        );
+        let mut status_ticks = Vec::new();
+        let mut last = String::new();
+        for tick in 0..120 {
+            let (lines, status) = watcher.feed(&sample(tick));
+            if status {
+                status_ticks.push(tick);
+                last = lines[0].clone();
+            }
+        }
+        assert_eq!(status_ticks, [0, 50, 100]);
+        assert!(last.starts_with("t     1.000 s  armed test"), "{last}");
+        assert!(last.contains("phase sweep"), "{last}");
+        assert!(last.contains("test entry 3 #2"), "{last}");
+        assert!(last.contains("hold -HF"), "{last}");
+        assert!(last.contains("att  +10.0"), "{last}");
+        let expected = sweephold_firmware::mix(
+            &mixer,
+            &Controls {
+                lat: 0.25,
+                ..Controls::default()
+            },
+        );
+        let servos = format!(
+            "servos {} {} {} {} us",
+            expected[0], expected[1], expected[2], expected[3]
+        );
+        assert!(last.ends_with(&servos), "{last}");
+    }
+}
