@@ -272,7 +272,7 @@ mod tests {
         });
         let mixer = MixerConfig::trex700l();
         let mut watcher = Watcher::new(0.5, Some(mixer));
-        assert_eq!(watcher.feed(&Frame::Header(header)).1, false);
+        assert!(!watcher.feed(&Frame::Header(header)).1);
         let change = Frame::Event(Event::ModeChange {
             tick: 0,
             from: FlightMode::Disarmed,
