@@ -121,7 +121,8 @@ EVENTS = ["phase_change", "hold_engaged", "hold_released", "trim_captured", "abo
 IMU_HEALTH = ["ok", "calibrating", "missing", "stuck", "saturated", "not_ready", "not_finite",
               "stale"]
 FRAME_KINDS = ["header", "sample", "event", "sensor_in", "actuator_out", "configure",
-               "configure_result", "param_request", "param_reply", "measurement_filter"]
+               "configure_result", "param_request", "param_reply", "measurement_filter",
+               "servo_test", "servo_test_reply"]
 
 
 def varint(n):

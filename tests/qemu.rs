@@ -782,3 +782,6 @@ fn wait_until_calibrated(board: &mut Board, rc: &RcInput) {
 
 #[path = "qemu_params.rs"]
 mod qemu_params;
+
+#[path = "qemu_bench_tools.rs"]
+mod qemu_bench_tools;

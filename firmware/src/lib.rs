@@ -41,7 +41,7 @@
 //! adaptive sweep amplitude), [`noise`] (PRNG,
 //! filtered noise), [`hold`] (the hysteresis), [`attitude_hold`] (the PID),
 //! [`safety`] (abort checks), [`trim`] (trim capture), [`slew`] (the commands' slew
-//! limit), [`mixer`] (swash and tail mixing), [`swash`] (the swash types, phase angle
+//! limit), [`mixer`] (swash and tail mixing), [`servo_test`] (the bench servo test), [`swash`] (the swash types, phase angle
 //! and cyclic ring),
 //! [`sink`] (telemetry output), [`config`] and [`controller`] (the sequencer); for the
 //! board's inputs: [`imu`] (the ICM-42688-P driver, its health monitor, boot calibration
@@ -86,6 +86,7 @@ pub mod params;
 pub mod pulse;
 pub mod receiver;
 pub mod safety;
+pub mod servo_test;
 pub mod sink;
 pub mod slew;
 pub mod swash;

@@ -16,6 +16,10 @@ pub use crate::board_events::{FlightMode, HostFrame, ImuHealth, RefusedCheck, Re
 pub use crate::param_frames::{
     ParamName, ParamOp, ParamRefusal, ParamReply, ParamRequest, ParamStoreStatus, PARAM_NAME_LEN,
 };
+pub use crate::servo_frames::{
+    ServoTarget, ServoTest, ServoTestEnd, ServoTestRefusal, ServoTestReply, ServoTestStatus,
+    MAX_SERVO_HOLD_MS,
+};
 
 /// Version of the wire protocol. A host refuses a dump whose `major` differs from its
 /// own; `minor` bumps only add frame variants at the end of [`Frame`] or enum variants at
@@ -39,8 +43,9 @@ pub struct ProtocolVersion {
 /// refusals [`RefusedCheck::ParamsInvalid`] and [`RefusedCheck::NotLevel`]; 1.6 the
 /// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`];
 /// 1.7 the Header's [`Header::selection`] (the test list entry and the engagement count),
-/// the refusal [`RefusedCheck::NoTestSelected`] and [`Frame::MeasurementFilter`].
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 7 };
+/// the refusal [`RefusedCheck::NoTestSelected`] and [`Frame::MeasurementFilter`]; 1.8 the
+/// bench servo test ([`Frame::ServoTest`], [`Frame::ServoTestReply`]).
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 8 };
 
 impl ProtocolVersion {
     /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
@@ -669,6 +674,11 @@ pub enum Frame {
     /// logic read them; sent by the board application right after each [`Header`].
     /// Since 1.7.
     MeasurementFilter(MeasurementFilter),
+    /// Move one servo on the bench, disarmed (host → flight controller). Since 1.8.
+    ServoTest(ServoTest),
+    /// The answer to a [`Frame::ServoTest`], and the end of a servo test (flight
+    /// controller → host). Since 1.8.
+    ServoTestReply(ServoTestReply),
 }
 
 /// Biquad sections in series per [`MeasurementFilter`]: the board's low-pass and its

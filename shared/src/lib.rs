@@ -31,6 +31,7 @@ pub mod codec;
 pub mod decoder;
 pub mod frames;
 pub mod param_frames;
+pub mod servo_frames;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
 

@@ -136,7 +136,8 @@ fn protocol_1_6_appends_landed_and_not_airborne() {
 
 #[test]
 fn protocol_1_7_appends_the_selection_and_no_test_selected() {
-    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 7 });
+    // 1.7 or later: later minor versions only append.
+    const { assert!(PROTOCOL_VERSION.major == 1 && PROTOCOL_VERSION.minor >= 7) };
     assert_eq!(
         ProtocolVersion::BOARD_APPLICATION,
         ProtocolVersion { major: 1, minor: 7 }
@@ -179,7 +180,8 @@ fn protocol_1_7_appends_the_selection_and_no_test_selected() {
 #[test]
 fn protocol_1_7_appends_the_measurement_filter_frame() {
     use sweephold_protocol::{Frame, MeasurementFilter};
-    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 7 });
+    // 1.7 or later: later minor versions only append.
+    const { assert!(PROTOCOL_VERSION.major == 1 && PROTOCOL_VERSION.minor >= 7) };
     let filter = MeasurementFilter {
         sample_rate_hz: 1000.0,
         sections: [[1.0, 0.0, 0.0, 0.0, 0.0]; 4],
@@ -191,4 +193,34 @@ fn protocol_1_7_appends_the_measurement_filter_frame() {
     assert_eq!(bytes.len(), 1 + 4 + 4 * 5 * 4);
     // It does not raise the largest frame.
     assert!(bytes.len() + 4 + 2 <= sweephold_protocol::MAX_FRAME_LEN);
+}
+
+#[test]
+fn protocol_1_8_appends_the_servo_test_frames() {
+    use sweephold_protocol::{
+        codec, Decoder, Frame, ServoTarget, ServoTest, ServoTestEnd, ServoTestReply,
+        ServoTestStatus,
+    };
+    assert_eq!(PROTOCOL_VERSION, ProtocolVersion { major: 1, minor: 8 });
+    let request = Frame::ServoTest(ServoTest {
+        servo: 2,
+        target: ServoTarget::PulseUs(1600),
+        hold_ms: 500,
+    });
+    // MeasurementFilter stays variant 9; ServoTest is 10, ServoTestReply 11.
+    let bytes = postcard_bytes(&request);
+    // Variant, servo, target variant 3 and 1600 as a varint (0xC0 0x0C), hold 500 (0xF4 0x03).
+    assert_eq!(bytes, [10, 2, 3, 0xC0, 0x0C, 0xF4, 0x03]);
+    let reply = Frame::ServoTestReply(ServoTestReply {
+        servo: 2,
+        pulse_us: 0,
+        status: ServoTestStatus::Ended(ServoTestEnd::TimedOut),
+    });
+    assert_eq!(postcard_bytes(&reply), [11, 2, 0, 1, 1]);
+    for frame in [request, reply] {
+        let mut wire = [0u8; sweephold_protocol::MAX_FRAME_LEN];
+        let n = codec::encode(&frame, &mut wire).unwrap();
+        let decoded: Vec<_> = Decoder::new().feed(&wire[..n]).collect();
+        assert_eq!(decoded, vec![Ok(frame)]);
+    }
 }

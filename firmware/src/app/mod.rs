@@ -14,6 +14,7 @@
 //!   aborts);
 //! * [`test_list`]: the tests a flight can fly, chosen by the selector channel;
 //! * [`failsafe`]: receiver and IMU monitors and the failsafe policies;
+//! * [`cues`]: the status LED's pattern per phase, for the pilot;
 //! * [`throttle`]: the ESC channel and its soft start;
 //! * [`inputs`]: the input types;
 //! * [`outputs`]: the output type.
@@ -55,6 +56,7 @@
 
 pub mod airborne;
 pub mod arming;
+pub mod cues;
 pub mod failsafe;
 pub mod inputs;
 pub mod modes;
@@ -81,6 +83,7 @@ use crate::trim::Trim;
 
 use airborne::{AirborneDetector, AirborneInput, AirborneSettings};
 use arming::{CheckInput, SwitchEdge};
+use cues::{Cue, CueState, CueTracker};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
 use reporting::{BoardTap, Reporter};
@@ -291,6 +294,8 @@ pub struct BoardApp {
     /// The mixer turned around: the command each tick's pulses express, which its Sample
     /// logs.
     pulse_inverse: PulseInverse,
+    /// The pilot cue shown and since when.
+    cues: CueTracker,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -343,6 +348,7 @@ impl BoardApp {
             measurement_filter: None,
             engagements: 0,
             pulse_inverse: PulseInverse::new(&config.flight.mixer),
+            cues: CueTracker::default(),
             fc,
             config,
         })
@@ -412,6 +418,18 @@ impl BoardApp {
     /// The pilot-mode loops' state.
     pub fn pilot_loops(&self) -> &PilotLoops {
         &self.loops
+    }
+
+    /// The pilot cue of the last tick.
+    pub fn cue(&self) -> Cue {
+        self.cues.cue()
+    }
+
+    /// Whether the status LED is lit after the last tick: [`Cue::lit`] of the cue, from
+    /// the tick it began.
+    pub fn status_led(&self) -> bool {
+        self.cues
+            .lit(self.fc.tick().wrapping_sub(1), self.config.flight.rate_hz)
     }
 
     /// Run one tick: monitors, mode transition, the mode's command, the sequencer's step
@@ -541,6 +559,26 @@ impl BoardApp {
         };
 
         self.last_command = command;
+        let phase = self.fc.phase();
+        let ended = if sink.reason.is_some() || transition.refused.is_some() {
+            Some(Cue::Aborted)
+        } else if reported_mode == Mode::Test && phase == Phase::Done {
+            Some(Cue::Done)
+        } else {
+            None
+        };
+        self.cues.update(
+            tick,
+            self.config.flight.rate_hz,
+            ended,
+            CueState {
+                mode: reported_mode,
+                phase,
+                hold: self.fc.hold_states(),
+                params_valid: self.params_valid,
+                ending: None,
+            },
+        );
         TickOutput {
             mode: reported_mode,
             stick_mode,

@@ -11,9 +11,10 @@ use super::pilot_mode::{Drive, LoopFactors, RateAxisGains, RateLoop};
 use super::*;
 use crate::mixer::expressed;
 use proptest::prelude::*;
-use sweephold_protocol::{AbortReason, Decoder, Event, Frame};
+use sweephold_protocol::{AbortReason, Decoder, Event, Frame, HoldState};
 
 mod airborne;
+mod cues;
 mod test_list;
 
 const DEG: f32 = core::f32::consts::PI / 180.0;

@@ -199,14 +199,16 @@ fn handle_frame<W: Write>(
         Frame::MeasurementFilter(filter) => {
             rows.json_line(&measurement_filter_json(&filter).to_string())?;
         }
-        // In-the-loop and parameter traffic is not telemetry; a dump of a serial link may
-        // hold it.
+        // In-the-loop, parameter and servo-test traffic is not telemetry; a dump of a
+        // serial link may hold it.
         Frame::SensorIn(_)
         | Frame::ActuatorOut(_)
         | Frame::Configure(_)
         | Frame::ConfigureResult(_)
         | Frame::ParamRequest(_)
-        | Frame::ParamReply(_) => {}
+        | Frame::ParamReply(_)
+        | Frame::ServoTest(_)
+        | Frame::ServoTestReply(_) => {}
     }
     Ok(())
 }

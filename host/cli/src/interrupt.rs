@@ -111,6 +111,11 @@ fn clean_up_and_exit() -> ! {
     std::process::exit(EXIT_INTERRUPTED);
 }
 
+/// Whether a stop was requested (a verb that ends cleanly on a signal, `fc watch`, asks).
+pub fn requested() -> bool {
+    REQUESTED.load(Ordering::SeqCst)
+}
+
 /// An error when a stop was requested.
 pub fn check() -> anyhow::Result<()> {
     if REQUESTED.load(Ordering::SeqCst) {

@@ -95,6 +95,10 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Campaign(_) | Command::Fly(_) | Command::Decode(_) => {
             interrupt::Handling::Deferred
         }
+        // A watch ends cleanly (exit 0) on the first signal.
+        Command::Fc(ref fc) if matches!(fc.command, fc::FcCommand::Watch(_)) => {
+            interrupt::Handling::Deferred
+        }
         _ => interrupt::Handling::AtOnce,
     };
     interrupt::install(handling);

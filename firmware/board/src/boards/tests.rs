@@ -19,7 +19,7 @@ fn all_pins(board: &BoardMap) -> Vec<(Pin, &'static str)> {
         (board.swd[1], "swclk"),
         (board.esc.pin, "esc"),
     ];
-    pins.extend(board.led.map(|led| (led, "led")));
+    pins.extend(board.led.map(|led| (led.pin, "led")));
     pins.extend(board.servos.iter().map(|servo| (servo.pin, "servo")));
     pins
 }

@@ -9,7 +9,7 @@ use crate::chip::boot::Boot;
 use crate::chip::clocks;
 use crate::chip::dividers;
 use crate::chip::flash::{F405Flash, Registers};
-use crate::chip::gpio::Gpio;
+use crate::chip::gpio::{Gpio, GpioOutput};
 use crate::chip::imu_device::{self, ImuDevice};
 use crate::chip::logport;
 use crate::chip::nvic::Nvic;
@@ -18,6 +18,7 @@ use crate::chip::sbus_uart::{self, SbusRx};
 use crate::chip::servo::{self, OutputTimers, ServoChannel, Servos};
 use crate::chip::usart::{self, UsartRx, UsartTx};
 use crate::chip::watchdog::Watchdog;
+use sweephold_firmware::app::cues::StatusLed;
 
 /// The drivers of a board, set up, and what the loop still starts itself.
 pub struct Devices {
@@ -41,6 +42,8 @@ pub struct Devices {
     pub flash: F405Flash<Registers>,
     /// The loop tick's timer, started by the loop once its flight logic is ready.
     pub tim5: pac::TIM5,
+    /// The status LED, off, when the board has one.
+    pub led: Option<StatusLed<GpioOutput>>,
 }
 
 /// Take the peripherals and set up every driver on `map`'s pins; a driver that cannot
@@ -92,8 +95,14 @@ pub fn bring_up(map: &BoardMap) -> Devices {
         Ok(imu) => imu,
         Err(error) => defmt::panic!("SPI1 (IMU): {}", error),
     };
+    let led = map.led.map(|led| {
+        // Off until the first control tick: the level that does not light it.
+        let output = GpioOutput::new(boot.gpio, &boot.gates, led.pin, led.active_low);
+        StatusLed::new(output, led.active_low)
+    });
     Devices {
         boot,
+        led,
         servos,
         esc,
         tx,

@@ -7,6 +7,7 @@
 //! is used (the IMU's chip select), a write of the port's set/reset register, atomic by
 //! the hardware.
 
+use embedded_hal::digital::{ErrorType, OutputPin};
 use stm32f4::stm32f405 as pac;
 
 use crate::chip::clocks::{ClockGate, ClockGates};
@@ -111,5 +112,36 @@ impl Gpio {
                 gpio.afrh().modify(|_, w| w.afr(n - 8).set(af));
             }
         });
+    }
+}
+
+/// One pin made an output by [`Gpio::output`], as an `embedded-hal` [`OutputPin`] (the
+/// status LED's driver takes one). Each write is one set/reset register write.
+pub struct GpioOutput {
+    gpio: &'static Gpio,
+    pin: Pin,
+}
+
+impl GpioOutput {
+    /// Make `pin` a push-pull output driving `high` and hand it out.
+    pub fn new(gpio: &'static Gpio, gates: &ClockGates, pin: Pin, high: bool) -> Self {
+        gpio.output(gates, pin, high);
+        GpioOutput { gpio, pin }
+    }
+}
+
+impl ErrorType for GpioOutput {
+    type Error = core::convert::Infallible;
+}
+
+impl OutputPin for GpioOutput {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        self.gpio.set(self.pin, false);
+        Ok(())
+    }
+
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        self.gpio.set(self.pin, true);
+        Ok(())
     }
 }

@@ -8,8 +8,8 @@
 //! twice, alternate functions that match the peripherals, output groups on timers of
 //! their own).
 
-// The map names the whole board: its name, the LED the image does not drive yet and the
-// SWD pins it must never touch are read by the tests only, and on the host (tests) the
+// The map names the whole board: its name and the SWD pins it must never touch are read
+// by the tests only, and on the host (tests) the
 // drivers that read the rest are not built.
 #![allow(dead_code)]
 
@@ -96,6 +96,16 @@ pub struct TimerRate {
     pub frame_hz: u32,
 }
 
+/// The status LED: its pin (a GPIO output) and which level lights it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Led {
+    /// The pin.
+    pub pin: Pin,
+    /// The LED lights when the pin is low (wired from the supply through the LED to the
+    /// pin).
+    pub active_low: bool,
+}
+
 /// The IMU's SPI1 pins.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ImuPins {
@@ -165,8 +175,9 @@ pub struct BoardMap {
     /// face), from the board's published definitions. The parameter `IMU_ROT` is the
     /// aircraft's mounting of the board, applied after this one.
     pub imu_mounting: ImuRotation,
-    /// Status LED (GPIO output), when the board has one off the SWD pins.
-    pub led: Option<Pin>,
+    /// Status LED (GPIO output), when the board has one off the SWD pins: the pilot
+    /// cues (`sweephold_firmware::app::cues`).
+    pub led: Option<Led>,
     /// The SWD pins: never reconfigured by the image.
     pub swd: [Pin; 2],
 }

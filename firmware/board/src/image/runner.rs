@@ -45,6 +45,13 @@
 //! Set or Reset is applied on the next disarmed control tick (`Runner::apply_params`);
 //! a Save stretches the watchdog around the flash erase.
 //!
+//! **Bench tools**: after every control tick the status LED shows the board
+//! application's pilot cue (`sweephold_firmware::app::cues`). A ServoTest frame
+//! (protocol 1.8) puts one servo at a pulse while the board application is disarmed with a
+//! valid parameter set (`sweephold_firmware::servo_test`): the control tick replaces that
+//! servo's pulse until the request's hold passes without another request, and never on an
+//! armed tick (a test running when the board arms ends there, reported).
+//!
 //! **Configure** (protocol 1.1): a [`LinkConfig`] from the host replaces the in-the-loop
 //! configuration at run time. The image builds the preset of the frame's vehicle for
 //! its test's primary axis, puts the frame's rate and test in, and restarts the flight
@@ -54,13 +61,15 @@
 //! entry's, so the first SensorIn does not send another).
 
 use embedded_hal::pwm::SetDutyCycle;
+use sweephold_firmware::app::cues::StatusLed;
 use sweephold_firmware::app::Mode as AppMode;
 use sweephold_firmware::board_stack::{BoardStack, BootState, ImuStep, IMU_RATE_HZ};
 use sweephold_firmware::params::Params;
+use sweephold_firmware::servo_test::ServoTester;
 use sweephold_firmware::FlightController;
 use sweephold_protocol::{
     ActuatorOut, ConfigureResult, Controls, Event, Frame, FrameError, Header, HostFrame,
-    LinkConfig, ParamRequest, SensorIn,
+    LinkConfig, ParamRequest, SensorIn, ServoTest, ServoTestRefusal,
 };
 
 use crate::boards::BOARD;
@@ -68,6 +77,7 @@ use crate::chip::clocks::{ClockSource, Clocks};
 use crate::chip::delay::BusyDelay;
 use crate::chip::devices::{self, Devices};
 use crate::chip::dividers;
+use crate::chip::gpio::GpioOutput;
 use crate::chip::imu_device::{self, ImuDevice};
 use crate::chip::logport;
 use crate::chip::nvic::{self, Irq};
@@ -164,6 +174,10 @@ pub struct Runner {
     params: HostParams,
     /// The clock tree (the servo timers' dividers).
     clocks: Clocks,
+    /// The status LED: the board application's pilot cue after every control tick.
+    led: Option<StatusLed<GpioOutput>>,
+    /// The bench servo test (protocol 1.8), disarmed only.
+    servo_test: ServoTester,
 }
 
 impl Runner {
@@ -215,9 +229,17 @@ impl Runner {
             received.get(..count).unwrap_or(&[]),
             &mut Telemetry::new(&mut self.tx, &mut self.scratch),
         );
+        // A bench servo test replaces one pulse while disarmed, never armed.
+        let mut servo_us = out.servo_us;
+        if let Some(end) = self.servo_test.apply(!out.mode.is_armed(), &mut servo_us) {
+            link::send_waiting(&mut self.tx, &mut self.scratch, &Frame::ServoTestReply(end));
+        }
         // Infallible: the channels write compare registers.
-        let _ = self.servos.apply(out.servo_us);
+        let _ = self.servos.apply(servo_us);
         let _ = self.esc.set_duty_cycle(out.esc_us);
+        if let Some(led) = &mut self.led {
+            led.show(self.stack.app().status_led());
+        }
         self.stats.steps = self.stats.steps.wrapping_add(1);
         if !out.mode.is_armed() {
             self.host_ignored_reported = false;
@@ -412,6 +434,8 @@ impl Runner {
     /// Leave the board application for the loop: the ESC to the cut, the link timer's
     /// silence count from zero.
     fn enter_the_loop(&mut self) {
+        // The host's simulation flies the servos from now on.
+        self.servo_test.stop();
         if self.mode == Mode::BoardApplication {
             let _ = self.esc.set_duty_cycle(ESC_CUT_US);
             defmt::info!("host in the loop: the board application stops");
@@ -463,6 +487,30 @@ impl Runner {
         );
     }
 
+    /// A bench servo test request: refused in the loop, armed, or without a valid
+    /// parameter set; answered at once.
+    fn servo_test_request(&mut self, request: &ServoTest) {
+        let app = self.stack.app();
+        let refused = if self.mode != Mode::BoardApplication {
+            Some(ServoTestRefusal::InTheLoop)
+        } else if !app.host_link_allowed() {
+            Some(ServoTestRefusal::Armed)
+        } else if !self.params.valid() {
+            Some(ServoTestRefusal::ParamsInvalid)
+        } else {
+            None
+        };
+        let flight = &self.stack.config().app.flight;
+        let reply = self
+            .servo_test
+            .request(request, refused, &flight.mixer, flight.rate_hz);
+        link::send_waiting(
+            &mut self.tx,
+            &mut self.scratch,
+            &Frame::ServoTestReply(reply),
+        );
+    }
+
     /// A frame (or a decoding error) from the host.
     fn on_frame(&mut self, frame: Result<Frame, FrameError>) {
         match frame {
@@ -482,6 +530,7 @@ impl Runner {
                 self.watchdog.fed_by_fresh_sample();
             }
             Ok(Frame::Configure(request)) => self.configure(&request),
+            Ok(Frame::ServoTest(request)) => self.servo_test_request(&request),
             Ok(Frame::ParamRequest(request)) => {
                 let disarmed = self.params_allowed();
                 // A save may erase a flash sector: the loop stalls up to 2 s (disarmed
@@ -516,6 +565,7 @@ pub fn run() -> ! {
         watchdog,
         flash,
         tim5,
+        led,
     } = devices::bring_up(&BOARD);
     let clocks = boot.clocks;
 
@@ -580,6 +630,8 @@ pub fn run() -> ! {
         watchdog,
         params,
         clocks,
+        led,
+        servo_test: ServoTester::default(),
     };
     runner.apply_frame_rates(&flown);
     runner.announce();

@@ -65,12 +65,27 @@ pub trait ParamBoard {
 /// Parameter requests over a frame channel.
 pub struct ParamClient<W> {
     channel: FrameChannel<W>,
+    /// The telemetry read past while waiting for replies (at most [`PASSED_KEEP`] bytes,
+    /// the first ones), for a caller that shows it (`fc watch`).
+    passed: Vec<u8>,
 }
+
+/// How many bytes of telemetry read past a client keeps.
+pub const PASSED_KEEP: usize = 1 << 20;
 
 impl<W: ByteWire> ParamClient<W> {
     /// A client on `channel` (its boot frame already read, if the link has one).
     pub fn new(channel: FrameChannel<W>) -> Self {
-        ParamClient { channel }
+        ParamClient {
+            channel,
+            passed: Vec::new(),
+        }
+    }
+
+    /// The channel back (to read the telemetry on), and the telemetry's bytes read past
+    /// so far (whole frames with their delimiters).
+    pub fn into_channel(self) -> (FrameChannel<W>, Vec<u8>) {
+        (self.channel, self.passed)
     }
 
     /// Send `request` and return its next reply.
@@ -93,6 +108,14 @@ impl<W: ByteWire> ParamClient<W> {
                 &mut telemetry,
             )
             .map_err(ParamError::Link)?;
+        let room = PASSED_KEEP.saturating_sub(self.passed.len());
+        // Whole frames only: cut at the last delimiter that fits.
+        let kept = telemetry
+            .get(..room.min(telemetry.len()))
+            .and_then(|part| part.iter().rposition(|&b| b == 0))
+            .map_or(0, |end| end + 1);
+        self.passed
+            .extend_from_slice(telemetry.get(..kept).unwrap_or(&[]));
         match frame {
             Frame::ParamReply(reply) => Ok(reply),
             other => Err(ParamError::Link(anyhow!("unexpected frame {other:?}"))),

@@ -6,13 +6,17 @@
 //! board-sim:FLASH` (the simulated board, its parameter sectors in a file: [`board_sim`]).
 //!
 //! Its parts: [`client`] (the frames), [`params_file`] (the file format) and [`push`]
-//! (checking a file against the board, then writing it all or nothing).
+//! (checking a file against the board, then writing it all or nothing). `fc watch`
+//! ([`watch`]) shows the board's telemetry live; `fc servo` ([`servo`]) moves one servo
+//! on the bench.
 
 pub mod aircraft_params;
 pub mod board_sim;
 pub mod client;
 pub mod params_file;
 pub mod push;
+pub mod servo;
+pub mod watch;
 
 use std::path::{Path, PathBuf};
 
@@ -39,6 +43,67 @@ pub struct FcArgs {
 pub enum FcCommand {
     /// The board's parameters (list, get, set, save, reset, pull, push, diff).
     Params(ParamsArgs),
+    /// A live view of the board: mode, phase, test, attitude, rates, command, servo
+    /// pulses and events, one line per update, until Ctrl-C (or --count / --seconds).
+    Watch(WatchArgs),
+    /// Bench servo test: one servo to its centre, min, max or a pulse for --hold, while
+    /// disarmed; back to the disarmed output afterwards.
+    Servo(ServoArgs),
+}
+
+/// `sweephold fc servo`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "The board obeys only while disarmed and with a valid parameter set \
+saved; armed, the request is refused and nothing moves, and a test running when the board \
+arms ends at once. The pulse is clamped to the servo's own limits (SERVOn_MIN/MAX, \
+TAIL_MIN/MAX). The host repeats the request every 0.2 s with a 0.5 s hold: if it stops \
+asking (Ctrl-C, a pulled cable) the servo is back at the disarmed output within 0.5 s."
+)]
+pub struct ServoArgs {
+    /// The servo: 1, 2, 3 (swash servos) or 4 (tail).
+    #[arg(value_parser = clap::value_parser!(u8).range(1..=4))]
+    pub servo: u8,
+    /// Where to put it: centre, min, max, or a pulse such as 1600us.
+    #[arg(value_parser = servo::parse_target)]
+    pub target: sweephold_protocol::ServoTarget,
+    /// How long to hold it (2s, 500ms, 1.5).
+    #[arg(long, value_name = "DURATION", default_value = "2s", value_parser = servo::parse_duration)]
+    pub hold: std::time::Duration,
+    /// The flight controller: `qemu-usart` or `serial:PATH[@BAUD]` (as for `fc params`).
+    #[arg(long, value_name = "FC", value_parser = parse_fc)]
+    pub fc: Option<FcLink>,
+    /// Board image for `--fc qemu-usart` (as for `fc params`).
+    #[arg(long, value_name = "PATH")]
+    pub elf: Option<PathBuf>,
+}
+
+/// `sweephold fc watch`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Status line: board time, armed or disarmed and the mode, the \
+sequencer's phase, the test list entry and engagement of the last Header, the hold states \
+(lat lon ped: - released, H engaged, F frozen), attitude phi theta psi, rates p q r, the \
+command (lat lon ped col) and the servo pulses that command makes through the board's \
+mixer (from the parameters listed at the start; `?` when the board refused the list, i.e. \
+armed). Events are lines of their own. Ctrl-C ends the watch with exit status 0."
+)]
+pub struct WatchArgs {
+    /// The flight controller: `qemu-usart` or `serial:PATH[@BAUD]` (as for `fc params`).
+    #[arg(long, value_name = "FC", value_parser = parse_fc)]
+    pub fc: Option<FcLink>,
+    /// Board image for `--fc qemu-usart` (as for `fc params`).
+    #[arg(long, value_name = "PATH")]
+    pub elf: Option<PathBuf>,
+    /// Board seconds between two status lines.
+    #[arg(long, value_name = "S", default_value_t = 0.2)]
+    pub every: f64,
+    /// Stop after N status lines.
+    #[arg(long, value_name = "N")]
+    pub count: Option<u64>,
+    /// Stop after S seconds (wall time).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
 }
 
 /// `sweephold fc params`.
@@ -200,7 +265,86 @@ impl ByteWire for FcWire {
 pub fn run(args: &FcArgs) -> anyhow::Result<()> {
     match &args.command {
         FcCommand::Params(params) => run_params(params),
+        FcCommand::Watch(watch) => run_watch(watch),
+        FcCommand::Servo(args) => run_servo(args),
     }
+}
+
+fn run_servo(args: &ServoArgs) -> anyhow::Result<()> {
+    let Some(fc) = &args.fc else {
+        bail!("--fc is required (qemu-usart or serial:PATH[@BAUD])");
+    };
+    if let FcLink::BoardSim(_) = fc {
+        bail!("fc servo needs a board with servos: qemu-usart or serial:PATH");
+    }
+    let (client, _) = connect(fc, args.elf.as_deref())?;
+    let (mut channel, _) = client.into_channel();
+    let held = servo::hold_servo(&mut channel, args.servo, args.target, args.hold)?;
+    output::print(&format!(
+        "servo {} at {} us for {:.1} s, then back to the disarmed output\n",
+        args.servo,
+        held.pulse_us,
+        args.hold.as_secs_f64()
+    ))
+}
+
+fn run_watch(args: &WatchArgs) -> anyhow::Result<()> {
+    let Some(fc) = &args.fc else {
+        bail!("--fc is required (qemu-usart or serial:PATH[@BAUD])");
+    };
+    if let FcLink::BoardSim(_) = fc {
+        bail!("fc watch needs a board that streams telemetry: qemu-usart or serial:PATH");
+    }
+    if !(args.every.is_finite() && args.every > 0.0) {
+        bail!("--every must be a positive number of seconds");
+    }
+    if args.seconds.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
+        bail!("--seconds must be a positive number of seconds");
+    }
+    let (mut client, _) = connect(fc, args.elf.as_deref())?;
+    let (mixer, note) = match board_mixer(&mut client) {
+        Ok(mixer) => (Some(mixer), None),
+        Err(error) => (None, Some(format!("servo pulses not shown: {error:#}"))),
+    };
+    let (mut channel, passed) = client.into_channel();
+    let mut watcher = watch::Watcher::new(args.every, mixer);
+    let mut out = output::StdoutWriter::lock();
+    if let Some(note) = note {
+        use std::io::Write;
+        writeln!(out, "{note}")?;
+    }
+    // What the board sent before and during the List (its boot Header and Events).
+    watch::replay(&passed, &mut watcher, &mut out)?;
+    let limits = watch::Limits {
+        count: args.count,
+        seconds: args.seconds,
+    };
+    watch::watch(
+        &mut channel,
+        &mut watcher,
+        limits,
+        &mut out,
+        crate::interrupt::requested,
+    )?;
+    Ok(())
+}
+
+/// The mixer of the board's parameters (a List, answered only while disarmed).
+pub fn board_mixer<W: ByteWire>(
+    client: &mut ParamClient<W>,
+) -> anyhow::Result<sweephold_firmware::mixer::MixerConfig> {
+    let values = client.list()?;
+    client::check_same_table(&values)?;
+    let mut array = [0.0; sweephold_firmware::params::COUNT];
+    for (slot, value) in array.iter_mut().zip(&values) {
+        *slot = value.value;
+    }
+    let table = sweephold_firmware::params::ParamTable::from_values(array)
+        .map_err(|(id, e)| anyhow::anyhow!("the board's {}: {}", id.def().name, e.message()))?;
+    let params = table
+        .params()
+        .map_err(|e| anyhow::anyhow!("the board's parameters: {}", e.message()))?;
+    Ok(params.stack.app.flight.mixer)
 }
 
 fn run_params(args: &ParamsArgs) -> anyhow::Result<()> {

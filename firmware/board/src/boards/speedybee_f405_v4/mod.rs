@@ -17,7 +17,7 @@
 //! | tail servo               | TIM8 CH3       | PC8 (AF3)         | M5               |
 //! | ESC (throttle)           | TIM2 CH3       | PB10 (AF1)        | M7               |
 //! | loop tick                | TIM5           | —                 | —                |
-//! | status LED               | GPIO           | PC13              | on board         |
+//! | status LED (active low)  | GPIO           | PC13              | on board         |
 //! | SWD (probe-rs, RTT logs) | —              | PA13 SWDIO, PA14 SWCLK | SWD pads    |
 //!
 //! Nothing of the image sits on the IMU's SPI1 pins. The STM32F405's USARTs cannot
@@ -39,7 +39,9 @@
 //! `-serial`, USART2 the second; TIM2..TIM5 and USART1..6 are emulated, TIM8 is not
 //! (its writes go nowhere), which leaves the emulated runs unchanged.
 
-use crate::chip::pins::{pin, BoardMap, Crystal, ImuPins, Output, OutputTimer, Port, TimerRate};
+use crate::chip::pins::{
+    pin, BoardMap, Crystal, ImuPins, Led, Output, OutputTimer, Port, TimerRate,
+};
 use sweephold_firmware::imu::ImuRotation;
 
 /// Frame rate of the swash servos (TIM4 and TIM3) at boot [Hz], until the parameter
@@ -118,7 +120,12 @@ pub const BOARD: BoardMap = BoardMap {
     // Betaflight's `GYRO_1_ALIGN CW90_DEG` and ArduPilot's `ROTATION_PITCH_180_YAW_270`
     // alike (docs/decisions/2026-11-26-imu-mounting-defaults.md).
     imu_mounting: ImuRotation::Roll180Yaw90,
-    led: Some(pin(Port::C, 13, 0)),
+    // Betaflight's `LED0_PIN PC13` without `LED0_INVERTED` (its LED driver lights a
+    // non-inverted LED by driving the pin low), ArduPilot's `PC13 LED0 OUTPUT`.
+    led: Some(Led {
+        pin: pin(Port::C, 13, 0),
+        active_low: true,
+    }),
     swd: [pin(Port::A, 13, 0), pin(Port::A, 14, 0)],
 };
 
