@@ -66,6 +66,10 @@ pub struct Parameter {
     /// A-priori value ± σ (`prior`, `sigma`): a weighted term of the cost
     /// ([`crate::fit::prior`]).
     pub prior: Option<Prior>,
+    /// The `[constants]` name the prior's value was given as (`prior =
+    /// "servo_natural_frequency"`), when it was a name: the a-priori constant this
+    /// parameter estimates.
+    pub prior_constant: Option<String>,
 }
 
 /// A parameter's prior: value ± one standard deviation.

@@ -172,6 +172,7 @@ impl ModelStructure {
                         upper: None,
                         line,
                         prior: None,
+                        prior_constant: None,
                     });
                 }
                 RawParameter::Table(table) => {
@@ -240,6 +241,10 @@ impl ModelStructure {
                             upper: table.max,
                             line,
                             prior,
+                            prior_constant: match &table.prior {
+                                Some(RawValue::Expression(name)) => Some(name.trim().to_string()),
+                                _ => None,
+                            },
                         });
                     }
                 }
