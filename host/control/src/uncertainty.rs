@@ -48,11 +48,23 @@ impl ParameterSampler {
         let mut free = Vec::new();
         let mut sigma = Vec::new();
         for (index, parameter) in structure.parameters.iter().enumerate() {
-            let reported = document
+            let Some(reported) = document
                 .parameters
                 .iter()
                 .find(|p| p.name == parameter.name)
-                .ok_or_else(|| format!("model.json has no parameter `{}`", parameter.name))?;
+            else {
+                // A model fitted before the structure estimated this parameter under its
+                // prior (the TREX's servo ω_n) held it at that prior: held here too.
+                match parameter.prior {
+                    Some(prior) => {
+                        base.push(prior.value);
+                        continue;
+                    }
+                    None => {
+                        return Err(format!("model.json has no parameter `{}`", parameter.name))
+                    }
+                }
+            };
             base.push(reported.value);
             let bound = reported
                 .cramer_rao_percent

@@ -43,6 +43,8 @@ pub fn file_constants(
         let mut all: Vec<(String, f64)> = vehicle_constants(aircraft)
             .into_iter()
             .filter(|(name, _)| structure.constants.contains_key(name))
+            // A prior's σ is not an a-priori constant of its own.
+            .filter(|(name, _)| !name.ends_with("_sigma"))
             .collect();
         if fixes_kcs {
             let kcs = Helicopter::from_aircraft(aircraft).flap_cross_coupling();

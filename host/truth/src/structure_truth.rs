@@ -29,7 +29,9 @@
 //!   `teq_lat`, `teq_lon` add the rotor lag τ_f (the flapping folded in), `teq_ped`,
 //!   `teq_col` do not. These delays are approximations of the truth, not exact entries.
 //!   A structure that models the servos (`[actuators]`, their ω_n and ζ put in by
-//!   [`crate::with_vehicle_data`]) has them exactly; its `tau_*` are the transport delay.
+//!   [`crate::with_vehicle_data`]) has them exactly; its `tau_*` are the transport delay,
+//!   and the parameters its actuators take ω_n and ζ from (servos identified under their
+//!   priors) are the simulator's servo's.
 //!
 //! A structure parameter the mapping does not know is left out of the truth values; the
 //! truth model then holds it at 0 (listed in [`StructureTruth::unmapped`]). Truth values
@@ -146,6 +148,18 @@ pub fn structure_truth(
     };
 
     let value_of = |name: &str| -> Option<f64> {
+        // A parameter the structure's actuators take their ω_n or ζ from (identified
+        // servos) is the simulator's servo.
+        if let Some(index) = structure.parameter_index(name) {
+            for [frequency, damping] in &structure.actuator_parameters {
+                if *frequency == Some(index) {
+                    return Some(truth.actuator.natural_frequency_rad_s);
+                }
+                if *damping == Some(index) {
+                    return Some(truth.actuator.damping);
+                }
+            }
+        }
         match name {
             "tau_f" => return Some(tau_f),
             "tau_lat" | "tau_lon" | "tau_ped" | "tau_col" => {

@@ -98,6 +98,17 @@ pub fn with_vehicle_data(
     Ok(structure)
 }
 
+/// σ of a servo's natural frequency when the aircraft file states none, relative to the
+/// value: a data sheet gives the servo unloaded, and under a rotor's loads and another
+/// supply voltage its bandwidth is commonly 10–20 % lower; 20 % keeps a wrong data-sheet
+/// value within 1σ, so that the responses, which inform ω_n well (Cramér–Rao about
+/// 1–2 % on the TREX), decide.
+pub const SERVO_NATURAL_FREQUENCY_DEFAULT_RELATIVE_SIGMA: f64 = 0.2;
+
+/// σ of a servo's damping ratio when the file states none: servo data sheets do not
+/// state it, and hobby servos' step responses range from about 0.5 to 0.9.
+pub const SERVO_DAMPING_DEFAULT_SIGMA: f64 = 0.2;
+
 /// The constants a structure may declare that come from the aircraft file, by name, as
 /// [`with_vehicle_data`] puts them in (the trim attitude's and `Kcs` aside).
 pub(crate) fn vehicle_constants(aircraft: &Aircraft) -> BTreeMap<String, f64> {
@@ -118,6 +129,22 @@ pub(crate) fn vehicle_constants(aircraft: &Aircraft) -> BTreeMap<String, f64> {
             servo.natural_frequency_rad_s,
         ),
         ("servo_damping".to_string(), servo.damping),
+        // The priors' σ of the servos (a structure that identifies them declares these):
+        // the file's, else the default of their kind.
+        (
+            "servo_natural_frequency_sigma".to_string(),
+            aircraft.servos.natural_frequency.sigma.unwrap_or(
+                SERVO_NATURAL_FREQUENCY_DEFAULT_RELATIVE_SIGMA * servo.natural_frequency_rad_s,
+            ),
+        ),
+        (
+            "servo_damping_sigma".to_string(),
+            aircraft
+                .servos
+                .damping
+                .sigma
+                .unwrap_or(SERVO_DAMPING_DEFAULT_SIGMA),
+        ),
         (
             "inertia_xz_over_zz".to_string(),
             helicopter.ixz / helicopter.izz,
@@ -238,6 +265,48 @@ mod tests {
         assert!(!bo105.constants.contains_key("inertia_xz_over_zz"));
         let index = bo105.parameter_index("Nb1s").unwrap();
         assert_eq!(bo105.parameters[index].kind, ParameterKind::Free);
+    }
+
+    #[test]
+    fn the_servo_natural_frequency_is_estimated_under_the_aircraft_files_prior() {
+        use sysid::fit::structure::Prior;
+        let prior = |aircraft: &Aircraft| {
+            let structure = nine_dof_hybrid(aircraft, None).unwrap();
+            let index = structure.parameter_index("servo_omega").unwrap();
+            let parameter = &structure.parameters[index];
+            assert_eq!(parameter.kind, ParameterKind::Free);
+            assert_eq!(
+                parameter.value,
+                parameter.prior.unwrap().value,
+                "starts at it"
+            );
+            // The four actuators take their ω_n from it; ζ stays the file's constant.
+            assert!(structure
+                .actuator_parameters
+                .iter()
+                .all(|&[w, z]| w == Some(index) && z.is_none()));
+            parameter.prior.unwrap()
+        };
+        // The TREX's file states no σ: the default of the kind, 20 % of 60 rad/s.
+        assert_eq!(
+            prior(&trex_aircraft()),
+            Prior {
+                value: 60.0,
+                sigma: 12.0
+            }
+        );
+        // The fbl700's states "48 ± 5 rad/s".
+        let fbl = aircraft::shipped("fbl700").unwrap();
+        assert_eq!(
+            prior(&fbl),
+            Prior {
+                value: 48.0,
+                sigma: 5.0
+            }
+        );
+        // The Bo-105's structure has no identified servo (its delays stand for it).
+        let bo105 = nine_dof_hybrid(&bo105_aircraft(), None).unwrap();
+        assert!(bo105.parameters.iter().all(|p| p.prior.is_none()));
     }
 
     /// The TREX file ties its body terms to the tail rotor, the shaft and the hub (its

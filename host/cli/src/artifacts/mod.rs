@@ -9,6 +9,7 @@
 pub mod aircraft_constants;
 pub mod files;
 pub mod flown;
+pub mod priors;
 pub mod stage;
 pub mod summary;
 pub mod truth_model;

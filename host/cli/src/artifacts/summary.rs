@@ -128,6 +128,11 @@ pub struct FitSummary {
     /// What the trim points gave (`trim-points.csv`): null without them.
     #[serde(default)]
     pub trim: Option<sysid::fit::trim::TrimOutcome>,
+    /// Every prior: the aircraft file's constants the structure holds and the parameters
+    /// estimated under a prior, with how far the data moved them
+    /// ([`super::priors`]). Empty in older files.
+    #[serde(default)]
+    pub priors: Vec<super::priors::PriorSummary>,
 }
 
 /// One quasi-static speed derivative of [`FitSummary::speed_derivatives`].

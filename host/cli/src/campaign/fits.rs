@@ -23,9 +23,12 @@ impl Campaign<'_> {
     fn pipeline(&self) -> Pipeline<'_> {
         Pipeline {
             dir: self.dir(),
-            vehicle: &self.args.vehicle,
+            vehicle: self.args.priors_vehicle(),
             seed: self.args.seed,
-            trim_balance: self.args.trim_balance.for_vehicle(&self.args.vehicle),
+            trim_balance: self
+                .args
+                .trim_balance
+                .for_vehicle(self.args.priors_vehicle()),
         }
     }
 

@@ -305,6 +305,7 @@ mod tests {
             amplitude: AmplitudeArg::Adaptive,
             fc: CampaignLink::InProcess,
             quiet: true,
+            priors: None,
         };
         let run = Campaign::new(&args);
         let sweeps = run

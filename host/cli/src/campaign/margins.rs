@@ -113,6 +113,7 @@ mod tests {
             amplitude: AmplitudeArg::Fixed,
             fc: CampaignLink::InProcess,
             quiet: true,
+            priors: None,
         };
         let mut run = Campaign::new(&args);
         run.stage(Stage::Setup, Campaign::set_up).unwrap();

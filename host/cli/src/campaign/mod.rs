@@ -104,6 +104,12 @@ pub struct CampaignArgs {
     /// record's test (axis, input, mode, seed, band, length, amplitude).
     #[arg(long, default_value = "in-process", value_name = "LINK", value_parser = CampaignLink::parse)]
     pub fc: CampaignLink,
+    /// The aircraft file whose a-priori knowledge the identification takes (its 9-DOF
+    /// structure's constants and priors, valid-range source, trim balance) instead of
+    /// --vehicle's; the simulator still flies --vehicle, and the truth is its. For
+    /// measuring what a wrong prior does (docs/decisions/2026-11-27-priors-with-sigma.md).
+    #[arg(long, value_name = "NAME|FILE", value_parser = Vehicle::parse)]
+    pub priors: Option<Vehicle>,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -117,6 +123,12 @@ impl CampaignArgs {
         } else {
             PAPER_T_REC_S
         }
+    }
+
+    /// The aircraft the identification takes its a-priori knowledge from: `--priors`,
+    /// else the one flown.
+    pub fn priors_vehicle(&self) -> &Vehicle {
+        self.priors.as_ref().unwrap_or(&self.vehicle)
     }
 
     /// Seed of the held-out doublets: another seed than the fit data's, so that the

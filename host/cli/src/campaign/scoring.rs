@@ -75,7 +75,7 @@ impl Campaign<'_> {
         write_model(
             &self.dir().join(files::MODEL_9DOF),
             &document,
-            &vehicle.file_constants()?,
+            &self.args.priors_vehicle().file_constants()?,
         )?;
         Ok(((), line))
     }

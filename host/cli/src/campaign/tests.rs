@@ -37,6 +37,7 @@ fn a_failed_stage_keeps_the_previous_campaign_and_its_own_files() {
         amplitude: AmplitudeArg::Fixed,
         fc: CampaignLink::InProcess,
         quiet: true,
+        priors: None,
     };
     let mut run = Campaign::new(&args);
     run.stage(Stage::Setup, Campaign::set_up).unwrap();

@@ -28,6 +28,7 @@ use sysid::models;
 use crate::artifacts::aircraft_constants::write_model;
 use crate::artifacts::files;
 use crate::artifacts::flown::LATERAL;
+use crate::artifacts::priors::prior_summaries;
 use crate::artifacts::summary::{
     FitSummary, PairSummary, ParameterSummary, SpeedDerivativeSummary, VerifySummary,
 };
@@ -256,7 +257,8 @@ impl Pipeline<'_> {
             &result.to_document(),
             &self.vehicle.file_constants()?,
         )?;
-        let summary = fit_summary(&result, six.average_cost);
+        let mut summary = fit_summary(&result, six.average_cost);
+        summary.priors = prior_summaries(&result, &self.vehicle.file_constants()?);
         let line = format!(
             "{}: J_ave {:.1}, {} reduction step(s)",
             result.structure.name,
@@ -377,6 +379,8 @@ fn fit_summary(result: &FitResult, start_cost_ave: f64) -> FitSummary {
         poles_at_origin: identified_modes.as_deref().ok().map(poles_at_origin),
         speed_derivatives: speed_derivatives(&result.model, None),
         trim: result.trim.clone(),
+        // The caller adds them (it knows the aircraft file).
+        priors: Vec::new(),
     }
 }
 

@@ -116,13 +116,21 @@ fn an_aircraft_file_is_simulated_flown_and_identified_with_its_own_numbers() {
         json(&out.join("truth-model9.json"))["vehicle"],
         name.as_str()
     );
-    // The fit's servo prior is the file's 51 rad/s, not the preset's 60.
+    // The fit's servo prior is the file's 51 rad/s (σ the default 20 %), not the preset's
+    // 60; the servo the model carries is its estimate under that prior.
     let model = json(&out.join("model9.json"));
+    let parameters = model["parameters"].as_array().unwrap();
+    let omega = parameters
+        .iter()
+        .find(|p| p["name"] == "servo_omega")
+        .expect("the TREX hybrid's servo ω_n");
+    assert_eq!(omega["prior"]["value"], 51.0, "{omega}");
+    assert!((omega["prior"]["sigma"].as_f64().unwrap() - 10.2).abs() < 1e-12);
     let actuators = model["actuators"]
         .as_array()
         .expect("the TREX hybrid's servos");
     let servo = actuators.iter().find(|a| !a.is_null()).expect("a servo");
-    assert_eq!(servo["natural_frequency_rad_s"], 51.0, "{servo}");
+    assert_eq!(servo["natural_frequency_rad_s"], omega["value"], "{servo}");
     // The file's σ reaches the constants it enters: the mass, written 5.6 ± 0.05 kg, makes
     // M/I_yy = 5.6/0.48 uncertain by 0.05/0.48; the hub height has no σ in the file.
     let constants = model["aircraft_constants"]

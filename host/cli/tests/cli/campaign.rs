@@ -393,6 +393,18 @@ fn quick_campaign_report_and_errors() {
     let message = one_line_failure(&sweephold(&["report", out.to_str().unwrap()]));
     assert!(message.contains("model9.json"), "{message}");
 
+    // A priors file that does not read: one line, before anything is flown.
+    let missing = dir.join("no-such-aircraft.toml");
+    let message = one_line_failure(&sweephold(&[
+        "campaign",
+        "--priors",
+        missing.to_str().unwrap(),
+        "--out",
+        dir.join("never").to_str().unwrap(),
+    ]));
+    assert!(message.contains("--priors"), "{message}");
+    assert!(!dir.join("never").exists());
+
     // An output folder that cannot be created (its parent is a file).
     let blocker = dir.join("file");
     std::fs::write(&blocker, "x").unwrap();

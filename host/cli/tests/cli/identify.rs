@@ -271,6 +271,32 @@ fn identify_fits_and_verifies_a_board_log_with_every_test_listed_and_no_truth() 
         .iter()
         .all(|p| p["truth"].is_null() && p["error_percent"].is_null()));
     assert_eq!(fit["structure"], "trex700l-9dof-hybrid");
+    // Every prior: the servo's ω_n estimated under the aircraft file's 60 rad/s (σ the
+    // default 20 %), the other constants held at the file's values.
+    let priors = fit["priors"].as_array().unwrap();
+    let prior = |name: &str| priors.iter().find(|p| p["name"] == name).unwrap();
+    let servo = prior("servo_omega");
+    assert_eq!(servo["estimated"], true, "{servo}");
+    assert_eq!(servo["constant"], "servo_natural_frequency");
+    assert_eq!(
+        (servo["file_value"].as_f64(), servo["sigma"].as_f64()),
+        (Some(60.0), Some(12.0))
+    );
+    let (estimate, moved) = (
+        servo["estimate"].as_f64().unwrap(),
+        servo["moved_sigma"].as_f64().unwrap(),
+    );
+    assert!((moved - (estimate - 60.0) / 12.0).abs() < 1e-9, "{servo}");
+    assert_eq!(servo["warning"], moved.abs() > 3.0);
+    let hub = prior("hub_height");
+    assert_eq!(hub["estimated"], false);
+    assert_eq!(hub["estimate"], hub["file_value"]);
+    assert!(
+        priors
+            .iter()
+            .all(|p| p["name"] != "servo_natural_frequency"),
+        "listed once"
+    );
 
     // Every test of the file is listed with what became of it; the sweeps give the
     // responses (lat, lon, ped, col), the doublets the verification, the aborted sweep

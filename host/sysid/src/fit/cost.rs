@@ -26,14 +26,16 @@
 //!
 //! and since ln T = ln|T| + j∠T: ∂|T|_dB = (20/ln 10)·Re(∂T/T), ∂∠T_deg = (180/π)·Im(∂T/T).
 //! Parameters enter entries linearly (`coef·θ`), so ∂T/∂θ sums `coef·∂T/∂entry` over the
-//! entries the parameter appears in.
+//! entries the parameter appears in. A parameter that is an actuator's ω or ζ enters
+//! through the factor A(s) = ω²/(s² + 2ζωs + ω²): ∂T/∂p = T·∂ ln A/∂p
+//! ([`actuator_log_derivative`]).
 
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
 use super::error::FitError;
-use super::model::Model;
+use super::model::{Actuator, Model};
 use super::structure::{MatrixName, ModelStructure, PairRange};
 use crate::document::{FrfDocument, PairResponse};
 
@@ -309,6 +311,11 @@ enum Occurrence {
         control: usize,
         coefficient: f64,
     },
+    /// The natural frequency (`damping` false) or damping of the control's actuator.
+    Actuator {
+        control: usize,
+        damping: bool,
+    },
 }
 
 /// Occurrences of each base parameter in the structure.
@@ -330,6 +337,16 @@ fn occurrences(structure: &ModelStructure) -> Vec<Vec<Occurrence>> {
                 control,
                 coefficient,
             });
+        }
+    }
+    for (control, indices) in structure.actuator_parameters.iter().enumerate() {
+        for (which, index) in indices.iter().enumerate() {
+            if let Some(&index) = index.as_ref() {
+                list[index].push(Occurrence::Actuator {
+                    control,
+                    damping: which == 1,
+                });
+            }
         }
     }
     list
@@ -398,6 +415,12 @@ pub fn residuals_and_jacobian(
                             coefficient,
                         } if control == input => -s * response * coefficient,
                         Occurrence::Delay { .. } => Complex64::new(0.0, 0.0),
+                        Occurrence::Actuator { control, damping } if control == input => {
+                            model.actuators[input].map_or(Complex64::new(0.0, 0.0), |a| {
+                                response * actuator_log_derivative(&a, s, damping)
+                            })
+                        }
+                        Occurrence::Actuator { .. } => Complex64::new(0.0, 0.0),
                     };
                 }
                 let relative = derivative * inverse;
@@ -408,6 +431,18 @@ pub fn residuals_and_jacobian(
         }
     }
     Ok((residual, jacobian))
+}
+
+/// ∂ ln A/∂ω (`damping` false) or ∂ ln A/∂ζ of A(s) = ω²/D, D = s² + 2ζωs + ω²:
+/// 2/ω − (2ζs + 2ω)/D and −2ωs/D. T carries A as a factor, so ∂T/∂p = T·∂ ln A/∂p.
+fn actuator_log_derivative(actuator: &Actuator, s: Complex64, damping: bool) -> Complex64 {
+    let (w, z) = (actuator.natural_frequency_rad_s, actuator.damping);
+    let d = s * s + s * (2.0 * z * w) + w * w;
+    if damping {
+        -(s * (2.0 * w)) / d
+    } else {
+        Complex64::new(2.0 / w, 0.0) - (s * (2.0 * z) + 2.0 * w) / d
+    }
 }
 
 /// J of each band and J_ave when `candidate` is scored against `reference`.

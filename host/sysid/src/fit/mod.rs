@@ -25,6 +25,7 @@ pub mod modes;
 pub mod optimizer;
 mod options;
 pub mod plausible;
+pub mod prior;
 pub mod reduce;
 pub mod report;
 mod result;

@@ -133,6 +133,7 @@ fn worst_parameter(
             p.status == ParameterStatus::Free
                 && !needed.contains(&p.name)
                 && !balanced.contains(&p.name)
+                && !has_prior(&result.structure, &p.name)
         })
     };
     let worst_by = |key: fn(&super::ParameterReport) -> f64| {
@@ -181,6 +182,14 @@ fn largest_shift(
             (bound > 0.0 && shift.is_finite()).then(|| (p.name.clone(), shift))
         })
         .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Whether `name` carries a prior: the prior informs it (its bounds are at most σ), and
+/// zero is no value for it (a servo's ω_n), so it is never dropped.
+fn has_prior(structure: &super::structure::ModelStructure, name: &str) -> bool {
+    structure
+        .parameter_index(name)
+        .is_some_and(|index| structure.parameters[index].prior.is_some())
 }
 
 /// Whether the structure's mass matrix M at its current values can be inverted.
@@ -382,6 +391,7 @@ u = "b"
             cramer_rao_percent: Some(cramer_rao_percent),
             insensitivity_percent: None,
             flags: Vec::new(),
+            prior: None,
         }
     }
 

@@ -138,6 +138,10 @@ pub struct ParameterReport {
     pub insensitivity_percent: Option<f64>,
     /// Guideline violations.
     pub flags: Vec<AccuracyFlag>,
+    /// The structure's prior of the parameter (value ± σ), when it has one; absent in
+    /// `model.json` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prior: Option<super::prior::Prior>,
 }
 
 /// The cost of one pair at the fitted model.
@@ -208,14 +212,22 @@ pub struct FitResult {
 }
 
 impl FitResult {
-    /// What the fit minimised, per pair: J_ave plus the trim balances' share
-    /// ([`Self::balance_cost`] over the number of pairs). J_ave without the balances.
+    /// What the fit minimised, per pair: J_ave plus the trim balances' and the priors'
+    /// shares ([`Self::balance_cost`], [`Self::prior_cost`]) over the number of pairs.
+    /// J_ave without them.
     pub fn objective(&self) -> f64 {
-        if self.balance_cost == 0.0 || self.pairs.is_empty() {
+        let extra = self.balance_cost + self.prior_cost();
+        if extra == 0.0 || self.pairs.is_empty() {
             self.average_cost
         } else {
-            self.average_cost + self.balance_cost / self.pairs.len() as f64
+            self.average_cost + extra / self.pairs.len() as f64
         }
+    }
+
+    /// The priors' share of the cost, Σ ((θ − θ_p)/σ)² over the free parameters with a
+    /// prior ([`super::prior`]; 0 without).
+    pub fn prior_cost(&self) -> f64 {
+        super::prior::cost(&self.structure, &self.values)
     }
 
     /// Value of a parameter (base or constrained) by name.
@@ -377,6 +389,7 @@ pub(super) fn parameter_reports(
                         cramer_rao_percent: Some(cramer_rao),
                         insensitivity_percent: Some(insensitivity),
                         flags,
+                        prior: parameter.prior,
                     }
                 }
                 None => ParameterReport {
@@ -390,6 +403,7 @@ pub(super) fn parameter_reports(
                     cramer_rao_percent: None,
                     insensitivity_percent: None,
                     flags: Vec::new(),
+                    prior: parameter.prior,
                 },
             }
         })
@@ -401,6 +415,7 @@ pub(super) fn parameter_reports(
         cramer_rao_percent: None,
         insensitivity_percent: None,
         flags: Vec::new(),
+        prior: None,
     }));
     reports
 }

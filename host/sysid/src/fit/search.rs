@@ -9,6 +9,7 @@ use super::cost::{self, PairGrid};
 use super::error::FitError;
 use super::optimizer;
 use super::options::FitOptions;
+use super::prior;
 use super::result::parameter_reports;
 use super::result::{FitResult, PairFit, StartOutcome};
 use super::structure::ModelStructure;
@@ -103,15 +104,18 @@ pub(super) fn search_minima(
         } else {
             let model = structure.model(&values)?;
             let r = DVector::from_vec(cost::residuals(&model, grids)?);
-            match &balance {
-                None => Ok((r, None)),
+            let r = match &balance {
+                None => r,
                 Some(balance) => {
                     let e = balance
                         .residuals(structure, &values)
                         .map_err(balance_error)?;
-                    Ok((stack(&r, &e), None))
+                    stack(&r, &e)
                 }
-            }
+            };
+            // The priors' residuals last (`prior`), as with the Jacobian.
+            let priors = prior::residuals_and_jacobian(structure, &values, &free).0;
+            Ok((stack(&r, &priors), None))
         }
     };
 
@@ -218,8 +222,10 @@ pub(super) fn finish_fit(
     // The pairs' residuals come first; the balances' (if any) after them.
     let costs = cost::pair_costs_from_residuals(grids, residual.as_slice());
     let pair_rows: usize = grids.iter().map(|g| 2 * g.omega.len()).sum();
+    // The priors' rows are the last ones (`prior::cost` gives their share).
+    let prior_rows = prior::count(structure, &free);
     let balance_cost = residual
-        .rows(pair_rows, residual.len() - pair_rows)
+        .rows(pair_rows, residual.len() - pair_rows - prior_rows)
         .norm_squared();
     let analysis = accuracy::analyse(&jacobian);
     let fitted_structure = structure.with_values(&values)?;
@@ -302,8 +308,9 @@ fn residuals_and_jacobian(
     balance: &Option<JointBalance>,
 ) -> Result<(DVector<f64>, DMatrix<f64>), FitError> {
     let (r, j) = cost::residuals_and_jacobian(structure, values, free, grids)?;
+    let priors = prior::residuals_and_jacobian(structure, values, free);
     let Some(balance) = balance else {
-        return Ok((r, j));
+        return Ok(prior::stack((r, j), priors));
     };
     let (e, je) = balance
         .residuals_and_jacobian(structure, values, free)
@@ -311,5 +318,5 @@ fn residuals_and_jacobian(
     let mut jacobian = DMatrix::zeros(j.nrows() + je.nrows(), free.len());
     jacobian.rows_mut(0, j.nrows()).copy_from(&j);
     jacobian.rows_mut(j.nrows(), je.nrows()).copy_from(&je);
-    Ok((stack(&r, &e), jacobian))
+    Ok(prior::stack((stack(&r, &e), jacobian), priors))
 }

@@ -239,6 +239,7 @@ mod tests {
                     cramer_rao_percent: None,
                     insensitivity_percent: None,
                     flags: Vec::new(),
+                    prior: None,
                 })
                 .collect(),
             pairs: Vec::new(),

@@ -71,5 +71,6 @@ pub fn fit_with_modes(
         poles_at_origin: Some(poles),
         speed_derivatives: Vec::new(),
         trim: None,
+        priors: Vec::new(),
     }
 }

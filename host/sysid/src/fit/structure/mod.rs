@@ -63,6 +63,29 @@ pub struct Parameter {
     pub upper: Option<f64>,
     /// Line of the definition in the structure file.
     pub line: usize,
+    /// A-priori value ± σ (`prior`, `sigma`): a weighted term of the cost
+    /// ([`crate::fit::prior`]).
+    pub prior: Option<Prior>,
+    /// The `[constants]` name the prior's value was given as (`prior =
+    /// "servo_natural_frequency"`), when it was a name: the a-priori constant this
+    /// parameter estimates.
+    pub prior_constant: Option<String>,
+}
+
+/// A parameter's prior: value ± one standard deviation.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Prior {
+    /// θ_p: the a-priori value.
+    pub value: f64,
+    /// σ > 0: its standard uncertainty, in the parameter's units.
+    pub sigma: f64,
+}
+
+impl Prior {
+    /// (θ − θ_p)/σ: how far `value` lies from the prior, in σ.
+    pub fn distance(&self, value: f64) -> f64 {
+        (value - self.value) / self.sigma
+    }
 }
 
 /// `constant + Σ coefficient·θ_k` over base-parameter indices.
@@ -189,9 +212,13 @@ pub struct ModelStructure {
     pub entries: Vec<MatrixEntry>,
     /// Delay τ per control \[s\], as expressions (constant 0 when not given).
     pub delays: Vec<ParameterExpression>,
-    /// Known actuator per control (`[actuators]`; `None` when not given): fixed, not
-    /// parameters.
+    /// Known actuator per control (`[actuators]`; `None` when not given), at the values
+    /// of the file (its numbers and constants; base parameters at their start values).
     pub actuators: Vec<Option<Actuator>>,
+    /// Per control, the base parameters (indices) that give its actuator's natural
+    /// frequency and damping when the file names parameters there: the model takes
+    /// them from the parameter values.
+    pub actuator_parameters: Vec<[Option<usize>; 2]>,
     /// Pairs to fit.
     pub pairs: Vec<PairSpec>,
     /// Clips every `auto` range to this band [rad/s] (e.g. 6-DOF fits stop below the
@@ -275,6 +302,16 @@ impl ModelStructure {
             model.delays[control] = delay.evaluate(values);
         }
         model.actuators = self.actuators.clone();
+        for (control, [frequency, damping]) in self.actuator_parameters.iter().enumerate() {
+            if let Some(actuator) = model.actuators[control].as_mut() {
+                if let Some(index) = *frequency {
+                    actuator.natural_frequency_rad_s = values[index];
+                }
+                if let Some(index) = *damping {
+                    actuator.damping = values[index];
+                }
+            }
+        }
         Ok(model)
     }
 

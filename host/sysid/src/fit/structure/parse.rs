@@ -9,7 +9,9 @@ use super::schema::{
     explain_syntax, line_of, Context, RawActuator, RawParameter, RawRange, RawRows, RawStructure,
     RawValue,
 };
-use super::validate::{check_band, check_every_parameter_is_used, check_sizes, file_constants};
+use super::validate::{
+    check_band, check_every_parameter_is_used, check_sizes, file_constants, parse_prior,
+};
 use super::{
     DerivedParameter, MatrixEntry, MatrixName, ModelStructure, PairRange, PairSpec, Parameter,
     ParameterExpression, ParameterKind,
@@ -169,13 +171,21 @@ impl ModelStructure {
                         lower: None,
                         upper: None,
                         line,
+                        prior: None,
+                        prior_constant: None,
                     });
                 }
                 RawParameter::Table(table) => {
                     let given = usize::from(table.start.is_some())
                         + usize::from(table.fixed.is_some())
                         + usize::from(table.expr.is_some());
-                    if given != 1 {
+                    let prior = parse_prior(table, &constants).map_err(|reason| bad(&reason))?;
+                    if prior.is_some() && (table.fixed.is_some() || table.expr.is_some()) {
+                        return Err(bad(
+                            "a parameter with a `prior` is free: `fixed` and `expr` do not go with it",
+                        ));
+                    }
+                    if given != 1 && !(given == 0 && prior.is_some()) {
                         return Err(bad("give exactly one of `start`, `fixed`, `expr`"));
                     }
                     for (label, number) in [
@@ -210,10 +220,12 @@ impl ModelStructure {
                         derived_forms.insert(name.clone(), form);
                         derived_order.push((name, line, value.span()));
                     } else {
-                        let (value, kind) = match (table.start, table.fixed) {
-                            (Some(start), None) => (start, ParameterKind::Free),
-                            (None, Some(fixed)) => (fixed, ParameterKind::Fixed),
-                            _ => unreachable!("exactly one of start/fixed was checked above"),
+                        let (value, kind) = match (table.start, table.fixed, prior) {
+                            (Some(start), None, _) => (start, ParameterKind::Free),
+                            (None, Some(fixed), _) => (fixed, ParameterKind::Fixed),
+                            // A prior alone: the fit starts from it.
+                            (None, None, Some(prior)) => (prior.value, ParameterKind::Free),
+                            _ => unreachable!("exactly one of start/fixed/prior was checked above"),
                         };
                         if table.min.is_some_and(|lo| value < lo)
                             || table.max.is_some_and(|hi| value > hi)
@@ -228,6 +240,11 @@ impl ModelStructure {
                             lower: table.min,
                             upper: table.max,
                             line,
+                            prior,
+                            prior_constant: match &table.prior {
+                                Some(RawValue::Expression(name)) => Some(name.trim().to_string()),
+                                _ => None,
+                            },
                         });
                     }
                 }
@@ -360,17 +377,35 @@ impl ModelStructure {
             delays[control] = resolve_value(value, &|| format!("delay of `{}`", key.get_ref()))?;
         }
         let mut actuators = vec![None; controls.len()];
+        let mut actuator_parameters = vec![[None, None]; controls.len()];
         for (key, value) in &raw.actuators {
             let control = context.index_of(&controls, key, "control")?;
-            actuators[control] = Some(actuator(context, key, value, &constants)?);
+            let (actuator, indices) =
+                actuator(context, key, value, &constants, &base_index, &parameters)?;
+            actuators[control] = Some(actuator);
+            actuator_parameters[control] = indices;
         }
+        // A parameter an actuator names is used (as a unit term of that actuator).
+        let actuator_terms: Vec<ParameterExpression> = actuator_parameters
+            .iter()
+            .flatten()
+            .flatten()
+            .map(|&index| ParameterExpression {
+                constant: 0.0,
+                terms: vec![(index, 1.0)],
+            })
+            .collect();
         check_every_parameter_is_used(
             context,
             &raw_parameters,
             &base_index,
             &derived_forms,
             referenced,
-            entries.iter().map(|entry| &entry.expression).chain(&delays),
+            entries
+                .iter()
+                .map(|entry| &entry.expression)
+                .chain(&delays)
+                .chain(&actuator_terms),
         )?;
 
         let auto_range_limit = match &raw.auto_range_limit {
@@ -462,6 +497,7 @@ impl ModelStructure {
             entries,
             delays,
             actuators,
+            actuator_parameters,
             pairs,
             auto_range_limit,
             default_output_states,
@@ -485,14 +521,17 @@ impl std::str::FromStr for ModelStructure {
     }
 }
 
-/// An `[actuators]` entry: each number given as a number or a constant's name, both
-/// finite and positive.
+/// An `[actuators]` entry: each number given as a number, a constant's name or a base
+/// parameter's name (then identified: its index is returned, and it needs `min > 0` so
+/// that the fit keeps the actuator a stable lag), all finite and positive.
 fn actuator(
     context: &Context,
     control: &Spanned<String>,
     raw: &Spanned<RawActuator>,
     constants: &BTreeMap<String, f64>,
-) -> Result<Actuator, StructureError> {
+    base_index: &HashMap<String, usize>,
+    parameters: &[Parameter],
+) -> Result<(Actuator, [Option<usize>; 2]), StructureError> {
     let bad = |reason: String| {
         context.error(
             control.span(),
@@ -503,16 +542,31 @@ fn actuator(
         )
     };
     let number = |value: &RawValue, what: &str| match value {
-        RawValue::Number(x) => Ok(*x),
-        RawValue::Expression(name) => constants.get(name.trim()).copied().ok_or_else(|| {
-            bad(format!(
-                "{what} `{name}` is neither a number nor a name under [constants]"
-            ))
-        }),
+        RawValue::Number(x) => Ok((*x, None)),
+        RawValue::Expression(name) => {
+            let name = name.trim();
+            if let Some(&index) = base_index.get(name) {
+                let parameter = &parameters[index];
+                if !parameter.lower.is_some_and(|lo| lo > 0.0) {
+                    return Err(bad(format!(
+                        "{what} `{name}` is a parameter: give it `min` > 0"
+                    )));
+                }
+                return Ok((parameter.value, Some(index)));
+            }
+            constants.get(name).map(|&x| (x, None)).ok_or_else(|| {
+                bad(format!(
+                    "{what} `{name}` is neither a number nor a name under [constants] or [parameters]"
+                ))
+            })
+        }
     };
+    let (frequency, frequency_index) =
+        number(&raw.get_ref().natural_frequency, "natural_frequency")?;
+    let (damping, damping_index) = number(&raw.get_ref().damping, "damping")?;
     let actuator = Actuator {
-        natural_frequency_rad_s: number(&raw.get_ref().natural_frequency, "natural_frequency")?,
-        damping: number(&raw.get_ref().damping, "damping")?,
+        natural_frequency_rad_s: frequency,
+        damping,
     };
     if !actuator.is_valid() {
         return Err(bad(format!(
@@ -520,5 +574,5 @@ fn actuator(
             actuator.natural_frequency_rad_s, actuator.damping
         )));
     }
-    Ok(actuator)
+    Ok((actuator, [frequency_index, damping_index]))
 }

@@ -23,6 +23,11 @@ pub(super) struct RawParameterTable {
     pub(super) expr: Option<String>,
     pub(super) min: Option<f64>,
     pub(super) max: Option<f64>,
+    /// A-priori value (a number or a constant's name): the parameter is free, starts
+    /// there unless `start` says otherwise, and the cost holds it to `prior ± sigma`.
+    pub(super) prior: Option<RawValue>,
+    /// The prior's standard uncertainty (a number or a constant's name), > 0.
+    pub(super) sigma: Option<RawValue>,
     #[allow(dead_code)]
     pub(super) description: Option<String>,
 }
@@ -42,7 +47,7 @@ pub(super) enum RawRange {
 }
 
 /// `[actuators]` entry: `lat = { natural_frequency = 60.0, damping = "servo_damping" }`,
-/// numbers or names of `[constants]`.
+/// numbers, names of `[constants]` or names of base parameters (identified then).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawActuator {
@@ -98,12 +103,13 @@ pub(super) struct RawStructure {
 pub(super) fn explain_syntax(message: &str) -> String {
     let expected = if message.contains("RawParameter") {
         "a parameter is a number (free, its start value) or a table with one of \
-         `start`, `fixed`, `expr` (and optional `min`, `max`, `description`)"
+         `start`, `fixed`, `expr` (and optional `min`, `max`, `prior` with `sigma`, \
+         `description`)"
     } else if message.contains("RawValue") {
         "a matrix entry or delay is a number or a string expression such as \"-tau_f\""
     } else if message.contains("RawActuator") {
         "an actuator is a table { natural_frequency = …, damping = … } of numbers or \
-         names of constants"
+         names of constants or parameters"
     } else if message.contains("RawRange") {
         "a range is \"auto\" or [lo, hi] in rad/s"
     } else {

@@ -5,9 +5,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use toml::Spanned;
 
-use super::schema::{Context, RawParameter, RawStructure};
+use super::schema::{Context, RawParameter, RawParameterTable, RawStructure, RawValue};
 use super::{
-    ParameterExpression, MAX_CONTROLS, MAX_OUTPUTS, MAX_PAIRS, MAX_PARAMETERS, MAX_STATES,
+    ParameterExpression, Prior, MAX_CONTROLS, MAX_OUTPUTS, MAX_PAIRS, MAX_PARAMETERS, MAX_STATES,
 };
 use crate::fit::error::{StructureError, StructureProblem};
 use crate::fit::expression::LinearForm;
@@ -153,5 +153,36 @@ pub(super) fn check_every_parameter_is_used<'e>(
                 unused.iter().map(|key| key.get_ref().clone()).collect(),
             ),
         )),
+    }
+}
+
+/// A parameter table's `prior` ± `sigma` (each a number or a constant's name): both or
+/// neither, finite, σ > 0.
+pub(super) fn parse_prior(
+    table: &RawParameterTable,
+    constants: &BTreeMap<String, f64>,
+) -> Result<Option<Prior>, String> {
+    let number = |value: &RawValue, what: &str| match value {
+        RawValue::Number(x) => Ok(*x),
+        RawValue::Expression(name) => constants.get(name.trim()).copied().ok_or_else(|| {
+            format!("{what} `{name}` is neither a number nor a name under [constants]")
+        }),
+    };
+    match (&table.prior, &table.sigma) {
+        (None, None) => Ok(None),
+        (Some(value), Some(sigma)) => {
+            let prior = Prior {
+                value: number(value, "prior")?,
+                sigma: number(sigma, "sigma")?,
+            };
+            if !(prior.value.is_finite() && prior.sigma.is_finite() && prior.sigma > 0.0) {
+                return Err(format!(
+                    "prior {} ± {}: the value must be finite and sigma finite and positive",
+                    prior.value, prior.sigma
+                ));
+            }
+            Ok(Some(prior))
+        }
+        _ => Err("give `prior` and `sigma` together".to_string()),
     }
 }
