@@ -137,6 +137,18 @@ pub fn check_budgets(ws: &Workspace, elf: &Path) -> StepResult {
     }
     let table = String::from_utf8_lossy(&output.stdout);
     print!("{table}");
+    let (flash, ram) = flash_and_ram(&table)?;
+    println!(
+        "flash text+data {flash} B (limit 262144, tight 147456), static RAM data+bss {ram} B (limit 98304, tight 16384)"
+    );
+    match over_budget(flash, ram) {
+        Some(why) => Err(format!("{}: {why}", elf.display())),
+        None => Ok(()),
+    }
+}
+
+/// Flash (text + data) and static RAM (data + bss) in bytes, from `size`'s table.
+fn flash_and_ram(table: &str) -> Result<(u64, u64), String> {
     let sizes: Vec<u64> = table
         .lines()
         .last()
@@ -148,21 +160,55 @@ pub fn check_budgets(ws: &Workspace, elf: &Path) -> StepResult {
                 .map_err(|_| format!("cannot read size's output: {table}"))
         })
         .collect::<Result<_, _>>()?;
-    let [text, data, bss] = sizes[..] else {
-        return Err(format!("cannot read size's output: {table}"));
-    };
-    let (flash, ram) = (text + data, data + bss);
-    println!(
-        "flash text+data {flash} B (limit 262144, tight 147456), static RAM data+bss {ram} B (limit 98304, tight 16384)"
-    );
+    match sizes[..] {
+        [text, data, bss] => Ok((text + data, data + bss)),
+        _ => Err(format!("cannot read size's output: {table}")),
+    }
+}
+
+/// The first budget an image breaks, if any.
+fn over_budget(flash: u64, ram: u64) -> Option<&'static str> {
     let budgets = [
         (flash, 262_144, "image flash over 256 KiB"),
         (ram, 98_304, "static RAM over 96 KiB"),
         (flash, 147_456, "image flash over the tight 144 KiB"),
         (ram, 16_384, "static RAM over the tight 16 KiB"),
     ];
-    match budgets.iter().find(|(used, limit, _)| used > limit) {
-        Some((_, _, why)) => Err(format!("{}: {why}", elf.display())),
-        None => Ok(()),
+    budgets
+        .iter()
+        .find(|(used, limit, _)| used > limit)
+        .map(|&(_, _, why)| why)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn size_table_gives_flash_and_ram() {
+        let table = "   text\t   data\t    bss\t    dec\t    hex\tfilename\n 140000\t    880\t   6744\t 147624\t  240a8\tsweephold-fc\n";
+        assert_eq!(flash_and_ram(table), Ok((140_880, 7_624)));
+        assert!(flash_and_ram("size: nothing\n").is_err());
+    }
+
+    #[test]
+    fn budgets_name_the_first_one_broken() {
+        assert_eq!(over_budget(140_880, 7_624), None);
+        assert_eq!(
+            over_budget(147_457, 7_624),
+            Some("image flash over the tight 144 KiB")
+        );
+        assert_eq!(
+            over_budget(140_880, 16_385),
+            Some("static RAM over the tight 16 KiB")
+        );
+        assert_eq!(
+            over_budget(300_000, 100_000),
+            Some("image flash over 256 KiB")
+        );
+        assert_eq!(
+            over_budget(100_000, 100_000),
+            Some("static RAM over 96 KiB")
+        );
     }
 }
