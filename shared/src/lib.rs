@@ -34,6 +34,7 @@ pub mod param_frames;
 pub mod servo_frames;
 #[cfg(feature = "synthetic")]
 pub mod synthetic;
+pub mod vocabulary;
 
 pub use codec::{encode, MAX_FRAME_LEN};
 pub use decoder::{tick_step, DecodeStats, Decoder, FrameError, TickStep};

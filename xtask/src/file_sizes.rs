@@ -1,9 +1,7 @@
 //! `cargo xtask file-sizes`: no non-test Rust source file over its size limit.
 //!
-//! The limits, by where a file lives (the first matching rule of [`RULES`] wins):
-//! `firmware/` and `shared/` 900 lines (their
-//! larger files are split with the firmware's regrouping, issue 36, item 5); `host/` and
-//! every other folder 600 lines. With a fixed limit, that one limit applies to every file.
+//! The limit is 600 lines for every crate ([`RULES`]: the first matching rule wins, so a
+//! folder may be given its own). With a fixed limit, that one limit applies to every file.
 //!
 //! A file is a test file when it is named `tests.rs`, `*_tests.rs` or `test_support.rs`,
 //! or lives in a `tests/`, `benches/` or `fuzz/` folder. Build output (`target/`,
@@ -16,11 +14,7 @@ use std::path::Path;
 use crate::report::Report;
 
 /// (path prefix, limit in lines): the first match wins; the last rule matches every path.
-pub const RULES: &[(&str, usize)] = &[
-    ("firmware/", 900),
-    ("shared/", 900),
-    ("", 600),
-];
+pub const RULES: &[(&str, usize)] = &[("", 600)];
 
 /// Checks every `.rs` file under `root` against `fixed` or, without it, [`RULES`].
 pub fn check(root: &Path, fixed: Option<usize>) -> std::io::Result<Report> {
@@ -35,25 +29,26 @@ pub fn check(root: &Path, fixed: Option<usize>) -> std::io::Result<Report> {
     if !report.failed {
         report.line(match fixed {
             Some(limit) => format!("no non-test source file over {limit} lines"),
-            None => {
-                let rules: Vec<String> = RULES
-                    .iter()
-                    .map(|(prefix, limit)| {
-                        format!(
-                            "{} {limit}",
-                            if prefix.is_empty() {
+            None => match RULES {
+                [("", limit)] => format!("no non-test source file over {limit} lines"),
+                rules => {
+                    let rules: Vec<String> = rules
+                        .iter()
+                        .map(|(prefix, limit)| {
+                            let place = if prefix.is_empty() {
                                 "elsewhere"
                             } else {
                                 prefix
-                            }
-                        )
-                    })
-                    .collect();
-                format!(
-                    "no non-test source file over its limit ({})",
-                    rules.join(", ")
-                )
-            }
+                            };
+                            format!("{place} {limit}")
+                        })
+                        .collect();
+                    format!(
+                        "no non-test source file over its limit ({})",
+                        rules.join(", ")
+                    )
+                }
+            },
         });
     }
     Ok(report)
@@ -126,8 +121,8 @@ mod tests {
     fn limits_follow_the_first_matching_rule() {
         assert_eq!(limit_of("host/cli/src/fly/mod.rs"), 600);
         assert_eq!(limit_of("host/cli/src/fly/link.rs"), 600);
-        assert_eq!(limit_of("firmware/src/app/mod.rs"), 900);
-        assert_eq!(limit_of("shared/src/lib.rs"), 900);
+        assert_eq!(limit_of("firmware/src/app/mod.rs"), 600);
+        assert_eq!(limit_of("shared/src/lib.rs"), 600);
         assert_eq!(limit_of("xtask/src/main.rs"), 600);
     }
 

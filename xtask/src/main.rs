@@ -35,8 +35,7 @@ enum Task {
     /// No two modules of a crate import each other; `sweephold identify`'s code names
     /// neither the simulator nor its truth.
     ImportCycles,
-    /// No non-test source file over its size limit (600 lines in host/ and elsewhere, 900
-    /// in firmware/ and shared/).
+    /// No non-test source file over its size limit (600 lines, every crate).
     FileSizes {
         /// One limit for every file instead of the rules.
         limit: Option<usize>,
@@ -82,9 +81,7 @@ impl Task {
             Task::Fmt => "cargo fmt --check",
             Task::Links => "docs: no dead link, nothing outside the project",
             Task::ImportCycles => "no import circle between the modules of a crate",
-            Task::FileSizes { .. } => {
-                "no non-test source file over its size limit (600 lines in host/, 900 in firmware/ and shared/)"
-            }
+            Task::FileSizes { .. } => "no non-test source file over 600 lines",
             Task::Clippy => "clippy (host workspace)",
             Task::FwClippy => "clippy (firmware, thumbv7em-none-eabihf)",
             Task::Doc => "cargo doc (warnings are errors)",

@@ -56,9 +56,11 @@
 
 pub mod airborne;
 pub mod arming;
+mod config;
 pub mod cues;
 pub mod failsafe;
 pub mod inputs;
+mod mode_command;
 pub mod modes;
 pub mod outputs;
 pub mod pilot_mode;
@@ -91,6 +93,7 @@ use test_list::{TestList, TestListError};
 use throttle::{Throttle, ThrottleSettings};
 
 pub use arming::{CheckFailure, Refusal};
+pub use config::{AppConfig, AppConfigError};
 pub use failsafe::ImuProblem;
 pub use inputs::{ImuFaultKind, ImuInput, ImuStatus, ModeSwitch, RcInput, Receiver, TickInput};
 pub use modes::Mode;
@@ -107,124 +110,6 @@ pub const SAFE_COMMAND: Controls = Controls {
     ped: 0.0,
     col: 0.0,
 };
-
-/// Everything the board application needs.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AppConfig {
-    /// The sequencer's configuration (rate, test, hold gains, abort limits, mixer).
-    pub flight: Config,
-    /// Stabilised pilot mode.
-    pub pilot: PilotModeGains,
-    /// Throttle channel.
-    pub throttle: ThrottleSettings,
-    /// Failsafes.
-    pub failsafe: FailsafeSettings,
-    /// The airborne and landed rule.
-    pub airborne: AirborneSettings,
-    /// The test list the selector channel chooses from (unused without one).
-    pub tests: TestList,
-}
-
-impl AppConfig {
-    /// TREX 700L: [`Config::trex700l_default`], [`PilotModeGains::trex700l`], standard
-    /// throttle and failsafe settings, [`AirborneSettings::trex700l`], the preset's
-    /// campaign as the test list ([`TestList::campaign`]).
-    pub const fn trex700l(primary: Axis) -> Self {
-        AppConfig {
-            flight: Config::trex700l_default(primary),
-            pilot: PilotModeGains::trex700l(),
-            throttle: ThrottleSettings::standard(),
-            failsafe: FailsafeSettings::standard(),
-            airborne: AirborneSettings::trex700l(),
-            tests: TestList::campaign(VehicleId::Trex700l),
-        }
-    }
-
-    /// The preset of `vehicle` ([`AppConfig::bo105`], [`AppConfig::trex700l`]).
-    pub const fn preset(vehicle: VehicleId, primary: Axis) -> Self {
-        match vehicle {
-            VehicleId::Bo105 => AppConfig::bo105(primary),
-            VehicleId::Trex700l => AppConfig::trex700l(primary),
-        }
-    }
-
-    /// Bo-105 (simulator): [`Config::bo105_default`], [`PilotModeGains::bo105`],
-    /// standard throttle and failsafe settings, [`AirborneSettings::bo105`], the
-    /// preset's campaign as the test list.
-    pub const fn bo105(primary: Axis) -> Self {
-        AppConfig {
-            flight: Config::bo105_default(primary),
-            pilot: PilotModeGains::bo105(),
-            throttle: ThrottleSettings::standard(),
-            failsafe: FailsafeSettings::standard(),
-            airborne: AirborneSettings::bo105(),
-            tests: TestList::campaign(VehicleId::Bo105),
-        }
-    }
-
-    /// Check the application's own settings (the sequencer's are checked by
-    /// [`FlightController::new`]).
-    pub fn validate(&self) -> Result<(), AppConfigError> {
-        if !self.pilot.is_valid() {
-            return Err(AppConfigError::PilotGainsInvalid);
-        }
-        if !self.throttle.is_valid() {
-            return Err(AppConfigError::ThrottleInvalid);
-        }
-        if !self.failsafe.is_valid() {
-            return Err(AppConfigError::FailsafeInvalid);
-        }
-        if !self.airborne.is_valid() {
-            return Err(AppConfigError::AirborneInvalid);
-        }
-        // The entries are checked as tests of this configuration: it must be valid first.
-        self.flight.validate().map_err(AppConfigError::Flight)?;
-        self.tests
-            .validate(&self.flight)
-            .map_err(AppConfigError::TestList)
-    }
-}
-
-/// Why a configuration was refused.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum AppConfigError {
-    /// The sequencer refused its configuration.
-    Flight(ConfigError),
-    /// A pilot-mode gain or limit is out of range.
-    PilotGainsInvalid,
-    /// A throttle setting is out of range.
-    ThrottleInvalid,
-    /// A failsafe setting is out of range.
-    FailsafeInvalid,
-    /// An airborne-rule setting is out of range.
-    AirborneInvalid,
-    /// The test list's slices are out of range or an entry makes a refused test.
-    TestList(TestListError),
-}
-
-impl AppConfigError {
-    /// Human-readable explanation.
-    pub const fn message(self) -> &'static str {
-        match self {
-            AppConfigError::Flight(error) => error.message(),
-            AppConfigError::PilotGainsInvalid => "pilot-mode gains or limits invalid",
-            AppConfigError::ThrottleInvalid => "throttle settings invalid",
-            AppConfigError::FailsafeInvalid => "failsafe settings invalid",
-            AppConfigError::AirborneInvalid => "airborne settings invalid",
-            AppConfigError::TestList(error) => error.message(),
-        }
-    }
-}
-
-impl core::fmt::Display for AppConfigError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.message())
-    }
-}
-
-#[cfg(any(test, feature = "std"))]
-impl std::error::Error for AppConfigError {}
 
 /// Running mean of the pilot's raw sticks during a trim capture.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -700,133 +585,5 @@ impl BoardApp {
     fn held_collective(&self) -> Option<f32> {
         self.loss
             .map(|hold| hold.collective(&self.config.failsafe, self.dt_s))
-    }
-
-    /// The command of the current mode (for Test: the sequencer's pilot input), the
-    /// loops' stick mode if they produced it, and the test switch the sequencer sees.
-    fn mode_command(
-        &mut self,
-        rc: Option<&RcInput>,
-        imu: &ImuView,
-        integrate: bool,
-    ) -> (Controls, Option<StickMode>, bool) {
-        let sensors = LoopSensors {
-            rates: imu.rates,
-            attitude: imu.attitude,
-        };
-        match self.mode {
-            Mode::Disarmed => (SAFE_COMMAND, None, false),
-            Mode::Pilot => {
-                let (command, mode) = self.fly_loops(rc, &sensors, integrate);
-                (command, Some(mode), false)
-            }
-            Mode::RcFailsafe => {
-                let (command, mode) = self.fly_loops(None, &sensors, integrate);
-                (command, Some(mode), false)
-            }
-            Mode::ImuFailsafe => {
-                let usable = rc.filter(|_| self.loss.is_none());
-                let collective = self
-                    .held_collective()
-                    .or(usable.map(|frame| frame.sticks.col))
-                    .unwrap_or(self.last_command.col);
-                let command = failsafe::imu_failsafe_command(
-                    self.imu_trim,
-                    usable.map(|frame| &frame.sticks),
-                    self.config.failsafe.imu_direct_authority,
-                    collective,
-                );
-                (command, None, false)
-            }
-            Mode::Test => {
-                let phase = self.fc.phase();
-                let test_switch = rc.is_some_and(|frame| frame.test_switch);
-                if is_excitation(phase) {
-                    let [t_lat, t_lon, t_ped, t_col] = self.fc.trim().sticks;
-                    let trim = [t_lat, t_lon, t_ped, t_col];
-                    let raw = rc.map_or(trim, |frame| frame.sticks.to_array());
-                    let reference = self.stick_reference.mean().unwrap_or(raw);
-                    let mut feed = [0.0; 4];
-                    for (((feed, trim), raw), reference) in
-                        feed.iter_mut().zip(trim).zip(raw).zip(reference)
-                    {
-                        *feed = clamp_finite(trim + (raw - reference), 1.0);
-                    }
-                    (Controls::from_array(feed), None, test_switch)
-                } else {
-                    if matches!(phase, Phase::Armed | Phase::TrimCapture) {
-                        if let Some(frame) = rc {
-                            self.stick_reference.add(&frame.sticks);
-                        }
-                    }
-                    let (command, mode) = self.fly_loops(rc, &sensors, integrate);
-                    (command, Some(mode), test_switch)
-                }
-            }
-        }
-    }
-
-    /// One step of the pilot-mode loops: on the pilot's sticks (`rc`), or, without
-    /// them, the receiver failsafe's demand (trim attitude, heading held, held
-    /// collective).
-    fn fly_loops(
-        &mut self,
-        rc: Option<&RcInput>,
-        sensors: &LoopSensors,
-        integrate: bool,
-    ) -> (Controls, StickMode) {
-        let gains = &self.config.pilot;
-        let (demand, mode) = match rc {
-            Some(frame) => {
-                let switched = gains
-                    .switch_modes
-                    .get(frame.mode.index())
-                    .copied()
-                    .unwrap_or(StickMode::Rate);
-                let mode = if sensors.attitude.is_some() {
-                    switched
-                } else {
-                    StickMode::Rate
-                };
-                (Demand::from_sticks(&frame.sticks, mode, gains), mode)
-            }
-            None => {
-                let (phi, theta) = self.trim.map_or((0.0, 0.0), |trim| (trim.phi, trim.theta));
-                let collective = self.held_collective().unwrap_or(self.last_command.col);
-                let (roll, pitch, mode) = if sensors.attitude.is_some() {
-                    (
-                        AxisDemand::Angle(phi),
-                        AxisDemand::Angle(theta),
-                        StickMode::Level,
-                    )
-                } else {
-                    (
-                        AxisDemand::Rate(0.0),
-                        AxisDemand::Rate(0.0),
-                        StickMode::Rate,
-                    )
-                };
-                (
-                    Demand {
-                        roll,
-                        pitch,
-                        pedal: 0.0,
-                        collective,
-                    },
-                    mode,
-                )
-            }
-        };
-        let command = self.loops.step(
-            gains,
-            &self.factors,
-            &demand,
-            sensors,
-            &self.last_command,
-            integrate,
-            self.preload,
-        );
-        self.preload = false;
-        (command, mode)
     }
 }

@@ -10,7 +10,7 @@
 //! points — identify takes a file (`--trim-points`) or, without one, fits the hybrid's
 //! `trim_derived` parameters like the others and says so in `summary.json`. Nothing in
 //! this folder imports the simulator (`rotorsim`) or its truth (`truth`); CI checks it
-//! (`docs/import_cycles.py`).
+//! (`cargo xtask import-cycles`).
 
 pub mod stages;
 pub mod summary;
