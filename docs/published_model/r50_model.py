@@ -30,6 +30,8 @@ identified. The model takes the damper's correction as subtracted from the pedal
 Nrfb = -Nped (the published values have |Nrfb| = Nped), which fixes that scale. The other
 32 entries are free (the issue counted 33 with Nrfb free).
 """
+import os
+
 import numpy as np
 
 G_FT = 32.17  # ft/s^2
@@ -38,18 +40,20 @@ STATES = ["u", "v", "p", "q", "phi", "theta", "a", "b", "c", "d", "w", "r", "rfb
 CONTROLS = ["lat", "lon", "ped", "col"]
 MEASURED = ["u", "v", "w", "p", "q", "r", "phi", "theta"]
 
-# The 32 free parameters, in the order the structure file lists them.
-PUBLISHED = {
-    "Xu": -0.0505, "Yv": -0.154,
-    "Lu": -0.144, "Lv": 0.143, "Lb": 166.0,
-    "Mu": -0.0561, "Mv": -0.0585, "Ma": 82.6,
-    "tau_f": 0.0991, "Ab": -0.189, "Ac": 0.644, "Ba": 0.368, "Bd": 0.71,
-    "Alat": 0.0313, "Alon": -0.1, "Blat": 0.14, "Blon": 0.0138,
-    "tau_s": 0.342, "Clon": -0.259, "Dlat": 0.273,
-    "Za": -131.0, "Zb": -29.6, "Zw": -0.614, "Zr": 0.93, "Zcol": -45.8,
-    "Np": -3.53, "Nw": 0.0634, "Nr": -4.13, "Nped": 33.1, "Ncol": -3.33,
-    "Kr": 2.16, "Krfb": -8.26,
-}
+# The 32 free parameters, in the order the structure file lists them (published_values.csv).
+def _read_published():
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "published_values.csv")
+    values = {}
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or line.startswith("name,"):
+                continue
+            name, value = line.strip().split(",")
+            values[name] = float(value)
+    return values
+
+
+PUBLISHED = _read_published()
 
 
 def matrices(p):

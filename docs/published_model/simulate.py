@@ -8,7 +8,7 @@ model is unstable in hover (its hover oscillation), so it flies under a fixed at
 yaw-rate and heave hold (GAINS below, closed-loop poles all left of -0.3 /s). In each record
 that control carries an exponential sweep, 0.3 to 40 rad/s over 300 s (after 3 s of trim),
 added to the hold's command; the other controls carry the hold's command plus small
-band-limited random noise of half its RMS (a fixed seed, also in noise-free data: without it the off-axis
+band-limited random noise, its RMS half the sweep amplitude (a fixed seed, also in noise-free data: without it the off-axis
 controls would be the hold's exact function of the response, and the multi-input
 conditioning of `frf` would have nothing independent to work with). The recorded controls
 are what the model received.

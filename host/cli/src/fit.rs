@@ -71,11 +71,15 @@ pub struct FitArgs {
     /// lower J_ave of the start sets is kept.
     #[arg(long)]
     pub equation_error_start: bool,
-    /// Most optimizer starts, 1–64: the structure's start values and two perturbations of
-    /// them (±30 %) explore, later starts perturb the best minimum so far (±10 %); stops
-    /// earlier once a minimum is found twice.
-    #[arg(long, default_value_t = 8, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
-    pub max_starts: usize,
+    /// A budget of optimizer starts, 1–64, all spent: the structure's start values, then
+    /// three quarters of the starts drawn across the parameter box (each free value's
+    /// magnitude log-uniform from a tenth to ten times its start value, sign kept, bounds
+    /// honoured), the rest perturbing the best minimum (±10 %); the minimum counts as
+    /// confirmed only when two of the independent starts reach it. Without it: at most 8
+    /// starts, the start values and two perturbations of them (±30 %) exploring, later
+    /// ones perturbing the best (±10 %), stopping once a minimum is found twice.
+    #[arg(long, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
+    pub max_starts: Option<usize>,
     /// Fit frequencies per pair (n_ω; CIFER uses 20), 2–200: the fit's time grows with it.
     #[arg(long, default_value_t = 20, value_parser = arg_values::count::<2, 200>, allow_hyphen_values = true)]
     pub points: usize,
@@ -150,7 +154,8 @@ impl FitArgs {
     pub fn options(&self, trim_points: Option<TrimPoints>) -> FitOptions {
         FitOptions {
             points_per_pair: self.points,
-            max_starts: self.max_starts.max(1),
+            max_starts: self.max_starts.unwrap_or(FitOptions::default().max_starts),
+            global_search: self.max_starts.is_some(),
             seed: self.seed,
             reduce: self.reduce,
             trim_points,
@@ -560,7 +565,7 @@ lat = "b"
             reduce: false,
             seed: 3,
             start_from: None,
-            max_starts: 4,
+            max_starts: Some(4),
             points: 20,
             truth: None,
             constants: Vec::new(),
@@ -576,7 +581,7 @@ lat = "b"
 
         // From an equation-error start too (the state is measured: x is an output).
         args.equation_error_start = true;
-        args.max_starts = 2;
+        args.max_starts = Some(2);
         run(&args).unwrap();
         let document: ModelDocument =
             serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();
