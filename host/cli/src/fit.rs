@@ -71,15 +71,20 @@ pub struct FitArgs {
     /// lower J_ave of the start sets is kept.
     #[arg(long)]
     pub equation_error_start: bool,
-    /// A budget of optimizer starts, 1–64, all spent: the structure's start values, then
-    /// three quarters of the starts drawn across the parameter box (each free value's
-    /// magnitude log-uniform from a tenth to ten times its start value, sign kept, bounds
-    /// honoured), the rest perturbing the best minimum (±10 %); the minimum counts as
-    /// confirmed only when two of the independent starts reach it. Without it: at most 8
-    /// starts, the start values and two perturbations of them (±30 %) exploring, later
-    /// ones perturbing the best (±10 %), stopping once a minimum is found twice.
-    #[arg(long, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
-    pub max_starts: Option<usize>,
+    /// Most optimizer starts, 1–64. The local search (default): the structure's start
+    /// values and two perturbations of them (±30 %) explore, later starts perturb the best
+    /// minimum so far (±10 %); stops earlier once a minimum is found twice. With `--search
+    /// global` a budget, all spent (see there).
+    #[arg(long, default_value_t = 8, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
+    pub max_starts: usize,
+    /// `local` (default) or `global`: every one of `--max-starts` made, the structure's
+    /// start values, then half the starts drawn across the parameter box (each free
+    /// value's magnitude log-uniform within half a decade of its start value, sign kept,
+    /// bounds honoured), the rest perturbing the best plausible minimum (±10 %); the
+    /// minimum counts as confirmed only when two independent starts reach it. For
+    /// structures started from rough values (e.g. `--search global --max-starts 64`).
+    #[arg(long, value_enum, default_value_t = SearchArg::Local, value_name = "HOW")]
+    pub search: SearchArg,
     /// Fit frequencies per pair (n_ω; CIFER uses 20), 2–200: the fit's time grows with it.
     #[arg(long, default_value_t = 20, value_parser = arg_values::count::<2, 200>, allow_hyphen_values = true)]
     pub points: usize,
@@ -109,6 +114,15 @@ pub struct FitArgs {
     /// 3.5·10⁻⁴ of travel, an SBUS count).
     #[arg(long, value_enum, default_value_t = TrimBalanceArg::Hold, value_name = "HOW")]
     pub trim_balance: TrimBalanceArg,
+}
+
+/// `--search` of `fit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SearchArg {
+    /// Restarts about the start values, then about the best minimum, until it is found twice.
+    Local,
+    /// The whole `--max-starts` budget, half of it drawn across the parameter box.
+    Global,
 }
 
 /// `--trim-balance` of `fit` and `campaign`.
@@ -154,8 +168,8 @@ impl FitArgs {
     pub fn options(&self, trim_points: Option<TrimPoints>) -> FitOptions {
         FitOptions {
             points_per_pair: self.points,
-            max_starts: self.max_starts.unwrap_or(FitOptions::default().max_starts),
-            global_search: self.max_starts.is_some(),
+            max_starts: self.max_starts.max(1),
+            global_search: self.search == SearchArg::Global,
             seed: self.seed,
             reduce: self.reduce,
             trim_points,
@@ -565,7 +579,8 @@ lat = "b"
             reduce: false,
             seed: 3,
             start_from: None,
-            max_starts: Some(4),
+            max_starts: 4,
+            search: SearchArg::Local,
             points: 20,
             truth: None,
             constants: Vec::new(),
@@ -581,7 +596,7 @@ lat = "b"
 
         // From an equation-error start too (the state is measured: x is an output).
         args.equation_error_start = true;
-        args.max_starts = Some(2);
+        args.max_starts = 2;
         run(&args).unwrap();
         let document: ModelDocument =
             serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();

@@ -179,11 +179,8 @@ impl Pipeline<'_> {
         // (docs/method.md, physical ranges): it only starts the hybrid, one of two start
         // sets of which the lower J_ave is kept, and the hybrid is judged. Recovering it
         // changed every default campaign's model6.json and refused the TREX 700L's seed 4.
-        // The local search with a larger limit (its 16 starts a limit, not a budget
-        // spent across the box: what every campaign's model6.json was measured with).
         let options = FitOptions {
             recover_implausible: false,
-            global_search: false,
             ..args.options(None)
         };
         let (result, _outcomes) = fit_from_alternative_starts(&starts, frf, &options)?;

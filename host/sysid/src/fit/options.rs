@@ -30,7 +30,7 @@ pub struct FitOptions {
     /// rest perturb the best minimum by `polish_spread`; the minimum counts as confirmed
     /// only when two independent starts (the structure's values or box draws) reach it
     /// ([`search`](super::search)). Off by default: the shipped structures' campaigns keep
-    /// the local search; `sweephold fit --max-starts N` turns it on.
+    /// the local search; `sweephold fit --search global` turns it on.
     pub global_search: bool,
     /// Half-width of the global phase's box in decades (default 1: a tenth to ten times
     /// each start value).
