@@ -71,11 +71,20 @@ pub struct FitArgs {
     /// lower J_ave of the start sets is kept.
     #[arg(long)]
     pub equation_error_start: bool,
-    /// Most optimizer starts, 1–64: the structure's start values and two perturbations of
-    /// them (±30 %) explore, later starts perturb the best minimum so far (±10 %); stops
-    /// earlier once a minimum is found twice.
+    /// Most optimizer starts, 1–64. The local search (default): the structure's start
+    /// values and two perturbations of them (±30 %) explore, later starts perturb the best
+    /// minimum so far (±10 %); stops earlier once a minimum is found twice. With `--search
+    /// global` a budget, all spent (see there).
     #[arg(long, default_value_t = 8, value_parser = arg_values::count::<1, 64>, allow_hyphen_values = true)]
     pub max_starts: usize,
+    /// `local` (default) or `global`: every one of `--max-starts` made, the structure's
+    /// start values, then half the starts drawn across the parameter box (each free
+    /// value's magnitude log-uniform within half a decade of its start value, sign kept,
+    /// bounds honoured), the rest perturbing the best plausible minimum (±10 %); the
+    /// minimum counts as confirmed only when two independent starts reach it. For
+    /// structures started from rough values (e.g. `--search global --max-starts 64`).
+    #[arg(long, value_enum, default_value_t = SearchArg::Local, value_name = "HOW")]
+    pub search: SearchArg,
     /// Fit frequencies per pair (n_ω; CIFER uses 20), 2–200: the fit's time grows with it.
     #[arg(long, default_value_t = 20, value_parser = arg_values::count::<2, 200>, allow_hyphen_values = true)]
     pub points: usize,
@@ -105,6 +114,15 @@ pub struct FitArgs {
     /// 3.5·10⁻⁴ of travel, an SBUS count).
     #[arg(long, value_enum, default_value_t = TrimBalanceArg::Hold, value_name = "HOW")]
     pub trim_balance: TrimBalanceArg,
+}
+
+/// `--search` of `fit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SearchArg {
+    /// Restarts about the start values, then about the best minimum, until it is found twice.
+    Local,
+    /// The whole `--max-starts` budget, half of it drawn across the parameter box.
+    Global,
 }
 
 /// `--trim-balance` of `fit` and `campaign`.
@@ -151,6 +169,7 @@ impl FitArgs {
         FitOptions {
             points_per_pair: self.points,
             max_starts: self.max_starts.max(1),
+            global_search: self.search == SearchArg::Global,
             seed: self.seed,
             reduce: self.reduce,
             trim_points,
@@ -516,80 +535,4 @@ fn write_report(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use sysid::fit::cost::PairBand;
-    use sysid::fit::synthetic::{exact_frf_document, SyntheticGrid};
-
-    const LAG: &str = r#"
-name = "lag"
-states = ["x"]
-controls = ["lat"]
-outputs = ["x"]
-pairs = [{ output = "x", input = "lat" }]
-[parameters]
-a = -2.0
-b = 3.0
-[F.x]
-x = "a"
-[G.x]
-lat = "b"
-"#;
-
-    #[test]
-    fn fits_and_writes_model_json() {
-        let directory = std::env::temp_dir().join(format!("sweephold-fit-{}", std::process::id()));
-        fs::create_dir_all(&directory).unwrap();
-        let structure_path = directory.join("lag.toml");
-        fs::write(&structure_path, LAG).unwrap();
-        let structure = ModelStructure::parse(LAG, "lag").unwrap();
-        let truth = structure.model(&[-1.5, 2.0]).unwrap();
-        let band = PairBand {
-            input: "lat".into(),
-            output: "x".into(),
-            range: [0.2, 20.0],
-        };
-        let frf = exact_frf_document(&truth, &[band], SyntheticGrid::FitPoints(20));
-        let frf_path = directory.join("frf.json");
-        fs::write(&frf_path, serde_json::to_string(&frf).unwrap()).unwrap();
-        let out = directory.join("model.json");
-        let mut args = FitArgs {
-            frf: frf_path,
-            model: structure_path.clone(),
-            out: Some(out.clone()),
-            reduce: false,
-            seed: 3,
-            start_from: None,
-            max_starts: 4,
-            points: 20,
-            truth: None,
-            constants: Vec::new(),
-            trim_points: None,
-            trim_balance: TrimBalanceArg::Hold,
-            equation_error_start: false,
-        };
-        run(&args).unwrap();
-        let document: ModelDocument =
-            serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();
-        assert!((document.parameter("a").unwrap() + 1.5).abs() < 1e-6);
-        assert!((document.parameter("b").unwrap() - 2.0).abs() < 1e-6);
-
-        // From an equation-error start too (the state is measured: x is an output).
-        args.equation_error_start = true;
-        args.max_starts = 2;
-        run(&args).unwrap();
-        let document: ModelDocument =
-            serde_json::from_str(&fs::read_to_string(&out).unwrap()).unwrap();
-        assert!((document.parameter("a").unwrap() + 1.5).abs() < 1e-6);
-        args.equation_error_start = false;
-
-        // A malformed structure file is reported with its line.
-        fs::write(&structure_path, LAG.replace("lat = \"b\"", "lat = \"Zq\"")).unwrap();
-        let error = run(&args).unwrap_err().to_string();
-        assert!(
-            error.contains("line 13") && error.contains("undefined parameter `Zq`"),
-            "{error}"
-        );
-        fs::remove_dir_all(&directory).ok();
-    }
-}
+mod tests;

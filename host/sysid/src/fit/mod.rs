@@ -31,6 +31,7 @@ pub mod report;
 mod result;
 mod search;
 pub mod start;
+mod start_box;
 pub mod structure;
 pub mod synthetic;
 pub mod trim;

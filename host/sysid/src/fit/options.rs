@@ -24,6 +24,17 @@ pub struct FitOptions {
     pub explore_starts: usize,
     /// Perturbation of the starts after `explore_starts`, about the best minimum so far.
     pub polish_spread: f64,
+    /// Spend every one of `max_starts` (a budget, not a limit): after the structure's
+    /// values, three quarters of the starts are drawn across the parameter box
+    /// (`box_decades` either side of each start value, log-uniform, sign kept) and the
+    /// rest perturb the best minimum by `polish_spread`; the minimum counts as confirmed
+    /// only when two independent starts (the structure's values or box draws) reach it
+    /// ([`search`](super::search)). Off by default: the shipped structures' campaigns keep
+    /// the local search; `sweephold fit --search global` turns it on.
+    pub global_search: bool,
+    /// Half-width of the global phase's box in decades (default 1: a tenth to ten times
+    /// each start value).
+    pub box_decades: f64,
     /// Seed of the restart perturbations.
     pub seed: u64,
     /// Two starts found the same minimum when their J_ave differ by at most
@@ -77,6 +88,8 @@ impl Default for FitOptions {
             start_spread: 0.3,
             explore_starts: 3,
             polish_spread: 0.1,
+            global_search: false,
+            box_decades: 0.5,
             seed: 1,
             same_minimum_tolerance: 1e-4,
             reduce: false,

@@ -1,6 +1,12 @@
 //! The multi-start search: Levenberg–Marquardt from the structure's start values, then
 //! from perturbed ones, until the same minimum is found twice ([`super::optimizer`]);
 //! then the accuracy analysis and the report at the best minimum.
+//!
+//! With [`FitOptions::global_search`] the starts are a budget, all spent: after the
+//! structure's values, three quarters of them are drawn across the parameter box
+//! ([`super::start_box`]) and the rest perturb the best minimum so far; the minimum is
+//! confirmed only when two independent starts (the structure's values or box draws, not
+//! the perturbations of the best) reach it.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -9,9 +15,11 @@ use super::cost::{self, PairGrid};
 use super::error::FitError;
 use super::optimizer;
 use super::options::FitOptions;
+use super::plausible;
 use super::prior;
 use super::result::parameter_reports;
 use super::result::{FitResult, PairFit, StartOutcome};
+use super::start_box;
 use super::structure::ModelStructure;
 use super::trim::{joint::JointBalance, TrimBalance, TrimError};
 
@@ -26,6 +34,45 @@ fn merge(base: &[f64], free: &[usize], free_values: &DVector<f64>) -> Vec<f64> {
         values[index] = free_values[k];
     }
     values
+}
+
+/// The index of the best of `finals`: the lowest J_ave, and with `prefer_plausible` the
+/// lowest among the plausible minima when there is one. A degenerate minimum (the R-50's
+/// yaw-damper pole driven to 10¹⁴ /s, its gain with it, J_ave 21.6) can be lower than the
+/// physical ones found so far; polishing it wastes the rest of the budget.
+fn best_index(
+    finals: &[(DVector<f64>, f64)],
+    plausible: &[bool],
+    prefer_plausible: bool,
+) -> Option<usize> {
+    let rank = |i: usize| {
+        (
+            prefer_plausible && !plausible.get(i).copied().unwrap_or(true),
+            finals[i].1,
+        )
+    };
+    (0..finals.len())
+        .filter(|&i| finals[i].1.is_finite())
+        .min_by(|&a, &b| {
+            let (ra, rb) = (rank(a), rank(b));
+            ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1))
+        })
+}
+
+/// Decades beyond the box's edge within which a global search's minimum still counts as
+/// plausible ([`near_the_box`]).
+const BEYOND_THE_BOX_DECADES: f64 = 2.0;
+
+/// Whether every free value of `x` lies within `decades` + [`BEYOND_THE_BOX_DECADES`] of
+/// its start value's magnitude (a start of exactly 0 sets no scale). The start values are
+/// the structure's orders of magnitude; the physical ranges ([`plausible`]) know only the
+/// states they can name (u … r, φ, θ and flapping), and a state such as the R-50's yaw
+/// damper r_fb is named by no rule: its pole slid to 10¹⁴ /s without a limit there.
+fn near_the_box(x: &DVector<f64>, start: &DVector<f64>, decades: f64) -> bool {
+    let limit = 10f64.powf(decades + BEYOND_THE_BOX_DECADES);
+    x.iter()
+        .zip(start.iter())
+        .all(|(value, start)| *start == 0.0 || value.abs() <= limit * start.abs())
 }
 
 /// Multi-start fit on prepared grids, then the accuracy analysis.
@@ -50,6 +97,12 @@ pub(super) struct StartSearch {
     starts: Vec<StartOutcome>,
     /// Final parameter vector and J_ave of each evaluated start.
     finals: Vec<(DVector<f64>, f64)>,
+    /// Whether each of `finals` came from an independent start (the structure's values or
+    /// a draw across the box), as opposed to a perturbation of the best minimum so far.
+    independent: Vec<bool>,
+    /// Whether each of `finals` lies within the physical ranges ([`plausible`]); the
+    /// global search ranks plausible minima before implausible ones.
+    plausible: Vec<bool>,
     minimum_confirmed: bool,
     last_error: Option<FitError>,
 }
@@ -61,6 +114,8 @@ impl StartSearch {
             attempts: 0,
             starts: Vec::new(),
             finals: Vec::new(),
+            independent: Vec::new(),
+            plausible: Vec::new(),
             minimum_confirmed: false,
             last_error: None,
         }
@@ -123,9 +178,13 @@ pub(super) fn search_minima(
     let tolerance = |a: f64, b: f64| {
         (a - b).abs() <= options.same_minimum_tolerance * a.abs().max(b.abs()).max(1.0)
     };
-    while !search.minimum_confirmed && search.attempts < max_starts.max(1) {
+    let global = options.global_search;
+    // Global search: starts 1 .. box_end are drawn across the box, the rest polish.
+    let box_end = 1 + (max_starts.max(1) - 1) / 2;
+    while (global || !search.minimum_confirmed) && search.attempts < max_starts.max(1) {
         let start_number = search.attempts;
         search.attempts += 1;
+        let independent = start_number == 0 || (global && start_number < box_end);
         let start = if start_number == 0 {
             let mut x = first_start.clone();
             // A free parameter at exactly zero makes the responses it alone carries
@@ -137,16 +196,21 @@ pub(super) fn search_minima(
             }
             bounds.project(&mut x);
             x
+        } else if independent {
+            start_box::draw(
+                &first_start,
+                options.box_decades,
+                ZERO_START_NUDGE,
+                &bounds,
+                &mut search.random,
+            )
         } else {
             // Explore about the structure's start values first, then perturb the best
             // minimum so far (`FitOptions::explore_starts`).
-            let best_so_far = search
-                .finals
-                .iter()
-                .filter(|(_, j)| j.is_finite())
-                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let best_so_far =
+                best_index(&search.finals, &search.plausible, global).map(|i| &search.finals[i]);
             let (centre, spread) = match best_so_far {
-                Some((x, _)) if start_number >= options.explore_starts => {
+                Some((x, _)) if global || start_number >= options.explore_starts => {
                     (x, options.polish_spread)
                 }
                 _ => (&first_start, options.start_spread),
@@ -155,6 +219,8 @@ pub(super) fn search_minima(
         };
         if free.is_empty() {
             search.finals.push((start, f64::NAN));
+            search.independent.push(true);
+            search.plausible.push(true);
             break;
         }
         match optimizer::levenberg_marquardt(evaluate, start, &bounds, &rules) {
@@ -165,7 +231,13 @@ pub(super) fn search_minima(
                     iterations: outcome.iterations,
                     stop: format!("{:?}", outcome.reason),
                 });
+                let values = merge(&base, &free, &outcome.x);
+                search.plausible.push(
+                    plausible::implausible_parameters(structure, &values).is_empty()
+                        && near_the_box(&outcome.x, &first_start, options.box_decades),
+                );
                 search.finals.push((outcome.x, average_cost));
+                search.independent.push(independent);
             }
             Err(FitError::SingularSystem { omega }) => {
                 search.starts.push(StartOutcome {
@@ -178,15 +250,13 @@ pub(super) fn search_minima(
             }
             Err(other) => return Err(other),
         }
-        let best = search
-            .finals
-            .iter()
-            .map(|(_, j)| *j)
-            .fold(f64::INFINITY, f64::min);
+        let best = best_index(&search.finals, &search.plausible, global)
+            .map_or(f64::INFINITY, |i| search.finals[i].1);
         let hits = search
             .finals
             .iter()
-            .filter(|(_, j)| tolerance(*j, best))
+            .zip(&search.independent)
+            .filter(|((_, j), &independent)| tolerance(*j, best) && (independent || !global))
             .count();
         search.minimum_confirmed = hits >= 2;
     }
@@ -205,14 +275,16 @@ pub(super) fn finish_fit(
     let StartSearch {
         starts,
         finals,
+        plausible,
         minimum_confirmed,
         last_error,
         ..
     } = search;
-    let best = finals
-        .iter()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(x, _)| x.clone());
+    let best = match best_index(&finals, &plausible, options.global_search) {
+        Some(i) => Some(finals[i].0.clone()),
+        // No evaluated start (free set empty: its one entry has J NaN).
+        None => finals.first().map(|(x, _)| x.clone()),
+    };
     let Some(best) = best else {
         return Err(last_error.unwrap_or(FitError::NoPairs));
     };

@@ -312,3 +312,41 @@ fn sliver_ranges_are_skipped_and_reported() {
         }
     }
 }
+
+/// The global search makes every start of its budget, and the starts that only polish the
+/// best minimum do not confirm it: with a budget of 2 (the structure's values and one
+/// polishing start, no box draw) the minimum is reached twice but not by two independent
+/// starts; with 6 (two box draws) the independent starts agree on it.
+#[test]
+fn the_global_search_spends_its_budget_and_confirms_from_independent_starts() {
+    let structure = first_order_structure();
+    let truth = structure.values();
+    let document = synthetic_document(&structure.model(&truth).unwrap(), &structure, 20);
+    let start = structure.with_values(&[-1.2, 3.3, 0.02]).unwrap();
+    let local = fit(
+        &start,
+        &document,
+        &FitOptions {
+            max_starts: 6,
+            ..FitOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(
+        local.minimum_confirmed && local.starts.len() < 6,
+        "{:?}",
+        local.starts
+    );
+    let budget = |max_starts| FitOptions {
+        max_starts,
+        global_search: true,
+        ..FitOptions::default()
+    };
+    let two = fit(&start, &document, &budget(2)).unwrap();
+    assert_eq!(two.starts.len(), 2);
+    assert!(!two.minimum_confirmed, "{:?}", two.starts);
+    let six = fit(&start, &document, &budget(6)).unwrap();
+    assert_eq!(six.starts.len(), 6);
+    assert!(six.minimum_confirmed, "{:?}", six.starts);
+    assert!(six.average_cost < 1e-10, "J_ave {}", six.average_cost);
+}
