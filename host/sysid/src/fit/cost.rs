@@ -28,7 +28,7 @@
 //! Parameters enter entries linearly (`coef·θ`), so ∂T/∂θ sums `coef·∂T/∂entry` over the
 //! entries the parameter appears in. A parameter that is an actuator's ω or ζ enters
 //! through the factor A(s) = ω²/(s² + 2ζωs + ω²): ∂T/∂p = T·∂ ln A/∂p
-//! ([`actuator_log_derivative`]).
+//! (`actuator_log_derivative`).
 
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;

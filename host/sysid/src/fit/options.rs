@@ -29,7 +29,7 @@ pub struct FitOptions {
     /// (`box_decades` either side of each start value, log-uniform, sign kept) and the
     /// rest perturb the best minimum by `polish_spread`; the minimum counts as confirmed
     /// only when two independent starts (the structure's values or box draws) reach it
-    /// ([`search`](super::search)). Off by default: the shipped structures' campaigns keep
+    /// (the `search` module). Off by default: the shipped structures' campaigns keep
     /// the local search; `sweephold fit --search global` turns it on.
     pub global_search: bool,
     /// Half-width of the global phase's box in decades (default 1: a tenth to ten times
