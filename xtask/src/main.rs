@@ -3,9 +3,12 @@
 //!
 //! A workspace member binary run through the cargo alias `xtask` (`.cargo/config.toml`),
 //! the pattern of defmt's xtask: the checks are Rust, so CI needs no Python for them.
-//! It depends on none of the project's crates (it reads the sources as text and runs
-//! cargo as a subprocess) and on two well-kept crates: clap for the subcommands and their
-//! help, regex for the source checks ported from Python with the same expressions.
+//!
+//! **Its room and what it may import.** The project's checks and CI steps, nothing of
+//! the product. It depends on none of the project's crates (it reads the sources as text
+//! and runs cargo as a subprocess, so a crate that does not build cannot stop a check)
+//! and on two well-kept crates: clap for the subcommands and their help, regex for the
+//! source checks ported from Python with the same expressions.
 
 mod file_sizes;
 mod import_cycles;
