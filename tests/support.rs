@@ -1,6 +1,10 @@
 //! Shared helpers of the cross-crate integration tests in this folder.
 //!
-//! The tests may import every crate of the workspace; nothing imports them.
+//! **Its room and what it may import.** The tests that cross crates (the firmware flown
+//! in the loop with the simulator in-process, in QEMU and over a pseudo-terminal; whole
+//! campaigns through the command-line library) and their helpers. They may import every
+//! crate of the workspace (today the protocol, the firmware with `std` and the
+//! command-line library `sweephold`); nothing imports them.
 
 use std::path::{Path, PathBuf};
 

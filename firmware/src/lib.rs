@@ -27,7 +27,9 @@
 //! The tick path has no `unwrap`, `expect`, panicking index or `unsafe`, runs in bounded
 //! time and turns NaN or infinite inputs into an abort and finite, clamped outputs.
 //!
-//! **What it may import.** Of the workspace, only the wire protocol
+//! **Its room and what it may import.** The flight logic and the board application,
+//! written against traits and plain data: no register, pin or peripheral of a board
+//! (those are the image's, `firmware/board`). Of the workspace, only the wire protocol
 //! (`sweephold-protocol`); otherwise `no_std` crates that allocate nothing (heapless,
 //! libm, micromath, embedded-hal, embedded-io, rand_pcg, defmt, and for the parameter
 //! store sequential-storage, embedded-storage and embassy-futures). It never imports the

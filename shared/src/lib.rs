@@ -7,7 +7,8 @@
 //! `no_std`, no allocation. Features: `std` (error trait impls for the host), `defmt`
 //! (derive `defmt::Format` on every wire type, for firmware logging).
 //!
-//! **What it may import.** No workspace crate: it is the one crate both sides share
+//! **Its room and what it may import.** The wire format and nothing else (no flight
+//! logic, no file format of the host). No workspace crate: it is the one crate both sides share
 //! (the firmware imports it and nothing else of the workspace; the host crates read the
 //! telemetry through it). Its dependencies are `no_std` serialization crates (serde,
 //! postcard, heapless) and, optionally, defmt.

@@ -3,14 +3,20 @@
 //!
 //! A workspace member binary run through the cargo alias `xtask` (`.cargo/config.toml`),
 //! the pattern of defmt's xtask: the checks are Rust, so CI needs no Python for them.
-//! It depends on none of the project's crates (it reads the sources as text and runs
-//! cargo as a subprocess) and on two well-kept crates: clap for the subcommands and their
-//! help, regex for the source checks ported from Python with the same expressions.
+//!
+//! **Its room and what it may import.** The project's checks and CI steps, nothing of
+//! the product. It depends on none of the project's crates (it reads the sources as text
+//! and runs cargo as a subprocess, so a crate that does not build cannot stop a check)
+//! and on two well-kept crates: clap for the subcommands and their help, regex for the
+//! source checks ported from Python with the same expressions.
 
 mod file_sizes;
 mod import_cycles;
+mod layers;
 mod links;
+mod module_tree;
 mod report;
+mod rust_text;
 mod steps;
 
 use clap::{Parser, Subcommand};
@@ -35,6 +41,11 @@ enum Task {
     /// No two modules of a crate import each other; `sweephold identify`'s code names
     /// neither the simulator nor its truth.
     ImportCycles,
+    /// Inside a crate, imports go down: no module imports from an ancestor's file (it
+    /// imports from the module that defines the item), and each crate with a stated
+    /// order of its top-level modules keeps it (sysid: `models > fit > frf > document,
+    /// records, random`). Other crates' findings are listed, not enforced.
+    Layers,
     /// No non-test source file over its size limit (600 lines, every crate).
     FileSizes {
         /// One limit for every file instead of the rules.
@@ -62,10 +73,11 @@ enum Task {
 
 impl Task {
     /// CI's order: the cheap source checks first, then lints, docs, tests, images, QEMU.
-    const CI: [Task; 11] = [
+    const CI: [Task; 12] = [
         Task::Fmt,
         Task::Links,
         Task::ImportCycles,
+        Task::Layers,
         Task::FileSizes { limit: None },
         Task::Clippy,
         Task::FwClippy,
@@ -81,6 +93,7 @@ impl Task {
             Task::Fmt => "cargo fmt --check",
             Task::Links => "docs: no dead link, nothing outside the project",
             Task::ImportCycles => "no import circle between the modules of a crate",
+            Task::Layers => "no upward import inside a crate, its layer order kept",
             Task::FileSizes { .. } => "no non-test source file over 600 lines",
             Task::Clippy => "clippy (host workspace)",
             Task::FwClippy => "clippy (firmware, thumbv7em-none-eabihf)",
@@ -101,6 +114,7 @@ impl Task {
                 "import-cycles",
                 import_cycles::check(&ws.root, import_cycles::CRATES, import_cycles::SEPARATED),
             ),
+            Task::Layers => print_report("layers", layers::check(&ws.root, layers::CRATES)),
             Task::FileSizes { limit } => {
                 print_report("file-sizes", file_sizes::check(&ws.root, limit))
             }

@@ -12,7 +12,9 @@
 //! folder, compiled in ([`shipped`]); [`resolve`] takes a shipped name or the path of a
 //! user's file.
 //!
-//! **What it may import.** serde, toml and thiserror; no other crate of the workspace.
+//! **Its room and what it may import.** The description of an aircraft and its checks,
+//! nothing that flies or identifies one. serde, toml and thiserror; no other crate of the
+//! workspace.
 //! The simulator, the identification's priors and the command-line tool import it.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

@@ -1,7 +1,9 @@
 //! The `sweephold` command-line tool, as a library so that integration tests and
 //! benchmarks drive the same code the binary runs.
 //!
-//! **What it may import.** Every library crate of the workspace: the protocol, the
+//! **Its room and what it may import.** The command-line program: the verbs, the files
+//! they read and write, their console text, plots and report.
+//! Every library crate of the workspace: the protocol, the
 //! firmware (with `std`, flown in-process), the aircraft files (`aircraft`), the
 //! simulator (`rotorsim`), the identification (`sysid`), the `truth` mapping and the
 //! loop margins (`control`). Nothing imports it but the integration tests. The console

@@ -14,7 +14,8 @@
 //! knows nothing of the flight controller; this crate joins the two (firmware control
 //! law and identified model), which neither may depend on the other for.
 //!
-//! **What it may import.** Of the workspace: the firmware (`sweephold-firmware` with
+//! **Its room and what it may import.** The pilot-mode law around a model, nothing
+//! else: no fitting, and no file read or written (the caller hands it the model). Of the workspace: the firmware (`sweephold-firmware` with
 //! `std`: the gains, tick and IMU filter bank), the wire protocol and `sysid` (the model
 //! and its structure); otherwise nalgebra, num-complex and serde. Only the command-line
 //! tool imports it.

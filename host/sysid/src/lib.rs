@@ -15,10 +15,16 @@
 //! * [`models`] — the structure files shipped with the crate, by name;
 //! * [`random`] — the one small deterministic generator (seeded restarts, test noise).
 //!
-//! Inside the crate the dependencies run one way: `models` → `fit` → `frf` → `records`,
-//! and `fit`, `frf` → `document` (`random` is a leaf that any of them may use); `records`
-//! imports no other module of the crate. A module imports its siblings and their public
-//! items, never the internals of its parent's siblings.
+//! Inside the crate the dependencies run one way, in layers: `models` > `fit` > `frf` >
+//! `document`, `records`, `random`. A module imports only the modules of the layers below
+//! its own: `models` → `fit` → `frf` → `records`, `fit` and `frf` → `document`, and any
+//! of them → `random`; `document`, `records` and `random` import no other module of the
+//! crate. Inside each module too, imports go down: a module imports its siblings and
+//! their public items, never the internals of its parent's siblings, and never an item
+//! from its parent's own file (what children share lives in a child of its own); it
+//! imports an item from the module that defines it, not through a parent's re-export.
+//! `cargo xtask layers` (run by CI) enforces both, with this order written in its table
+//! of crates.
 //!
 //! **What it may import.** This crate is numerics and file formats, and nothing else: it
 //! depends on numeric crates (nalgebra, num-complex, rustfft, and rand_core with

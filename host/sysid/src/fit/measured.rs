@@ -12,7 +12,8 @@
 
 use std::collections::BTreeSet;
 
-use super::{FitError, ModelStructure};
+use super::error::FitError;
+use super::structure::ModelStructure;
 use crate::document::FrfDocument;
 
 /// The outputs of which `data` holds at least one pair.

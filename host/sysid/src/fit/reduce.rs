@@ -136,14 +136,13 @@ fn worst_parameter(
                 && !has_prior(&result.structure, &p.name)
         })
     };
-    let worst_by = |key: fn(&super::ParameterReport) -> f64| {
+    let worst_by = |key: fn(&ParameterReport) -> f64| {
         free()
             .map(|p| (p, key(p)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let insensitivity =
-        |p: &super::ParameterReport| p.insensitivity_percent.unwrap_or(f64::INFINITY);
-    let cramer_rao = |p: &super::ParameterReport| p.cramer_rao_percent.unwrap_or(f64::INFINITY);
+    let insensitivity = |p: &ParameterReport| p.insensitivity_percent.unwrap_or(f64::INFINITY);
+    let cramer_rao = |p: &ParameterReport| p.cramer_rao_percent.unwrap_or(f64::INFINITY);
     if let Some((parameter, value)) = worst_by(insensitivity) {
         if value > options.insensitivity_limit_percent || value.is_nan() {
             return Some((

@@ -129,7 +129,7 @@ pub struct ModelDocument {
     pub reduction: Vec<ReductionStep>,
     /// `auto` pairs left out of the fit, and why.
     #[serde(default)]
-    pub skipped_pairs: Vec<super::SkippedPair>,
+    pub skipped_pairs: Vec<super::result::SkippedPair>,
     /// Parameters derived from trim points (absent without them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trim: Option<super::trim::TrimOutcome>,

@@ -31,6 +31,7 @@
 //!
 //! The steps are submodules: `prepare` (join a group, choose its band, grid, windows
 //! and channels), `responses` (spectra, MISO solves and composites of one group),
+//! `outcome` (what an analysis gives: [`FrfAnalysis`] and its parts),
 //! `filter_removal` (a measurement filter the flight controller announced, divided out
 //! of the responses) and `cross_coherence` (coherence between the controls of a group).
 //!
@@ -38,68 +39,22 @@
 
 use crate::document::{FrfDocument, PairResponse, FRF_DOCUMENT_VERSION};
 
+use super::error::FrfError;
 use super::groups::RecordGroup;
 use super::options::{FrfOptions, RangeSource, ResponseEstimator};
-use super::FrfError;
 
 mod cross_coherence;
 mod filter_removal;
+mod outcome;
 mod prepare;
 mod responses;
 
 pub use cross_coherence::{cross_control_coherence, CoherenceCurve};
+pub use outcome::{FrfAnalysis, GroupSummary, MultipleCoherence};
 
 use filter_removal::remove_measurement_filter;
 use prepare::prepare_group;
 use responses::analyse_group;
-
-/// Multiple coherence of one output with the conditioning inputs of its group.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MultipleCoherence {
-    /// Input of the pair it belongs to (its weights are that pair's).
-    pub input: String,
-    /// Output.
-    pub output: String,
-    /// Frequencies [rad/s].
-    pub omega: Vec<f64>,
-    /// γ²_y:u in [0, 1].
-    pub coherence: Vec<f64>,
-}
-
-/// What was done with one record group.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GroupSummary {
-    /// Primary axis.
-    pub axis: String,
-    /// Number of records joined.
-    pub records: usize,
-    /// Length of the joined record \[s\].
-    pub seconds: f64,
-    /// Frequency grid band [rad/s].
-    pub band: [f64; 2],
-    /// Window lengths used \[s\].
-    pub windows: Vec<f64>,
-    /// Controls in the conditioning (primary last).
-    pub conditioned_on: Vec<String>,
-    /// Inputs whose responses were computed (the primary first).
-    pub responses: Vec<String>,
-}
-
-/// The document plus what the plots and the command-line summary need.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FrfAnalysis {
-    /// The `frf.json` document.
-    pub document: FrfDocument,
-    /// Cross-control coherence versus frequency (the document has only the means).
-    pub cross_coherence_curves: Vec<CoherenceCurve>,
-    /// One summary per group.
-    pub groups: Vec<GroupSummary>,
-    /// Multiple coherence γ²_y:u of each output with all the conditioning inputs, one
-    /// per MISO pair in `document.pairs` order (composite, same weights as the response).
-    /// How much of the output the excited controls explain together; the partial
-    /// coherence in the document is the share of the swept control alone.
-    pub multiple_coherence: Vec<MultipleCoherence>,
-}
 
 /// Composite MISO-conditioned and SISO frequency responses of every (responding input,
 /// output) pair (the swept input of each group, or every excited one: [`ResponseInputs`]),

@@ -11,7 +11,7 @@
 //! (at least 2 samples). Inputs and outputs get the same taper, so the windows that
 //! span a join see the same slow gain on both sides of the input/output relation.
 
-use super::FrfError;
+use super::error::FrfError;
 use crate::records::{remove_line, Channel, MeasurementFilter, Record};
 
 /// The records of one swept axis, analysed as one joined record.

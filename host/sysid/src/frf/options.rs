@@ -1,6 +1,6 @@
 //! Settings of the frequency-response computation.
 
-use super::FrfError;
+use super::error::FrfError;
 
 /// Settings of [`compute_frequency_responses`](super::compute_frequency_responses).
 /// `FrfOptions::default()` gives the CIFER-like defaults listed per field.

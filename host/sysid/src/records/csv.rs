@@ -38,8 +38,8 @@ pub mod units;
 
 use std::path::Path;
 
+use super::error::RecordError;
 use super::record::{remove_line, rms, Channel, Record};
-use super::RecordError;
 pub use columns::{CsvColumns, PRIMARY_COLUMN};
 use timing::{median, uniform_samples};
 use units::{deg_per_s_note, detected_time_unit, TimeUnit};

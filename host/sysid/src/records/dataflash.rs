@@ -29,7 +29,8 @@
 
 use std::collections::HashMap;
 
-use super::{text, Bytes, Field, Log, LogError, LogFormat, Primitive, Topic, Values};
+use super::binary::{text, Bytes, Primitive};
+use super::log::{Field, Log, LogError, LogFormat, Topic, Values};
 
 /// First header byte of every message.
 pub const HEAD1: u8 = 0xA3;

@@ -19,10 +19,10 @@ use sweephold_protocol::{tick_step, Header, Phase, Sample, TickStep};
 #[cfg(test)]
 use super::dump_tests::TestEnd;
 use super::dump_tests::{is_excitation, split_tests, TestRecord};
+use super::error::RecordError;
 use super::measurement_filter::MeasurementFilter;
 use super::origin::DumpOrigin;
 use super::record::{Channel, Record};
-use super::RecordError;
 
 /// Names of the dump's input channels, in wire order.
 pub const DUMP_INPUTS: [&str; 4] = ["lat", "lon", "ped", "col"];

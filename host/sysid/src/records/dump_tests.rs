@@ -16,8 +16,8 @@
 
 use sweephold_protocol::{Decoder, Event, Frame, FrameError, Header, Phase, Sample};
 
+use super::error::RecordError;
 use super::record::Record;
-use super::RecordError;
 
 /// How a test ended; see the module documentation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -49,7 +49,6 @@ pub mod record;
 pub mod select;
 pub mod ulog;
 
-pub(crate) use binary::{text, Bytes, Primitive};
 pub use csv::units::{TimeUnit, Unit};
 pub use csv::{load_csv, load_csv_records, parse_csv_records, CsvColumns};
 pub use dump::{
@@ -60,7 +59,6 @@ pub use dump_tests::{
     split_tests, test_line, DumpTest, SplitDump, TestEnd, TestProgress, TestRecord,
 };
 pub use error::RecordError;
-pub(crate) use log::median_rate_hz;
 pub use log::{Field, Log, LogError, LogFormat, Topic, Values};
 pub use measurement_filter::MeasurementFilter;
 pub use origin::{check_one_origin, DumpOrigin};

@@ -6,7 +6,7 @@
 
 use sweephold_protocol::{Header, ProtocolVersion, VehicleId};
 
-use super::RecordError;
+use super::error::RecordError;
 
 /// What a dump's Header says about the record's origin.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -4,8 +4,8 @@
 //! The frequency-response analysis (`crate::frf`) and the time-domain verification
 //! (`crate::fit::verify`) read records; the readers beside this module make them.
 
+use super::error::RecordError;
 use super::measurement_filter::MeasurementFilter;
-use super::RecordError;
 
 /// One named channel of samples.
 #[derive(Clone, Debug, PartialEq)]

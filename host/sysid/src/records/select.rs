@@ -25,8 +25,8 @@
 //! given) and its `Ax` the excited axis (reported in the notes). The first sweep is
 //! used unless [`LogChannels::sweep`] picks another. Otherwise the whole overlap.
 
+use super::log::{median_rate_hz, Log, LogError, LogFormat, Topic, Values};
 use super::record::{Channel, Record};
-use super::{median_rate_hz, Log, LogError, LogFormat, Topic, Values};
 
 /// Which fields of a log make the record, and how it is sampled.
 #[derive(Clone, Debug, Default, PartialEq)]

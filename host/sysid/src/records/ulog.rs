@@ -22,7 +22,8 @@
 
 use std::collections::HashMap;
 
-use super::{text, Bytes, Field, Log, LogError, LogFormat, Primitive, Topic, Values};
+use super::binary::{text, Bytes, Primitive};
+use super::log::{Field, Log, LogError, LogFormat, Topic, Values};
 
 /// The first seven bytes of a ULog file.
 pub const MAGIC: &[u8] = b"ULog\x01\x12\x35";

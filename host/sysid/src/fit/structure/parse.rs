@@ -5,16 +5,16 @@ use std::path::Path;
 
 use toml::Spanned;
 
+use super::matrix::{MatrixEntry, MatrixName};
+use super::model_structure::ModelStructure;
+use super::pair::{PairRange, PairSpec};
+use super::parameter::{DerivedParameter, Parameter, ParameterExpression, ParameterKind};
 use super::schema::{
     explain_syntax, line_of, Context, RawActuator, RawParameter, RawRange, RawRows, RawStructure,
     RawValue,
 };
 use super::validate::{
     check_band, check_every_parameter_is_used, check_sizes, file_constants, parse_prior,
-};
-use super::{
-    DerivedParameter, MatrixEntry, MatrixName, ModelStructure, PairRange, PairSpec, Parameter,
-    ParameterExpression, ParameterKind,
 };
 use crate::fit::error::{StructureError, StructureProblem};
 use crate::fit::expression::{parse_linear_declared, LinearForm, MAX_NESTING};

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 
 use super::*;
 use crate::fit::error::{StructureError, StructureProblem};
+use crate::fit::model::Actuator;
 
 const SMALL: &str = r#"
 name = "first-order"

@@ -5,10 +5,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use toml::Spanned;
 
+use super::limits::{MAX_CONTROLS, MAX_OUTPUTS, MAX_PAIRS, MAX_PARAMETERS, MAX_STATES};
+use super::parameter::{ParameterExpression, Prior};
 use super::schema::{Context, RawParameter, RawParameterTable, RawStructure, RawValue};
-use super::{
-    ParameterExpression, Prior, MAX_CONTROLS, MAX_OUTPUTS, MAX_PAIRS, MAX_PARAMETERS, MAX_STATES,
-};
 use crate::fit::error::{StructureError, StructureProblem};
 use crate::fit::expression::LinearForm;
 

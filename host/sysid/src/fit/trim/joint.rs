@@ -30,7 +30,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{balance, balance_rows, TrimError, TrimPoints};
+use super::balance::{balance, balance_rows};
+use super::error::TrimError;
+use super::points::TrimPoints;
 use crate::fit::structure::ModelStructure;
 
 /// The default stick uncertainty of trim points [fraction of travel]: the quantization

@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::VerifyError;
+use super::error::VerifyError;
 use crate::fit::model::Model;
 
 /// The discrete-time form of a model at one sample interval.

@@ -4,10 +4,10 @@
 
 use crate::document::CrossCoherence;
 use crate::frf::coherence::debiased_coherence;
+use crate::frf::error::FrfError;
 use crate::frf::groups::RecordGroup;
 use crate::frf::options::FrfOptions;
 use crate::frf::spectra::WindowSpectra;
-use crate::frf::FrfError;
 use crate::records::Record;
 
 use super::prepare::{prepare_group, spectra_of, PreparedGroup};

@@ -2,13 +2,13 @@
 //! window lengths, the controls it conditions on and the inputs and outputs it gives
 //! responses for.
 
+use crate::frf::error::FrfError;
 use crate::frf::groups::{JoinedRecord, RecordGroup};
 use crate::frf::miso::MAX_INPUTS;
 use crate::frf::options::{FrfOptions, ResponseEstimator, ResponseInputs};
 use crate::frf::spectra::{
     compute_spectra, log_grid, lowest_resolved, window_lengths, SpectraSettings, WindowSpectra,
 };
-use crate::frf::FrfError;
 use crate::records::rms;
 
 /// A group ready for spectra: joined, with grid, windows and channel selection.

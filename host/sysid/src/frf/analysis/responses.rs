@@ -13,8 +13,8 @@ use crate::frf::reference::ReferenceSolve;
 use crate::frf::spectra::WindowSpectra;
 
 use super::cross_coherence::curves_from_spectra;
+use super::outcome::{FrfAnalysis, GroupSummary, MultipleCoherence};
 use super::prepare::{spectra_of, PreparedGroup};
-use super::{FrfAnalysis, GroupSummary, MultipleCoherence};
 
 /// The conditioning inputs' n×n block of a window's input matrix at grid index k, in
 /// `order` (positions in the spectra; n = `order.len()`).
