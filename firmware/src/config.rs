@@ -12,7 +12,7 @@ use crate::excitation_scale::ExcitationScale;
 use crate::hold::HoldThresholds;
 use crate::mixer::MixerConfig;
 use crate::safety::SafetyLimits;
-use crate::slew::CommandSlew;
+use crate::slew::{CommandSlew, HoldSlew};
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
@@ -62,6 +62,8 @@ pub struct Config {
     pub adaptive: AdaptiveSettings,
     /// Slew limit on the commands of the excitation phases (off: [`CommandSlew::NONE`]).
     pub slew: CommandSlew,
+    /// Slew limit on the attitude holds' share of the commands (off: [`HoldSlew::NONE`]).
+    pub hold_slew: HoldSlew,
     /// The share of the test's amplitude and noise each axis gets (the vehicle's stick
     /// units; [`ExcitationScale::UNIT`] flies the test as sent).
     pub excitation_scale: ExcitationScale,
@@ -244,6 +246,7 @@ impl Config {
             mixer: MixerConfig::trex700l(),
             adaptive: AdaptiveSettings::PRESET,
             slew: CommandSlew::NONE,
+            hold_slew: HoldSlew::NONE,
             excitation_scale: ExcitationScale::UNIT,
             collective: CollectiveSource::Trim,
         }
@@ -269,6 +272,7 @@ impl Config {
             mixer: MixerConfig::trex700l(),
             adaptive: AdaptiveSettings::PRESET,
             slew: TREX700L_SLEW,
+            hold_slew: HoldSlew::NONE,
             excitation_scale: ExcitationScale::trex700l(),
             collective: CollectiveSource::Trim,
         }
@@ -372,7 +376,7 @@ impl Config {
         if !self.adaptive.is_valid() {
             return Err(ConfigError::AdaptiveAmplitudeInvalid);
         }
-        if !self.slew.is_valid() {
+        if !self.slew.is_valid() || !self.hold_slew.is_valid() {
             return Err(ConfigError::SlewInvalid);
         }
         if !self.excitation_scale.is_valid() {

@@ -25,6 +25,10 @@
 //!   [`PulseSignal`](crate::pulse::PulseSignal)); every command there is
 //!   `trim + perturbation`, clamped to [−1, 1] and, with a slew limit configured
 //!   ([`Config::slew`]), moved from the tick before's command by at most its axis' step.
+//!   With a hold slew limit ([`Config::hold_slew`]) the hold's share of the perturbation
+//!   (what is left after the sweep and the noise) is first moved from its own value of
+//!   the tick before by at most its axis' step; the sweep and the noise are added as
+//!   they are.
 //!   The perturbation's sweep (or pulse) and noise are the test's, times the vehicle's
 //!   per-axis [`ExcitationScale`](crate::excitation_scale::ExcitationScale).
 //!
@@ -124,6 +128,9 @@ struct HeldAxis {
     last_perturbation: f32,
     /// What is left of the controller's output after a release, fading with τ_r.
     release_carry: f32,
+    /// The hold's share of the command applied last tick (the hold slew limit's starting
+    /// point; only kept with a limit configured).
+    last_hold: f32,
 }
 
 impl HeldAxis {
@@ -132,6 +139,7 @@ impl HeldAxis {
         controller: AttitudeController::ZERO,
         last_perturbation: 0.0,
         release_carry: 0.0,
+        last_hold: 0.0,
     };
 }
 
@@ -209,6 +217,8 @@ pub struct FlightController {
     decays: [AxisDecay; 3],
     /// Largest command step per tick of lat, lon, ped, col (infinite: no slew limit).
     slew_steps: [f32; 4],
+    /// Largest step per tick of the holds' share of lat, lon, ped (infinite: no limit).
+    hold_slew_steps: [f32; 3],
     /// The commands of the tick before (the slew limit's starting point).
     last_command: [f32; 4],
     trim_capture_ticks: u32,
@@ -272,6 +282,7 @@ impl FlightController {
                 AxisDecay::new(&config.gains.ped, dt_s),
             ],
             slew_steps: config.slew.steps(dt_s),
+            hold_slew_steps: config.hold_slew.steps(dt_s),
             last_command: [0.0; 4],
             trim_capture_ticks,
             phase: Phase::Idle,

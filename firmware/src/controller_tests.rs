@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::excitation_scale::ExcitationScale;
-use crate::slew::CommandSlew;
+use crate::slew::{CommandSlew, HoldSlew};
 use proptest::prelude::*;
 use sweephold_protocol::{Decoder, InputKind, PilotInput, WARN_RECORD_SHORT};
 
@@ -339,6 +339,85 @@ fn a_pedal_slew_limit_leaves_the_other_axes_bit_for_bit() {
         .all(|w| (w[1].command.ped - w[0].command.ped).abs() <= step * (1.0 + 1e-5)));
     // The held pedal still gets where the hold drives it, at the limit's pace.
     assert!((limited[299].command.ped - free[299].command.ped).abs() < 1e-3);
+}
+
+/// A lon sweep under conditional attitude hold with the pitch attitude driven through the
+/// engage and release angles every 40 ticks and a fast pitch rate for the hold's rate
+/// damping to answer: every tick's Sample.
+fn pitch_hold_run(hold_slew: HoldSlew) -> Vec<Sample> {
+    let mut config = short_config();
+    config.test.primary = Axis::Lon;
+    config.hold_reference = HoldReference::Level;
+    config.hold_slew = hold_slew;
+    let mut rig = Rig::into_sweep(config);
+    (0..400)
+        .map(|k| {
+            let m = &mut rig.input.meas;
+            m.theta = if (k / 40) % 2 == 0 {
+                8.0 * DEG
+            } else {
+                1.0 * DEG
+            };
+            m.q = 1.5 * libm::sinf(1.3 * k as f32);
+            rig.step();
+            rig.sample()
+        })
+        .collect()
+}
+
+#[test]
+fn a_hold_slew_limit_bounds_the_holds_share_and_passes_the_sweep_and_noise() {
+    let step = 4.0 * short_config().dt_s();
+    // The pilot's sticks are the trim the capture takes.
+    let trim = PILOT[1];
+    let hold = |s: &Sample| s.command.lon - trim - s.sweep.lon - s.noise.lon;
+    let free = pitch_hold_run(HoldSlew::NONE);
+    let limited = pitch_hold_run(HoldSlew {
+        per_s: [f32::INFINITY, 4.0, f32::INFINITY],
+    });
+    let engaged = |s: &Sample| s.hold[1] == HoldState::Engaged;
+    assert!(free.iter().any(engaged) && free.iter().any(|s| !engaged(s)));
+    // Without the limit the hold's rate damping moves its share faster than 4 /s.
+    assert!(free
+        .windows(2)
+        .any(|w| (hold(&w[1]) - hold(&w[0])).abs() > step));
+    let mut transitions = 0;
+    for w in limited.windows(2) {
+        // The hold's share moves by at most one step a tick, engagements and releases
+        // included; the sweep and the noise come and go with the hold state at once.
+        let moved = (hold(&w[1]) - hold(&w[0])).abs();
+        assert!(moved <= step * (1.0 + 1e-4) + 1e-6, "{moved} > {step}");
+        transitions += usize::from(w[0].hold[1] != w[1].hold[1]);
+    }
+    assert!(transitions >= 4, "{transitions}");
+    // The sweep on the swept axis and every other axis are bit for bit those without
+    // the limit.
+    for (a, b) in free.iter().zip(&limited) {
+        assert_eq!(
+            (a.command.lat, a.command.ped, a.command.col, a.hold),
+            (b.command.lat, b.command.ped, b.command.col, b.hold)
+        );
+        assert_eq!((a.sweep.lon, a.noise.lon), (b.sweep.lon, b.noise.lon));
+    }
+}
+
+#[test]
+fn hold_slew_limits_must_be_positive() {
+    for bad in [0.0, -4.0, f32::NAN] {
+        let mut config = short_config();
+        config.hold_slew = HoldSlew {
+            per_s: [f32::INFINITY, bad, f32::INFINITY],
+        };
+        assert_eq!(
+            FlightController::new(config).err(),
+            Some(ConfigError::SlewInvalid)
+        );
+    }
+    assert_eq!(Config::bo105_default(Axis::Lat).hold_slew, HoldSlew::NONE);
+    assert_eq!(
+        Config::trex700l_default(Axis::Lat).hold_slew,
+        HoldSlew::NONE
+    );
 }
 
 #[test]
@@ -854,6 +933,7 @@ proptest! {
         config.test.freeze_in_band = freeze;
         if slewed {
             config.slew = CommandSlew { per_s: [4.0, 2.0, 4.0, 1.0] };
+            config.hold_slew = HoldSlew { per_s: [3.0, 3.0, 1.0] };
         }
         let mixer = config.mixer;
         let mut rig = Rig::into_sweep(config);

@@ -47,6 +47,55 @@ impl CommandSlew {
     }
 }
 
+/// Slew limits of the attitude holds' share of the lat, lon and ped commands \[stick
+/// fraction per second\]: the part of each command the hold controller (and its fade
+/// after a release) produces moves from its own value of the tick before by at most its
+/// axis' rate per second; the sweep and the off-axis noise are added as they are, and
+/// leave or rejoin an axis at once when its hold engages or releases.
+///
+/// Why the hold's share alone: a hold's rate damping (`Kd·ω`) answers the rotor's fast
+/// motion with commands faster than a slow servo follows, so the recorded command is not
+/// the one flown; the sweep and the noise are designed within the servo's rate. Limiting
+/// the whole command instead ([`CommandSlew`]) also slews the noise's steps at the holds'
+/// engagements and releases into the command, which measured worse on the fbl700
+/// (docs/decisions/2026-11-27-fbl700-servo-rate-limit.md). `f32::INFINITY` on an axis:
+/// no limit, and its command is bit for bit the one without the setting.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoldSlew {
+    /// Largest rate of change of each hold's share \[1/s\]: lat, lon, ped.
+    pub per_s: [f32; 3],
+}
+
+impl HoldSlew {
+    /// No limit on any axis.
+    pub const NONE: HoldSlew = HoldSlew {
+        per_s: [f32::INFINITY; 3],
+    };
+
+    /// Every limit positive and not NaN (infinite allowed: no limit).
+    pub fn is_valid(&self) -> bool {
+        self.per_s.iter().all(|&rate| rate > 0.0)
+    }
+
+    /// The largest step per tick of each hold's share for a tick of `dt_s` seconds
+    /// (infinite for an axis without a limit).
+    pub fn steps(&self, dt_s: f32) -> [f32; 3] {
+        self.per_s.map(|rate| {
+            if rate.is_finite() {
+                rate * dt_s
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+}
+
+impl Default for HoldSlew {
+    fn default() -> Self {
+        HoldSlew::NONE
+    }
+}
+
 impl Default for CommandSlew {
     fn default() -> Self {
         CommandSlew::NONE

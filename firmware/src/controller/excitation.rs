@@ -108,8 +108,8 @@ impl FlightController {
             .zip(self.slew_steps);
         for (
             ((((command, sweep_part), noise_part), (&trim_stick, last)), max_step),
-            (held, input),
-        ) in held_parts.zip(self.axes.iter_mut().zip(inputs))
+            ((held, input), hold_step),
+        ) in held_parts.zip(self.axes.iter_mut().zip(inputs).zip(self.hold_slew_steps))
         {
             let step = step_axis(
                 held,
@@ -120,9 +120,20 @@ impl FlightController {
                 &self.thresholds,
                 self.dt_s,
             );
+            let perturbation = if hold_step.is_finite() {
+                let hold = slew::limit(
+                    held.last_hold,
+                    step.perturbation - step.sweep - step.noise,
+                    hold_step,
+                );
+                held.last_hold = hold;
+                step.sweep + step.noise + hold
+            } else {
+                step.perturbation
+            };
             *command = clamp_unit(slew::limit(
                 last,
-                clamp_unit(trim_stick + step.perturbation),
+                clamp_unit(trim_stick + perturbation),
                 max_step,
             ));
             held.last_perturbation = *command - trim_stick;

@@ -38,9 +38,9 @@ pub const MAX_NAME_LEN: usize = 16;
 /// `FRAME`, version 3 the excitation scales, slew limits and the holds' reference,
 /// integrator limits, time constants and directions, version 4 the test's collective
 /// source and the airborne rule, version 5 the test list (`TEST_SEL_CH`, `TEST_SEL_N`,
-/// `TEST1_*` … `TEST12_*`): a record of an older version holds no base preset or none
-/// of those and boots the defaults.
-pub const TABLE_VERSION: u16 = 5;
+/// `TEST1_*` … `TEST12_*`), version 6 the holds' slew limits (`HSLEW_*`): a record of
+/// an older version holds no base preset or none of those and boots the defaults.
+pub const TABLE_VERSION: u16 = 6;
 
 /// Swash type codes: H1, 120°, 135°, 140°.
 const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
@@ -298,6 +298,9 @@ params! {
     Test12Width = "TEST12_WIDTH", "s", 0.01, 60.0, Real, "Test list entry 12: doublet / 3-2-1-1 unit pulse width.";
     Test12Trec = "TEST12_TREC", "s", 0.0, 3600.0, Real, "Test list entry 12: record length; 0: empty entry.";
     Test12Amp = "TEST12_AMP", "", 0.001, 0.5, Real, "Test list entry 12: sweep or pulse amplitude, fraction of stick travel.";
+    HoldSlewLat = "HSLEW_LAT", "1/s", 0.0, 1000.0, Real, "Excitation phases: slew limit of the roll hold's share of lat (stick per s); 0: none.";
+    HoldSlewLon = "HSLEW_LON", "1/s", 0.0, 1000.0, Real, "Excitation phases: slew limit of the pitch hold's share of lon (stick per s); 0: none.";
+    HoldSlewPed = "HSLEW_PED", "1/s", 0.0, 1000.0, Real, "Excitation phases: slew limit of the heading hold's share of ped (stick per s); 0: none.";
 }
 
 /// The vehicle whose preset a `FRAME` value names (ArduPilot's `FRAME_CLASS` idea: one

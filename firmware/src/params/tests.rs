@@ -305,13 +305,20 @@ fn frame_names_the_preset_under_the_table() {
         ParamId::ALL[ParamId::HoldPedRev.index() + 1..ParamId::AirTime.index() + 1],
         [ParamId::TestColSrc, ParamId::AirColMin, ParamId::AirTime]
     );
-    // Version 5 appended the test list after them.
-    assert_eq!(TABLE_VERSION, 5);
+    // Version 5 appended the test list after them, version 6 the holds' slew limits.
+    assert_eq!(TABLE_VERSION, 6);
     assert_eq!(
         ParamId::ALL[ParamId::AirTime.index() + 1],
         ParamId::TestSelCh
     );
-    assert_eq!(ParamId::ALL.last(), Some(&ParamId::Test12Amp));
+    assert_eq!(
+        ParamId::ALL[ParamId::Test12Amp.index() + 1..],
+        [
+            ParamId::HoldSlewLat,
+            ParamId::HoldSlewLon,
+            ParamId::HoldSlewPed
+        ]
+    );
     for vehicle in VEHICLES {
         let table = ParamTable::defaults(vehicle);
         assert_eq!(table.get(ParamId::Frame), frame_code(vehicle));

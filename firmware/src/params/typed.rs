@@ -96,6 +96,13 @@ const SLEW_IDS: [ParamId; 4] = [
     ParamId::SlewCol,
 ];
 
+/// The excitation phases' slew limits of the holds' share of lat, lon, ped.
+const HOLD_SLEW_IDS: [ParamId; 3] = [
+    ParamId::HoldSlewLat,
+    ParamId::HoldSlewLon,
+    ParamId::HoldSlewPed,
+];
+
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
 /// Parameters per test list entry: `TESTn_AXIS`, `_INPUT`, `_WMIN`, `_WMAX`, `_WIDTH`,
@@ -339,6 +346,10 @@ impl Params {
         flight.excitation_scale.per_axis = EXC_SCALE_IDS.map(v);
         // 0 stands for no limit (an infinite value cannot be a parameter).
         flight.slew.per_s = SLEW_IDS.map(|id| match v(id) {
+            0.0 => f32::INFINITY,
+            rate => rate,
+        });
+        flight.hold_slew.per_s = HOLD_SLEW_IDS.map(|id| match v(id) {
             0.0 => f32::INFINITY,
             rate => rate,
         });

@@ -43,6 +43,10 @@ pub struct FlightController {
     /// Slew limit of the excitation phases' commands [stick fraction per s]: lat, lon, ped,
     /// col; `None` inside: no limit on that control. The outer `None`: the preset's.
     pub command_slew: Option<[Option<f64>; 4]>,
+    /// Slew limit of the attitude holds' share of the lat, lon and ped commands in the
+    /// excitation phases [stick fraction per s]; `None` inside: no limit on that axis.
+    /// The outer `None`: the preset's (none).
+    pub hold_slew: Option<[Option<f64>; 3]>,
     /// Abort when |φ| or |θ| exceeds this \[rad\].
     pub attitude_limit: Option<f64>,
     /// Abort when |p|, |q| or |r| exceeds these [rad/s].
@@ -185,6 +189,18 @@ pub(crate) fn read(
             Some(out)
         }
     };
+    let hold_slew = match &f.hold_slew {
+        None => None,
+        Some(table) => {
+            let mut out = [None; 3];
+            let written = [&table.lat, &table.lon, &table.ped];
+            for ((slot, value), control) in out.iter_mut().zip(written).zip(CONTROLS) {
+                let field = format!("hold_slew.{control}");
+                *slot = setting(r, value, &field, D::PerTime, Positive(1000.0))?;
+            }
+            Some(out)
+        }
+    };
     let rate_limits = match &f.rate_limits {
         None => None,
         Some(written) => Some(settings::<3>(
@@ -213,6 +229,7 @@ pub(crate) fn read(
         pulse_width: setting(r, &f.pulse_width, "pulse_width", D::Time, Positive(60.0))?,
         excitation_scale,
         command_slew,
+        hold_slew,
         attitude_limit: setting(r, &f.attitude_limit, "attitude_limit", D::Angle, angle)?,
         rate_limits,
         pilot_override: setting(

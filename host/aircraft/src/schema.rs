@@ -60,6 +60,7 @@ pub(crate) struct FlightController {
     pub pulse_width: Option<Value>,
     pub excitation_scale: Option<Values>,
     pub command_slew: Option<PerControl>,
+    pub hold_slew: Option<PerHeldAxis>,
     pub attitude_limit: Option<Value>,
     pub rate_limits: Option<Values>,
     pub pilot_override: Option<Value>,
@@ -74,6 +75,15 @@ pub(crate) struct PerControl {
     pub lon: Option<Value>,
     pub ped: Option<Value>,
     pub col: Option<Value>,
+}
+
+/// A value per held axis (lat, lon, ped), each optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PerHeldAxis {
+    pub lat: Option<Value>,
+    pub lon: Option<Value>,
+    pub ped: Option<Value>,
 }
 
 /// The attitude hold's gains of the three held axes, each optional.

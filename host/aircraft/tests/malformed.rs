@@ -379,6 +379,16 @@ const SETTING_CASES: &[(&str, &str, &str)] = &[
         "flight_controller.command_slew.ped: `4 s`: unit `s` is not one of /s, 1/s",
     ),
     (
+        "hold slew on the collective, which has no hold",
+        "hold_slew = { col = \"4 /s\" }",
+        "unknown field `col`",
+    ),
+    (
+        "hold slew of zero",
+        "hold_slew = { lon = \"0 /s\" }",
+        "flight_controller.hold_slew.lon",
+    ),
+    (
         "negative rate limit",
         "rate_limits = [\"200 deg/s\", \"-200 deg/s\", \"250 deg/s\"]",
         "flight_controller.rate_limits[1]: -3.49",
@@ -433,6 +443,7 @@ fn flight_controller_settings_read_in_si_and_default_to_none() {
          hold_engage = \"5 deg\"\n\
          hold_release = \"3 deg\"\npulse_width = \"300 ms\"\n\
          excitation_scale = [0.9, 0.8, 0.2, 1.0]\ncommand_slew = { ped = \"4 /s\" }\n\
+         hold_slew = { lat = \"3.6 /s\", lon = \"3 1/s\" }\n\
          attitude_limit = \"20 deg\"\nrate_limits = [\"180 deg/s\", \"3 rad/s\", \"250 deg/s\"]\n\
          pilot_override = 0.1\n\
          hold.lon = { kp = \"2.5 /rad\", ki = \"0.1 /(rad s)\", kd = \"0.2 s/rad\", reversed = true }\n";
@@ -448,6 +459,7 @@ fn flight_controller_settings_read_in_si_and_default_to_none() {
     assert_eq!(read.pulse_width, Some(0.3));
     assert_eq!(read.excitation_scale, Some([0.9, 0.8, 0.2, 1.0]));
     assert_eq!(read.command_slew, Some([None, None, Some(4.0), None]));
+    assert_eq!(read.hold_slew, Some([Some(3.6), Some(3.0), None]));
     assert_eq!(read.rate_limits, Some([180.0 * deg, 3.0, 250.0 * deg]));
     assert_eq!(read.pilot_override, Some(0.1));
     let lon = read.hold[1];

@@ -139,6 +139,9 @@ impl Vehicle {
         if let Some(slew) = file.command_slew {
             config.slew.per_s = slew.map(|rate| rate.map_or(f32::INFINITY, |r| r as f32));
         }
+        if let Some(slew) = file.hold_slew {
+            config.hold_slew.per_s = slew.map(|rate| rate.map_or(f32::INFINITY, |r| r as f32));
+        }
         set(&mut config.safety.attitude_limit_rad, file.attitude_limit);
         if let Some(limits) = file.rate_limits {
             config.safety.rate_limit_rad_s = limits.map(|l| l as f32);
@@ -264,7 +267,7 @@ mod tests {
         let trex = aircraft::SHIPPED[1].1;
         let preset = "preset = \"trex700l\"\n";
         let settings = "hold_engage = \"5 deg\"\nexcitation_scale = [0.8, 0.9, 0.2, 1.0]\n\
-             command_slew = { lon = \"3 /s\" }\nrate_limits = [\"3 rad/s\", \"3 rad/s\", \"4 rad/s\"]\n\
+             command_slew = { lon = \"3 /s\" }\nhold_slew = { ped = \"2 /s\" }\nrate_limits = [\"3 rad/s\", \"3 rad/s\", \"4 rad/s\"]\n\
              hold.lon = { kp = \"2.5 /rad\", release_time = \"0.2 s\" }\n";
         let path = dir.join("tuned.toml");
         std::fs::write(&path, trex.replace(preset, &format!("{preset}{settings}"))).unwrap();
@@ -274,6 +277,7 @@ mod tests {
         expected.test.hold_engage_rad = (5.0 * std::f64::consts::PI / 180.0) as f32;
         expected.excitation_scale.per_axis = [0.8, 0.9, 0.2, 1.0];
         expected.slew.per_s = [f32::INFINITY, 3.0, f32::INFINITY, f32::INFINITY];
+        expected.hold_slew.per_s = [f32::INFINITY, f32::INFINITY, 2.0];
         expected.safety.rate_limit_rad_s = [3.0, 3.0, 4.0];
         expected.gains.lon.kp = 2.5;
         expected.gains.lon.release_time_s = 0.2;

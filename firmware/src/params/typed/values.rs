@@ -132,6 +132,9 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
     for (id, rate) in SLEW_IDS.into_iter().zip(flight.slew.per_s) {
         put(id, if rate.is_finite() { rate } else { 0.0 });
     }
+    for (id, rate) in HOLD_SLEW_IDS.into_iter().zip(flight.hold_slew.per_s) {
+        put(id, if rate.is_finite() { rate } else { 0.0 });
+    }
     let test = &flight.test;
     put(ParamId::HoldEngage, test.hold_engage_rad / DEG);
     put(ParamId::HoldRelease, test.hold_release_rad / DEG);
