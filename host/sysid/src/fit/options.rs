@@ -54,6 +54,14 @@ pub struct FitOptions {
     /// origin (default 10 %: well inside the 25 % a hover mode may be off the truth)
     /// ([`reduce`](super::reduce)).
     pub reduce_max_hover_mode_shift_percent: f64,
+    /// A reduction step is also undone when its refit moves a remaining free parameter
+    /// that the refit identifies within `cramer_rao_limit_percent` by more than this
+    /// percentage of its value before the step (default 50 %: the data determine that
+    /// parameter within a fifth of its value, and it moved by more than twice that to
+    /// stand in for the dropped one; the R-50's yaw damping N_r dropped at CR 31 % moved
+    /// its damper gain K_r +104 %, identified at CR 6 % after the step)
+    /// ([`reduce`](super::reduce)).
+    pub reduce_max_shift_percent: f64,
     /// Flag a Cramér–Rao bound above this percentage of the value.
     pub cramer_rao_limit_percent: f64,
     /// Flag an insensitivity above this percentage of the value.
@@ -96,6 +104,7 @@ impl Default for FitOptions {
             reduce_max_cost_rise: 2.0,
             reduce_max_shift_cramer_rao: 10.0,
             reduce_max_hover_mode_shift_percent: 10.0,
+            reduce_max_shift_percent: 50.0,
             cramer_rao_limit_percent: 20.0,
             insensitivity_limit_percent: 10.0,
             correlation_limit: 0.9,
