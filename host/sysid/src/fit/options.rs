@@ -25,9 +25,10 @@ pub struct FitOptions {
     /// Perturbation of the starts after `explore_starts`, about the best minimum so far.
     pub polish_spread: f64,
     /// Spend every one of `max_starts` (a budget, not a limit): after the structure's
-    /// values, three quarters of the starts are drawn across the parameter box
+    /// values, half of the starts are drawn across the parameter box
     /// (`box_decades` either side of each start value, log-uniform, sign kept) and the
-    /// rest perturb the best minimum by `polish_spread`; the minimum counts as confirmed
+    /// rest perturb the best minimum by `polish_spread`, doubled after every four of them
+    /// in a row that find nothing lower (up to ±80 %); the minimum counts as confirmed
     /// only when two independent starts (the structure's values or box draws) reach it
     /// (the `search` module). Off by default: the shipped structures' campaigns keep
     /// the local search; `sweephold fit --search global` turns it on.
