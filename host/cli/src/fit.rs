@@ -80,7 +80,8 @@ pub struct FitArgs {
     /// `local` (default) or `global`: every one of `--max-starts` made, the structure's
     /// start values, then half the starts drawn across the parameter box (each free
     /// value's magnitude log-uniform within half a decade of its start value, sign kept,
-    /// bounds honoured), the rest perturbing the best plausible minimum (±10 %); the
+    /// bounds honoured), the rest perturbing the best plausible minimum (±10 %, doubled
+    /// after every four perturbations in a row that find nothing lower, up to ±80 %); the
     /// minimum counts as confirmed only when two independent starts reach it. For
     /// structures started from rough values (e.g. `--search global --max-starts 64`).
     #[arg(long, value_enum, default_value_t = SearchArg::Local, value_name = "HOW")]

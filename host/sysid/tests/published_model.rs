@@ -94,3 +94,61 @@ fn the_global_search_spends_its_budget_and_finds_the_same_minimum() {
     assert!(result.average_cost < 0.1, "J_ave {}", result.average_cost);
     assert_eq!(within.len(), 32, "within 10 %: {within:?}");
 }
+
+/// The published model's modes are named after their eigenvectors: the flapping `a b`,
+/// stabilizer-bar `c d` and yaw-damper `rfb` states join the axis that drives them
+/// (`sysid::fit::modes::state_kinds`) and its speeds weigh as ft/s. Measured names and
+/// shares (ω_n): the two hover oscillations (0.29 unstable, 0.38) coupled, lateral 0.56 /
+/// longitudinal 0.41 and 0.37 / 0.40; heave 0.61 (heave 0.84); pitch–flap 8.9 (rotor
+/// longitudinal 0.10 + longitudinal 0.10, heave 0.73 through Z_a); roll–flap 9.8 (rotor
+/// lateral 0.14 + lateral 0.28); yaw oscillation 10.3, the yaw damper's (yaw 0.99);
+/// roll–flap 13.1 (rotor lateral 0.37 + lateral 0.37). Before, with every unnamed state
+/// `other` and speeds read as m/s: "heave oscillation" for three of the rotor modes and
+/// "other" for the yaw damper's.
+#[test]
+fn the_published_models_modes_are_named_after_their_eigenvectors() {
+    use sysid::fit::modes::{modes, ModeName};
+    let (structure, truth) = structure_and_truth();
+    let model = structure.model(&truth).unwrap();
+    let found = modes(&model).unwrap();
+    let at = |omega: f64| {
+        found
+            .iter()
+            .find(|m| (m.eigenvalue.norm() - omega).abs() < 0.05)
+            .unwrap_or_else(|| panic!("no mode at {omega} rad/s: {found:?}"))
+    };
+    let hover_a = at(0.288);
+    let hover_b = at(0.383);
+    for hover in [hover_a, hover_b] {
+        assert_eq!(hover.name, ModeName::HoverOscillationCoupled);
+        let g = &hover.groups;
+        assert!(g.lateral + g.longitudinal > 0.75, "{g:?}");
+    }
+    assert!(
+        hover_a.eigenvalue.re > 0.0,
+        "the unstable hover oscillation"
+    );
+    let heave = at(0.609);
+    assert_eq!(heave.name, ModeName::Heave);
+    assert!(heave.groups.heave > 0.8, "{:?}", heave.groups);
+    let pitch_flap = at(8.914);
+    assert_eq!(pitch_flap.name, ModeName::PitchFlap);
+    assert!(
+        pitch_flap.groups.rotor_longitudinal > 0.05,
+        "{:?}",
+        pitch_flap.groups
+    );
+    for omega in [9.807, 13.080] {
+        let roll_flap = at(omega);
+        assert_eq!(roll_flap.name, ModeName::RollFlap);
+        let g = &roll_flap.groups;
+        assert!(
+            g.rotor_lateral > 0.1 && g.rotor_lateral + g.lateral > 0.4,
+            "{g:?}"
+        );
+    }
+    let damper = at(10.276);
+    assert_eq!(damper.name, ModeName::YawOscillation);
+    assert!(damper.groups.yaw > 0.95, "{:?}", damper.groups);
+    assert_eq!(found.len(), 7, "{found:?}");
+}

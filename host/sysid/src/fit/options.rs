@@ -25,9 +25,10 @@ pub struct FitOptions {
     /// Perturbation of the starts after `explore_starts`, about the best minimum so far.
     pub polish_spread: f64,
     /// Spend every one of `max_starts` (a budget, not a limit): after the structure's
-    /// values, three quarters of the starts are drawn across the parameter box
+    /// values, half of the starts are drawn across the parameter box
     /// (`box_decades` either side of each start value, log-uniform, sign kept) and the
-    /// rest perturb the best minimum by `polish_spread`; the minimum counts as confirmed
+    /// rest perturb the best minimum by `polish_spread`, doubled after every four of them
+    /// in a row that find nothing lower (up to ±80 %); the minimum counts as confirmed
     /// only when two independent starts (the structure's values or box draws) reach it
     /// (the `search` module). Off by default: the shipped structures' campaigns keep
     /// the local search; `sweephold fit --search global` turns it on.
@@ -54,6 +55,14 @@ pub struct FitOptions {
     /// origin (default 10 %: well inside the 25 % a hover mode may be off the truth)
     /// ([`reduce`](super::reduce)).
     pub reduce_max_hover_mode_shift_percent: f64,
+    /// A reduction step is also undone when its refit moves a remaining free parameter
+    /// that the refit identifies within `cramer_rao_limit_percent` by more than this
+    /// percentage of its value before the step (default 50 %: the data determine that
+    /// parameter within a fifth of its value, and it moved by more than twice that to
+    /// stand in for the dropped one; the R-50's yaw damping N_r dropped at CR 31 % moved
+    /// its damper gain K_r +104 %, identified at CR 6 % after the step)
+    /// ([`reduce`](super::reduce)).
+    pub reduce_max_shift_percent: f64,
     /// Flag a Cramér–Rao bound above this percentage of the value.
     pub cramer_rao_limit_percent: f64,
     /// Flag an insensitivity above this percentage of the value.
@@ -96,6 +105,7 @@ impl Default for FitOptions {
             reduce_max_cost_rise: 2.0,
             reduce_max_shift_cramer_rao: 10.0,
             reduce_max_hover_mode_shift_percent: 10.0,
+            reduce_max_shift_percent: 50.0,
             cramer_rao_limit_percent: 20.0,
             insensitivity_limit_percent: 10.0,
             correlation_limit: 0.9,

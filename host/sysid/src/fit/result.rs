@@ -279,6 +279,12 @@ pub struct ReductionStep {
     /// (so the step was undone whatever its cost): which mode, from where to where.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub moved_hover_mode: Option<String>,
+    /// The refit moved a remaining parameter that it identifies within the Cramér–Rao
+    /// guideline by more than [`FitOptions::reduce_max_shift_percent`] of its value (so
+    /// the step was undone whatever its cost: that parameter made up for the dropped
+    /// one): which, from where to where.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensated_by: Option<String>,
 }
 
 impl ReductionStep {
@@ -289,6 +295,8 @@ impl ReductionStep {
         }
         Some(if let Some(mode) = &self.moved_hover_mode {
             format!("without it the refit {mode}")
+        } else if let Some(compensation) = &self.compensated_by {
+            format!("without it the refit moves {compensation} to make up for it")
         } else if self.left_the_minimum {
             "without it the refit leaves the minimum".to_string()
         } else if self.average_cost_after.is_finite() {

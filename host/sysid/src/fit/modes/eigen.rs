@@ -26,6 +26,7 @@ use super::naming::{
     group_shares, name_of, scaled_shares, GroupShares, ModeName, HOVER_MODE_LIMIT_RAD_S,
     ORIGIN_LIMIT_RAD_S,
 };
+use super::state_kinds::StateKinds;
 use crate::fit::model::Model;
 
 /// Iteration limit of the Schur and SVD decompositions (they converge in a few dozen
@@ -132,6 +133,7 @@ pub fn modes(model: &Model) -> Result<Vec<Mode>, ModeError> {
         return Err(ModeError::NotFinite);
     }
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1.0);
+    let kinds = StateKinds::of(&model.states, &a);
     let mut found = Vec::new();
     for lambda in eigenvalues.iter() {
         // Real when its imaginary part is at rounding level; a pair by its Im > 0 member.
@@ -147,8 +149,8 @@ pub fn modes(model: &Model) -> Result<Vec<Mode>, ModeError> {
             *lambda
         };
         let magnitudes = eigenvector_magnitudes(&a, eigenvalue)?;
-        let shares = scaled_shares(&model.states, &magnitudes, eigenvalue.norm());
-        let groups = group_shares(&model.states, &shares);
+        let shares = scaled_shares(&kinds, &magnitudes, eigenvalue.norm());
+        let groups = group_shares(&kinds, &shares);
         let poles = if real { 1 } else { 2 };
         found.push(Mode {
             name: name_of(eigenvalue, poles, &groups),

@@ -5,6 +5,8 @@
 //! * [`eigen`] — the eigenvalues of `A = M⁻¹F` and their eigenvectors, as [`Mode`]s
 //!   (the figures of one mode);
 //! * [`naming`] — how a mode is named from its eigenvector (the rules);
+//! * [`state_kinds`] — each state's unit and group for the naming, by its name or, for
+//!   a state of another name, by what drives it in the model;
 //! * [`record`] — a mode as written in `model.json` ([`ModeRecord`]);
 //! * [`comparison`] — an identified model's modes paired with a truth model's;
 //! * [`text`] — an eigenvalue as text.
@@ -15,6 +17,7 @@ pub mod comparison;
 pub mod eigen;
 pub mod naming;
 pub mod record;
+pub mod state_kinds;
 pub mod text;
 
 pub use comparison::{
@@ -24,9 +27,10 @@ pub use comparison::{
 pub use eigen::{modes, state_matrix, Mode, ModeError};
 pub use naming::{
     GroupShares, ModeName, AXIS_DOMINANCE, HOVER_MODE_LIMIT_RAD_S, ORIGIN_LIMIT_RAD_S,
-    ROTOR_SHARE_LIMIT, SCALING_FLOOR_RAD_S, SPIRAL_LIMIT_RAD_S, SPIRAL_SHARE, STANDARD_GRAVITY,
+    ROTOR_SHARE_LIMIT, SCALING_FLOOR_RAD_S, SPIRAL_LIMIT_RAD_S, SPIRAL_SHARE,
 };
 pub use record::{mode_records, poles_at_origin, ModeRecord};
+pub use state_kinds::{FOOT_GRAVITY, STANDARD_GRAVITY};
 pub use text::eigenvalue_text;
 
 #[cfg(test)]

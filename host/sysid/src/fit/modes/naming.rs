@@ -12,19 +12,23 @@
 //! ```
 //!
 //! so that a rate and the attitude it integrates to, or a speed and the attitude whose
-//! gravity component drives it, weigh the same (g = 9.80665 m/s²). A state of another
-//! name keeps its own unit. The floor of 0.1 rad/s ([`SCALING_FLOOR_RAD_S`], a 63 s
+//! gravity component drives it, weigh the same (g = 9.80665 m/s², or 32.174 ft/s² when the
+//! model's gravity term says its speeds are in ft/s: [`super::state_kinds`]). A state of
+//! another name keeps its own unit. The floor of 0.1 rad/s ([`SCALING_FLOOR_RAD_S`], a 63 s
 //! period) keeps a drift from being named by a trace of attitude: with `|λ|` itself a heave
 //! mode that has lost its damping (`Z_w` = 0, λ = −0.0007 rad/s, eigenvector w 1, θ 0.0018
 //! — seed 2 of the default campaign) would weigh its speed by 7·10⁻⁵ and read as a pitch
 //! mode. The share of state i is `a_i² / Σ_j a_j²` (the shares sum to
 //! 1), and the states fall into groups: lateral body `v p φ`, longitudinal body `u q θ`,
 //! heave `w`, yaw `r ψ`, rotor `b1s` (lateral) and `b1c` (longitudinal) (also
-//! `beta1s`/`beta1c`), other. The rules, first match wins:
+//! `beta1s`/`beta1c`); a state of another name joins the group of what drives it in the
+//! model (a flap or stabilizer-bar state driven by p or q is that axis's rotor, a yaw
+//! damper's state driven by r is yaw: [`super::state_kinds`]), else other. The rules,
+//! first match wins:
 //!
 //! 1. `|λ| < 10⁻⁶` rad/s → `origin`.
 //! 2. rotor share ≥ 0.10 ([`ROTOR_SHARE_LIMIT`]) → `roll–flap` when
-//!    `b1s + lateral ≥ b1c + longitudinal`, else `pitch–flap`. (The flap states with p or q:
+//!    `rotor lateral + lateral ≥ rotor longitudinal + longitudinal`, else `pitch–flap`. (The flap states with p or q:
 //!    fast modes, above 7 rad/s on the Bo-105; on it the roll–flap pair's rotor share is
 //!    0.25.)
 //! 3. complex pair, `|λ| < 3` rad/s ([`HOVER_MODE_LIMIT_RAD_S`]): yaw the largest group →
@@ -49,13 +53,13 @@ use std::fmt;
 
 use num_complex::Complex64;
 
+use super::state_kinds::{Group, StateKinds, Unit};
+
 /// A mode with `|λ|` below this [rad/s] is a pole at the origin.
 pub const ORIGIN_LIMIT_RAD_S: f64 = 1e-6;
 /// Modes below this natural frequency [rad/s] are hover modes (the hover oscillations,
 /// heave, yaw): the issue's acceptance criteria compare them with the truth.
 pub const HOVER_MODE_LIMIT_RAD_S: f64 = 3.0;
-/// Gravity [m/s²] of the speed-to-attitude scaling of the eigenvector.
-pub const STANDARD_GRAVITY: f64 = 9.80665;
 /// The eigenvector's rates and speeds are scaled with `max(|λ|, this)` [rad/s].
 pub const SCALING_FLOOR_RAD_S: f64 = 0.1;
 /// A mode whose flap states take at least this share is a rotor (flap) mode.
@@ -136,49 +140,6 @@ impl fmt::Display for ModeName {
     }
 }
 
-/// The group a state's motion belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Group {
-    Lateral,
-    Longitudinal,
-    Heave,
-    Yaw,
-    RotorLateral,
-    RotorLongitudinal,
-    Other,
-}
-
-/// The unit of a state, which sets how its eigenvector component is scaled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Unit {
-    /// rad: as it is.
-    Angle,
-    /// rad/s: divided by |λ|.
-    Rate,
-    /// m/s: times |λ|/g.
-    Speed,
-    /// Anything else: as it is.
-    Own,
-}
-
-/// Unit and group of a state by its name.
-fn classify(state: &str) -> (Unit, Group) {
-    match state {
-        "u" => (Unit::Speed, Group::Longitudinal),
-        "v" => (Unit::Speed, Group::Lateral),
-        "w" => (Unit::Speed, Group::Heave),
-        "p" => (Unit::Rate, Group::Lateral),
-        "q" => (Unit::Rate, Group::Longitudinal),
-        "r" => (Unit::Rate, Group::Yaw),
-        "phi" => (Unit::Angle, Group::Lateral),
-        "theta" => (Unit::Angle, Group::Longitudinal),
-        "psi" => (Unit::Angle, Group::Yaw),
-        "b1s" | "beta1s" => (Unit::Angle, Group::RotorLateral),
-        "b1c" | "beta1c" => (Unit::Angle, Group::RotorLongitudinal),
-        _ => (Unit::Own, Group::Other),
-    }
-}
-
 /// Shares of a mode per group of states (they sum to 1).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GroupShares {
@@ -244,16 +205,17 @@ impl GroupShares {
 }
 
 /// Shares `a_i² / Σ a_j²` of the attitude-equivalent components (module documentation).
-pub(super) fn scaled_shares(states: &[String], magnitudes: &[f64], omega: f64) -> Vec<f64> {
+pub(super) fn scaled_shares(kinds: &StateKinds, magnitudes: &[f64], omega: f64) -> Vec<f64> {
     let omega = omega.max(SCALING_FLOOR_RAD_S);
-    let scaled: Vec<f64> = states
+    let scaled: Vec<f64> = kinds
+        .kinds
         .iter()
         .zip(magnitudes)
-        .map(|(state, magnitude)| {
-            let factor = match classify(state).0 {
+        .map(|(&(unit, _), magnitude)| {
+            let factor = match unit {
                 Unit::Angle | Unit::Own => 1.0,
                 Unit::Rate => 1.0 / omega,
-                Unit::Speed => omega / STANDARD_GRAVITY,
+                Unit::Speed => omega / kinds.gravity,
             };
             (magnitude * factor).powi(2)
         })
@@ -266,11 +228,11 @@ pub(super) fn scaled_shares(states: &[String], magnitudes: &[f64], omega: f64) -
     }
 }
 
-/// The shares of `states` by group (they sum to 1 when `shares` do).
-pub(super) fn group_shares(states: &[String], shares: &[f64]) -> GroupShares {
+/// The shares of the states by group (they sum to 1 when `shares` do).
+pub(super) fn group_shares(kinds: &StateKinds, shares: &[f64]) -> GroupShares {
     let mut groups = GroupShares::default();
-    for (state, share) in states.iter().zip(shares) {
-        groups.add(classify(state).1, *share);
+    for (&(_, group), share) in kinds.kinds.iter().zip(shares) {
+        groups.add(group, *share);
     }
     groups
 }
