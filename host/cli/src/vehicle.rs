@@ -243,13 +243,16 @@ mod tests {
         assert_eq!(trex.trim_balance(), TrimBalance::Joint);
         assert_eq!(trex.range_source(), RangeSource::Estimate);
         assert_eq!(trex.servos(), rotorsim::SimOptions::default().actuator);
-        // The third flies the TREX's preset with the gains and cyclic excitation its file
-        // states, and the preset's everything else.
+        // The third flies the TREX's preset with the gains, cyclic excitation and slew
+        // limits its file states (the holds' share limited, the whole command not), and
+        // the preset's everything else.
         let fbl = Vehicle::shipped("fbl700");
         assert_eq!(fbl.preset(), VehicleId::Trex700l);
         let own = fbl.firmware_config(Axis::Lat);
         let mut expected = Config::trex700l_default(Axis::Lat);
         expected.excitation_scale.per_axis = [0.7, 0.7, 0.2, 1.0];
+        expected.slew = sweephold_firmware::slew::CommandSlew::NONE;
+        expected.hold_slew.per_s = [3.6, 3.6, 4.0];
         for (gains, [kp, ki, kd]) in [
             (&mut expected.gains.lat, [2.12, 0.07, 0.113]),
             (&mut expected.gains.lon, [2.94, 0.074, 0.22]),
