@@ -8,26 +8,38 @@
 //! limit is off (infinite) by default; a vehicle preset turns it on where its controller
 //! drives a servo into its rate limit.
 
-/// Slew limits of the four commands \[stick fraction per second\], in the order lat, lon,
-/// ped, col. Each is positive; `f32::INFINITY` means no limit on that axis.
+/// Per-axis slew limits \[stick fraction per second\] of `N` axes. Each is positive;
+/// `f32::INFINITY` means no limit on that axis. Two uses: [`CommandSlew`] (the four
+/// commands) and [`HoldSlew`] (the holds' share of the three held ones).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CommandSlew {
-    /// Largest rate of change of each command \[1/s\]: lat, lon, ped, col.
-    pub per_s: [f32; 4],
+pub struct SlewLimits<const N: usize> {
+    /// Largest rate of change on each axis \[1/s\].
+    pub per_s: [f32; N],
 }
 
-impl CommandSlew {
-    /// No limit on any axis.
-    pub const NONE: CommandSlew = CommandSlew {
-        per_s: [f32::INFINITY; 4],
-    };
+/// Slew limits of the four commands, in the order lat, lon, ped, col.
+pub type CommandSlew = SlewLimits<4>;
 
-    /// Only the pedal limited, to `per_s` \[1/s\].
-    pub const fn pedal(per_s: f32) -> CommandSlew {
-        CommandSlew {
-            per_s: [f32::INFINITY, f32::INFINITY, per_s, f32::INFINITY],
-        }
-    }
+/// Slew limits of the attitude holds' share of the lat, lon and ped commands: the part of
+/// each command the hold controller (and its fade after a release) produces moves from
+/// its own value of the tick before by at most its axis' rate per second; the sweep and
+/// the off-axis noise are added as they are, and leave or rejoin an axis at once when its
+/// hold engages or releases.
+///
+/// Why the hold's share alone: a hold's rate damping (`Kd·ω`) answers the rotor's fast
+/// motion with commands faster than a slow servo follows, so the recorded command is not
+/// the one flown; the sweep and the noise are designed within the servo's rate. Limiting
+/// the whole command instead ([`CommandSlew`]) also slews the noise's steps at the holds'
+/// engagements and releases into the command, which measured worse on the fbl700
+/// (docs/decisions/2026-11-27-fbl700-servo-rate-limit.md). An infinite limit on an axis:
+/// its command is bit for bit the one without the setting.
+pub type HoldSlew = SlewLimits<3>;
+
+impl<const N: usize> SlewLimits<N> {
+    /// No limit on any axis.
+    pub const NONE: Self = SlewLimits {
+        per_s: [f32::INFINITY; N],
+    };
 
     /// Every limit positive and not NaN (infinite allowed: no limit).
     pub fn is_valid(&self) -> bool {
@@ -36,7 +48,7 @@ impl CommandSlew {
 
     /// The largest step per tick of each axis for a tick of `dt_s` seconds (infinite for an
     /// axis without a limit).
-    pub fn steps(&self, dt_s: f32) -> [f32; 4] {
+    pub fn steps(&self, dt_s: f32) -> [f32; N] {
         self.per_s.map(|rate| {
             if rate.is_finite() {
                 rate * dt_s
@@ -47,58 +59,18 @@ impl CommandSlew {
     }
 }
 
-/// Slew limits of the attitude holds' share of the lat, lon and ped commands \[stick
-/// fraction per second\]: the part of each command the hold controller (and its fade
-/// after a release) produces moves from its own value of the tick before by at most its
-/// axis' rate per second; the sweep and the off-axis noise are added as they are, and
-/// leave or rejoin an axis at once when its hold engages or releases.
-///
-/// Why the hold's share alone: a hold's rate damping (`Kd·ω`) answers the rotor's fast
-/// motion with commands faster than a slow servo follows, so the recorded command is not
-/// the one flown; the sweep and the noise are designed within the servo's rate. Limiting
-/// the whole command instead ([`CommandSlew`]) also slews the noise's steps at the holds'
-/// engagements and releases into the command, which measured worse on the fbl700
-/// (docs/decisions/2026-11-27-fbl700-servo-rate-limit.md). `f32::INFINITY` on an axis:
-/// no limit, and its command is bit for bit the one without the setting.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HoldSlew {
-    /// Largest rate of change of each hold's share \[1/s\]: lat, lon, ped.
-    pub per_s: [f32; 3],
-}
-
-impl HoldSlew {
-    /// No limit on any axis.
-    pub const NONE: HoldSlew = HoldSlew {
-        per_s: [f32::INFINITY; 3],
-    };
-
-    /// Every limit positive and not NaN (infinite allowed: no limit).
-    pub fn is_valid(&self) -> bool {
-        self.per_s.iter().all(|&rate| rate > 0.0)
-    }
-
-    /// The largest step per tick of each hold's share for a tick of `dt_s` seconds
-    /// (infinite for an axis without a limit).
-    pub fn steps(&self, dt_s: f32) -> [f32; 3] {
-        self.per_s.map(|rate| {
-            if rate.is_finite() {
-                rate * dt_s
-            } else {
-                f32::INFINITY
-            }
-        })
+impl CommandSlew {
+    /// Only the pedal limited, to `per_s` \[1/s\].
+    pub const fn pedal(per_s: f32) -> CommandSlew {
+        SlewLimits {
+            per_s: [f32::INFINITY, f32::INFINITY, per_s, f32::INFINITY],
+        }
     }
 }
 
-impl Default for HoldSlew {
+impl<const N: usize> Default for SlewLimits<N> {
     fn default() -> Self {
-        HoldSlew::NONE
-    }
-}
-
-impl Default for CommandSlew {
-    fn default() -> Self {
-        CommandSlew::NONE
+        Self::NONE
     }
 }
 
