@@ -179,27 +179,15 @@ pub(crate) fn read(
     };
     let command_slew = match &f.command_slew {
         None => None,
-        Some(table) => {
-            let mut out = [None; 4];
-            let written = [&table.lat, &table.lon, &table.ped, &table.col];
-            for ((slot, value), control) in out.iter_mut().zip(written).zip(CONTROLS) {
-                let field = format!("command_slew.{control}");
-                *slot = setting(r, value, &field, D::PerTime, Positive(1000.0))?;
-            }
-            Some(out)
-        }
+        Some(t) => Some(slew_rates(
+            r,
+            [&t.lat, &t.lon, &t.ped, &t.col],
+            "command_slew",
+        )?),
     };
     let hold_slew = match &f.hold_slew {
         None => None,
-        Some(table) => {
-            let mut out = [None; 3];
-            let written = [&table.lat, &table.lon, &table.ped];
-            for ((slot, value), control) in out.iter_mut().zip(written).zip(CONTROLS) {
-                let field = format!("hold_slew.{control}");
-                *slot = setting(r, value, &field, D::PerTime, Positive(1000.0))?;
-            }
-            Some(out)
-        }
+        Some(t) => Some(slew_rates(r, [&t.lat, &t.lon, &t.ped], "hold_slew")?),
     };
     let rate_limits = match &f.rate_limits {
         None => None,
@@ -301,6 +289,27 @@ fn hold_gains(r: &Reader, h: &schema::HoldAxis, axis: &str) -> Result<HoldGains,
 }
 
 /// An optional setting `flight_controller.KEY`: read in its dimension and range, without σ.
+/// A slew table's rates, per control in the order lat, lon, ped (, col): each optional,
+/// in (0, 1000] per second; `table` names it in errors (`command_slew.ped`).
+fn slew_rates<const N: usize>(
+    r: &Reader,
+    written: [&Option<Value>; N],
+    table: &str,
+) -> Result<[Option<f64>; N], AircraftError> {
+    let mut out = [None; N];
+    for ((slot, value), control) in out.iter_mut().zip(written).zip(CONTROLS) {
+        let field = format!("{table}.{control}");
+        *slot = setting(
+            r,
+            value,
+            &field,
+            Dimension::PerTime,
+            Range::Positive(1000.0),
+        )?;
+    }
+    Ok(out)
+}
+
 fn setting(
     r: &Reader,
     written: &Option<Value>,
