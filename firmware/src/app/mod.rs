@@ -89,7 +89,7 @@ use cues::{Cue, CueState, CueTracker};
 use failsafe::{FailsafeSettings, ImuMonitor, ImuView, RcLossHold, RcMonitor};
 use pilot_mode::{AxisDemand, Demand, LoopFactors, LoopSensors, PilotLoops, PilotModeGains};
 use reporting::{BoardTap, Reporter};
-use test_list::{TestList, TestListError};
+use test_list::{engagement_seed, TestList, TestListError};
 use throttle::{Throttle, ThrottleSettings};
 
 pub use arming::{CheckFailure, Refusal};
@@ -497,11 +497,12 @@ impl BoardApp {
     fn engage(&mut self, entry: u8) {
         self.engagements = self.engagements.saturating_add(1);
         let base = &self.config.flight.test;
-        let test = self
+        let mut test = self
             .config
             .tests
             .get(entry)
             .map_or(*base, |chosen| chosen.apply(base));
+        test.seed = engagement_seed(base.seed, self.engagements);
         let selection = TestSelection {
             entry,
             engagement: self.engagements,

@@ -7,6 +7,15 @@
 //! settings) stays the sequencer's one configuration: a campaign flies every record with
 //! the same ones. An entry with no axis or a zero record length is empty.
 //!
+//! # Each test of a flight its own noise
+//!
+//! The off-axis noise of the n-th test engaged since power-up is seeded with
+//! [`engagement_seed`]`(TEST_SEED, n)`: the stored seed for the first test, another seed for
+//! each later one. With one seed for all, every test of a flight would put the same noise
+//! sequence on its off-axes, and a noise-driven error would repeat in every record the
+//! identification combines instead of averaging out. The Header records the seed each
+//! test flew with; a flight of one test per power-up flies exactly as before.
+//!
 //! # Why [`TEST_LIST_LEN`] = 12
 //!
 //! The campaign the host flies for each aircraft preset (`sweephold campaign`) is two
@@ -32,6 +41,16 @@ use crate::config::{Config, ConfigError};
 
 /// Entries in the test list (see the module documentation for the choice).
 pub const TEST_LIST_LEN: usize = 12;
+
+/// The off-axis noise seed of the `engagement`-th test since power-up (1-based): `seed`
+/// for the first (and for 0, no engagement), then `seed` plus (n − 1) times the 32-bit
+/// golden-ratio constant 0x9E37_79B9 (a Weyl sequence: no two engagements below 2³² share
+/// a seed). The noise generator (PCG32) mixes its seed, so neighbouring seeds give
+/// unrelated sequences.
+pub const fn engagement_seed(seed: u32, engagement: u16) -> u32 {
+    let later = engagement.saturating_sub(1) as u32;
+    seed.wrapping_add(later.wrapping_mul(0x9E37_79B9))
+}
 
 /// One entry of the list.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,8 +3,8 @@
 //! an empty entry is refused, and without a selector the single test flies as before.
 
 use super::*;
-use crate::app::test_list::{TestEntry, TestList, TEST_LIST_LEN};
-use sweephold_protocol::{Header, InputKind, RefusedCheck, TestSelection};
+use crate::app::test_list::{engagement_seed, TestEntry, TestList, TEST_LIST_LEN};
+use sweephold_protocol::{Header, InputKind, RefusedCheck, TestConfig, TestSelection};
 
 /// The TREX 700L campaign list with 3 s records (the tests' short runs).
 fn short_list_config() -> AppConfig {
@@ -68,10 +68,13 @@ fn the_selector_at_each_slice_engages_that_entry_and_counts_the_engagements() {
         assert_eq!(header.test.sweep.t_rec_s, chosen.t_rec_s);
         assert_eq!(header.test.pulse.width_s, chosen.pulse_width_s);
         assert_eq!(header.test.sweep.amplitude, chosen.amplitude);
-        // What stays global: the mode, the noise and its seed.
+        // What stays global: the mode and the noise; its seed is the engagement's.
         assert_eq!(header.test.mode, config.flight.test.mode);
         assert_eq!(header.test.noise_rms, config.flight.test.noise_rms);
-        assert_eq!(header.test.seed, config.flight.test.seed);
+        assert_eq!(
+            header.test.seed,
+            engagement_seed(config.flight.test.seed, entry as u16)
+        );
         assert_eq!(header.protocol, ProtocolVersion::BOARD_APPLICATION);
     }
     // The ends of the travel select the first and the last entry.
@@ -196,9 +199,11 @@ fn without_a_selector_the_single_test_flies_as_entry_zero() {
                 engagement
             })
         );
-        // The configured test, its warnings as the sequencer filled them in.
+        // The configured test, its warnings as the sequencer filled them in and the
+        // engagement's noise seed.
         let mut expected = config.flight.test;
         expected.warnings = header.test.warnings;
+        expected.seed = engagement_seed(config.flight.test.seed, engagement);
         assert_eq!(header.test, expected);
         assert_eq!(header.test.input, InputKind::Sweep);
     }
@@ -211,5 +216,79 @@ fn without_a_selector_the_single_test_flies_as_entry_zero() {
     assert_eq!(
         single.selection.map(|s| (s.entry, s.engagement)),
         Some((0, 5))
+    );
+}
+
+/// Each test of a flight gets its own noise seed: the stored one for the first (a flight
+/// of one test flies as before), a different one for every later engagement, and so
+/// another noise sequence on the same entry.
+#[test]
+fn every_engagement_of_a_flight_has_its_own_noise_seed() {
+    let seed = 0xDEAD_BEEF;
+    assert_eq!(engagement_seed(seed, 1), seed);
+    assert_eq!(engagement_seed(seed, 0), seed);
+    let mut seeds: Vec<u32> = (1..=1000).map(|n| engagement_seed(seed, n)).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    assert_eq!(seeds.len(), 1000);
+    assert_eq!(
+        engagement_seed(u32::MAX, u16::MAX),
+        u32::MAX.wrapping_add(65_534u32.wrapping_mul(0x9E37_79B9))
+    );
+
+    // The same entry engaged twice: the same test but its seed, and other noise on the
+    // off-axes during the sweep.
+    let config = short_list_config();
+    let mut rig = Rig::armed(config);
+    let position = Some(slice_centre(1, TEST_LIST_LEN));
+    let fly = |rig: &mut Rig| {
+        rig.rc.selector = position;
+        rig.start_test();
+        let first = rig.outputs.len();
+        for _ in 0..400 {
+            rig.tick();
+            if matches!(rig.outputs.last().map(|o| o.phase), Some(Phase::Done)) {
+                break;
+            }
+        }
+        let commands: Vec<Controls> = rig.outputs[first..].iter().map(|o| o.command).collect();
+        rig.rc.test_switch = false;
+        rig.ticks(3);
+        commands
+    };
+    let first = fly(&mut rig);
+    let second = fly(&mut rig);
+    let sent = headers(&rig);
+    assert_eq!(sent.len(), 2);
+    assert_eq!(sent[0].test.seed, config.flight.test.seed);
+    assert_eq!(
+        sent[1].test.seed,
+        engagement_seed(config.flight.test.seed, 2)
+    );
+    assert_eq!(
+        Header {
+            test: TestConfig {
+                seed: 0,
+                ..sent[0].test
+            },
+            selection: None,
+            ..sent[0]
+        },
+        Header {
+            test: TestConfig {
+                seed: 0,
+                ..sent[1].test
+            },
+            selection: None,
+            ..sent[1]
+        },
+    );
+    let off_axis_differs = first
+        .iter()
+        .zip(&second)
+        .any(|(a, b)| a.lon != b.lon || a.ped != b.ped);
+    assert!(
+        off_axis_differs,
+        "the second engagement repeats the first one's noise"
     );
 }

@@ -88,7 +88,7 @@ impl Campaign<'_> {
         } else {
             AmplitudeArg::Fixed
         };
-        let argv: Vec<OsString> = vec![
+        let mut argv: Vec<OsString> = vec![
             "--vehicle".into(),
             self.args.vehicle.given().into(),
             "--mode".into(),
@@ -107,6 +107,12 @@ impl Campaign<'_> {
             self.dir().join(folder).into(),
             "--quiet".into(),
         ];
+        if matches!(self.args.fc, CampaignLink::BoardSim(_)) && amplitude == AmplitudeArg::Fixed {
+            // A flight as the board flies it: every test of the stage on one power-up,
+            // chosen from the test list by the transmitter's selector, in one log. An
+            // adaptive sweep is no entry of the list: a power-up per record.
+            argv.extend(["--power-up".into(), "once".into()]);
+        }
         verb_args("fly", argv)
     }
 
@@ -338,8 +344,22 @@ mod tests {
             .fly_args(ModeArg::Cah, InputArg::Sweep, 7, "fly-cah")
             .unwrap();
         assert_eq!(on_the_board.fc, crate::fly::FcArg::BoardSim(None));
-        // The board-sim link's own flags keep fly's defaults (vibration on, no faults).
+        // The board-sim link's own flags keep fly's defaults (vibration on, no faults);
+        // the stage is one power-up.
         assert!(on_the_board.vibration.is_none() && on_the_board.imu_fault.is_none());
+        // An adaptive sweep is no entry of the test list: a power-up per record; fixed
+        // sweeps and the doublets fly each stage on one power-up.
+        assert_eq!(on_the_board.power_up, None);
+        assert_eq!(sweeps.power_up, None);
+        let fixed = CampaignArgs {
+            amplitude: AmplitudeArg::Fixed,
+            ..board.clone()
+        };
+        let fixed = Campaign::new(&fixed);
+        for input in [InputArg::Sweep, InputArg::Doublet] {
+            let stage = fixed.fly_args(ModeArg::Cah, input, 7, "fly-cah").unwrap();
+            assert_eq!(stage.power_up, Some(crate::fly::PowerUpArg::Once));
+        }
         let doublets = run
             .fly_args(ModeArg::Cah, InputArg::Doublet, 8, "verify-doublet")
             .unwrap();

@@ -218,6 +218,33 @@ pub struct FlyArgs {
     /// the pilot's hands at trim (seconds, 0–600).
     #[arg(long = "fly-on", value_name = "SECONDS", value_parser = parse_fly_on, allow_hyphen_values = true)]
     pub fly_on_s: Option<f64>,
+    /// `--fc board-sim`: `per-record` powers the board up for every record (its settings
+    /// the record's); `once` flies every record on one power-up, one after the other, each
+    /// test chosen from the board's test list by the transmitter's selector with 5 s of
+    /// steady hover between two tests, and writes the board's log of the power-up, every
+    /// frame from power-on, as `log/power-up-N.bin` (a record that ends outside the pilot
+    /// mode ends the power-up: the next one starts another) [default: per-record].
+    #[arg(long = "power-up", value_enum, value_name = "HOW")]
+    pub power_up: Option<PowerUpArg>,
+}
+
+/// `--power-up` on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PowerUpArg {
+    /// One power-up per record.
+    PerRecord,
+    /// Every record on one power-up.
+    Once,
+}
+
+impl PowerUpArg {
+    /// The link's setting for `--power-up` (None: per record).
+    pub fn link(arg: Option<PowerUpArg>) -> link_board_sim::PowerUp {
+        match arg {
+            Some(PowerUpArg::Once) => link_board_sim::PowerUp::Once,
+            Some(PowerUpArg::PerRecord) | None => link_board_sim::PowerUp::PerRecord,
+        }
+    }
 }
 
 /// `--vibration` on the command line.
@@ -391,6 +418,7 @@ impl FlyArgs {
                 ("--rc-loss", self.rc_loss_at_s.is_some()),
                 ("--imu-fault", self.imu_fault.is_some()),
                 ("--fly-on", self.fly_on_s.is_some()),
+                ("--power-up", self.power_up.is_some()),
             ];
             if let Some((flag, _)) = board_only.iter().find(|(_, given)| *given) {
                 bail!("{flag} is for --fc board-sim only");

@@ -8,8 +8,9 @@
 //! slices. A record whose test is an entry of that list is chosen by the simulated
 //! pilot's selector; the board's own single test (`TEST_*`) is then the preset's, not the
 //! record's. The settings every test of a flight shares (mode, noise and its seed, fades,
-//! hold) are the board's one configuration, set at each power-up from the record (one
-//! record per power-up).
+//! hold) are the board's one configuration, set at each power-up from the record that
+//! powers it up (every record with `--power-up per-record`, the first of a flight with
+//! `once`).
 
 use sweephold_firmware::app::test_list::{TestEntry, TestList, TEST_LIST_LEN};
 use sweephold_protocol::{Axis, InputKind, TestConfig};

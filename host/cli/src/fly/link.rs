@@ -46,6 +46,13 @@ pub trait FlightControllerLink {
         let _ = dump_name;
         Ok(())
     }
+
+    /// No more records on this link: a link that keeps a log of the board's whole
+    /// power-up (`board-sim` with one power-up for many records) writes it here.
+    /// Default: nothing.
+    fn end_flight(&mut self) -> anyhow::Result<()> {
+        Ok(())
+    }
 }
 
 /// The firmware's flight logic called in-process.

@@ -34,8 +34,8 @@ use record::{fly_record, Disturbances};
 use summary::{FlySummary, RunSummary};
 
 pub use args::{
-    parse_fc, AmplitudeArg, FcArg, FcArgError, FlyArgs, InputArg, ModeArg, VibrationArg,
-    MAX_FLY_ON_S, MAX_T_REC_S, MIN_T_REC_S,
+    parse_fc, AmplitudeArg, FcArg, FcArgError, FlyArgs, InputArg, ModeArg, PowerUpArg,
+    VibrationArg, MAX_FLY_ON_S, MAX_T_REC_S, MIN_T_REC_S,
 };
 
 /// The firmware configuration of one record.
@@ -184,9 +184,16 @@ fn fly_on_link(args: &FlyArgs, image: Option<&std::path::Path>) -> anyhow::Resul
 /// Fly `args` into `args.out` on the board-sim link (one per worker).
 pub fn fly_board_sim(args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
     let settings = board_sim_settings(args)?;
-    fly(args, &|| {
-        Box::new(link_board_sim::BoardSimLink::new(settings.clone()))
-    })
+    // One power-up flies its records one after the other, on one board.
+    let workers = match settings.power_up {
+        link_board_sim::PowerUp::Once => 1,
+        link_board_sim::PowerUp::PerRecord => usize::MAX,
+    };
+    fly_with_workers(
+        args,
+        &|| Box::new(link_board_sim::BoardSimLink::new(settings.clone())),
+        workers,
+    )
 }
 
 /// The board-sim link's settings for `args`.
@@ -210,6 +217,8 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
             )),
             _ => link_board_sim::BoardSetup::FromAircraft,
         },
+        power_up: PowerUpArg::link(args.power_up),
+        log_folder: Some(args.out.join(link_board_sim::LOG_FOLDER)),
     })
 }
 
@@ -293,6 +302,7 @@ pub fn fly_with_workers(
         .progress_chars("=> ");
 
     let next = Mutex::new(0usize);
+    let flight_errors: Mutex<Vec<anyhow::Error>> = Mutex::new(Vec::new());
     let results: Mutex<Vec<Option<anyhow::Result<FinishedRecord>>>> =
         Mutex::new(plans.iter().map(|_| None).collect());
     let workers = std::thread::available_parallelism()
@@ -340,10 +350,24 @@ pub fn fly_with_workers(
                     bar.finish_and_clear();
                     results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(result);
                 }
+                if let Err(error) = link.end_flight() {
+                    flight_errors
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push(error);
+                }
             });
         }
     });
 
+    if let Some(error) = flight_errors
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .into_iter()
+        .next()
+    {
+        return Err(error.context("writing the board's log"));
+    }
     let mut runs = Vec::new();
     let mut records = Vec::new();
     let mut trims = Vec::new();

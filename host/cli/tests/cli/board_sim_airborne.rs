@@ -31,22 +31,37 @@ fn pilot_collective_bo105() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(PILOT_COLLECTIVE_BO105)
 }
 
+/// The shipped TREX 700L with the collective the pilot's (the file of the one-power-up
+/// measurement in docs/results.md).
+const PILOT_COLLECTIVE_TREX: &str = "../../docs/aircraft/trex700l-pilot-collective.toml";
+
 #[test]
-fn the_pilot_collective_file_is_the_shipped_bo105_but_for_the_collective() {
-    let text = std::fs::read_to_string(pilot_collective_bo105()).unwrap();
-    let body: String = text
-        .lines()
-        .skip_while(|line| !line.starts_with("# MBB Bo-105"))
-        .map(|line| format!("{line}\n"))
-        .collect();
-    let back = body
-        .replacen("name = \"bo105-pilot-collective\"", "name = \"bo105\"", 1)
-        .replacen(
-            "preset = \"bo105\"\ncollective = \"pilot\"\n",
-            "preset = \"bo105\"\n",
-            1,
-        );
-    assert_eq!(back, aircraft::SHIPPED[0].1);
+fn the_pilot_collective_files_are_the_shipped_files_but_for_the_collective() {
+    for (file, first_line, shipped) in [
+        (PILOT_COLLECTIVE_BO105, "# MBB Bo-105", 0),
+        (PILOT_COLLECTIVE_TREX, "# A TREX 700L-class", 1),
+    ] {
+        let name = aircraft::SHIPPED[shipped].0;
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let text = std::fs::read_to_string(path).unwrap();
+        let body: String = text
+            .lines()
+            .skip_while(|line| !line.starts_with(first_line))
+            .map(|line| format!("{line}\n"))
+            .collect();
+        let back = body
+            .replacen(
+                &format!("name = \"{name}-pilot-collective\""),
+                &format!("name = \"{name}\""),
+                1,
+            )
+            .replacen(
+                &format!("preset = \"{name}\"\ncollective = \"pilot\"\n"),
+                &format!("preset = \"{name}\"\n"),
+                1,
+            );
+        assert_eq!(back, aircraft::SHIPPED[shipped].1, "{file}");
+    }
 }
 
 /// `fly --fc board-sim --axes lat --t-rec 10 -q --out OUT` plus `args`.

@@ -36,6 +36,7 @@ mod links;
 mod margins;
 #[cfg(unix)]
 mod one_run_per_folder;
+mod power_up_log;
 #[cfg(target_os = "linux")]
 mod qemu_signals;
 #[cfg(unix)]
