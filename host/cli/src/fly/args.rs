@@ -220,7 +220,7 @@ pub struct FlyArgs {
     pub fly_on_s: Option<f64>,
     /// `--fc board-sim`: `per-record` powers the board up for every record (its settings
     /// the record's); `once` flies every record on one power-up, one after the other, each
-    /// test chosen from the board's test list by the transmitter's selector with 5 s of
+    /// test chosen from the board's test list by the transmitter's selector with 10 s of
     /// steady hover between two tests, and writes the board's log of the power-up, every
     /// frame from power-on, as `log/power-up-N.bin` (a record that ends outside the pilot
     /// mode ends the power-up: the next one starts another) [default: per-record].
