@@ -23,6 +23,10 @@ fly stage's `fly-*/summary.json` (`aborted`, `abort_reason`, `max_from_trim_deg`
 - flagged: free parameters above CR 20 % or insensitivity 10 % and not flagged `needed`
   (kept because the fit needs them: the reduction's reason is in summary.json);
 - s: the campaign's wall time.
+
+A degenerate model (`fit.degenerate` of summary.json: parameters outside their physical
+range or on a range bound of the structure) is marked DEGENERATE in the key column and
+counts as meeting no bar.
 """
 import argparse
 import json
@@ -98,6 +102,9 @@ def row(seed, summary, six):
         " ".join(flagged) or "-",
         f"{summary['timings_s'].get('total', float('nan')):.1f}",
     ]
+    degenerate = fit.get("degenerate") or []
+    if degenerate:
+        cells[1] += " DEGENERATE (" + ", ".join(d["parameter"] for d in degenerate) + ")"
     passes = {
         "key": key == 9,
         "hover": hover.get("matched") == hover.get("of") and origin == 0,
@@ -107,6 +114,9 @@ def row(seed, summary, six):
         "six": bool(six),
         "flagged": not flagged,
     }
+    # A degenerate model (summary.json `fit.degenerate`) meets no bar of the model's.
+    if degenerate:
+        passes = {name: False for name in passes}
     return "| " + " | ".join(cells) + " |", passes
 
 

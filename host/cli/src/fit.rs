@@ -17,6 +17,7 @@ use crate::vehicle::Vehicle;
 use anyhow::{bail, Context};
 use clap::Args;
 use sysid::document::FrfDocument;
+use sysid::fit::degenerate::describe as describe_degenerate;
 use sysid::fit::equation_error::equation_error_start;
 use sysid::fit::modes::{
     eigenvalue_text, mode_records, poles_at_origin, ModeComparison, ModeError, ModeRecord,
@@ -42,7 +43,12 @@ model.json layout are described in the models README of the sysid crate.\n\nGuid
 Physical ranges: every fitted parameter is judged by its part of each F or G entry against \
 that entry's dimension (e.g. 1000 m/s² per stick, 300 /s, 100 rad/s² per m/s); a fit outside \
 is run again with those parameters held at their start values, and exits 1 without a model \
-when that fails (docs/method.md, physical ranges)."
+when that fails (docs/method.md, physical ranges).\n\nDegenerate minima: a fit whose model \
+has a parameter outside its physical range or a free one on a bound of its structure file \
+that is not zero (tau_f on its 0.005 s floor; a bound of zero is a sign, and resting there \
+is physical) runs its search again with up to three other seeds and keeps the first model \
+that is not degenerate; otherwise the model is written with `degenerate` (the reasons) and \
+a warning line (`identify --strict` and `campaign --strict` exit 1 on it)."
 )]
 pub struct FitArgs {
     /// Frequency responses to fit (`frf.json` as `sweephold frf` writes it).
@@ -378,7 +384,27 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         write_json(path, &document)?;
         let _ = writeln!(report, "\nwrote {}", path.display());
     }
-    crate::output::print(&report)
+    crate::output::print(&report)?;
+    warn_degenerate(&result, args.out.as_deref());
+    Ok(())
+}
+
+/// The one-line warning (standard error) of a fit whose model is degenerate even after
+/// its restarts elsewhere ([`sysid::fit::degenerate`]): parameters on a range bound of
+/// the structure file. `out` is the model file written, marked `degenerate`.
+pub fn warn_degenerate(result: &sysid::fit::FitResult, out: Option<&Path>) {
+    if result.degenerate.is_empty() {
+        return;
+    }
+    crate::note!(
+        "warning: the fit is degenerate after {} restart(s) elsewhere: {}{}",
+        result.degenerate_restarts.len(),
+        describe_degenerate(&result.degenerate),
+        out.map_or(String::new(), |out| format!(
+            "; {} is marked `degenerate`, not a usable model",
+            out.display()
+        ))
+    );
 }
 
 /// Refuse a fit whose parameters lie outside their physical range
@@ -492,6 +518,26 @@ fn write_report(
         for dropped in &result.implausible_held {
             writeln!(out, "    {:<10} {:>14.6e}", dropped.name, dropped.value)?;
         }
+    }
+    if !result.degenerate_restarts.is_empty() {
+        writeln!(
+            out,
+            "  the model was degenerate: the search ran again with seed(s) {}{}",
+            result
+                .degenerate_restarts
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            if result.degenerate.is_empty() {
+                ", which found a model that is not"
+            } else {
+                ", none found a model that is not"
+            }
+        )?;
+    }
+    for reason in &result.degenerate {
+        writeln!(out, "  DEGENERATE: {}", reason.describe())?;
     }
     if !result.reduction.is_empty() {
         writeln!(out, "\nreduction:")?;

@@ -133,6 +133,11 @@ pub struct FitSummary {
     /// ([`super::priors`]). Empty in older files.
     #[serde(default)]
     pub priors: Vec<super::priors::PriorSummary>,
+    /// Why the model is degenerate (`model.json` `degenerate`: parameters outside their
+    /// physical range, free parameters on a range bound of the structure file); empty
+    /// when it is not. A degenerate model meets no bar. Empty in older files.
+    #[serde(default)]
+    pub degenerate: Vec<sysid::fit::degenerate::DegenerateReason>,
 }
 
 /// One quasi-static speed derivative of [`FitSummary::speed_derivatives`].

@@ -310,6 +310,7 @@ mod tests {
             trim_balance: super::super::CampaignTrimBalance::Default,
             amplitude: AmplitudeArg::Adaptive,
             fc: CampaignLink::InProcess,
+            strict: false,
             quiet: true,
             priors: None,
         };

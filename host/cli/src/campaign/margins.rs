@@ -112,6 +112,7 @@ mod tests {
             trim_balance: CampaignTrimBalance::Default,
             amplitude: AmplitudeArg::Fixed,
             fc: CampaignLink::InProcess,
+            strict: false,
             quiet: true,
             priors: None,
         };

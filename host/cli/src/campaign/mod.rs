@@ -110,6 +110,12 @@ pub struct CampaignArgs {
     /// measuring what a wrong prior does (docs/decisions/2026-11-27-priors-with-sigma.md).
     #[arg(long, value_name = "NAME|FILE", value_parser = Vehicle::parse)]
     pub priors: Option<Vehicle>,
+    /// Exit with status 1 (`error: …`) when the model written (`model9.json`) is
+    /// degenerate (parameters outside their physical range, or free ones on a range bound
+    /// of the structure file, after the fit's restarts elsewhere); without it, a warning
+    /// line on stderr. The campaign's files are written either way.
+    #[arg(long)]
+    pub strict: bool,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -153,7 +159,8 @@ pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
     if !args.quiet {
         crate::note_text!("{}", headline(&outcome.summary));
     }
-    crate::output::print(&format!("report: {}\n", outcome.report.display()))
+    crate::output::print(&format!("report: {}\n", outcome.report.display()))?;
+    crate::identify::stages::judge_degenerate(outcome.summary.fit.as_ref(), &args.out, args.strict)
 }
 
 /// The figures a user looks at first, for stderr.

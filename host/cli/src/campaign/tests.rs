@@ -36,6 +36,7 @@ fn a_failed_stage_keeps_the_previous_campaign_and_its_own_files() {
         trim_balance: CampaignTrimBalance::Default,
         amplitude: AmplitudeArg::Fixed,
         fc: CampaignLink::InProcess,
+        strict: false,
         quiet: true,
         priors: None,
     };

@@ -78,6 +78,11 @@ pub struct IdentifyArgs {
     /// Also use the tests that aborted or were cut off by the end of their file.
     #[arg(long)]
     pub include_aborted: bool,
+    /// Exit with status 1 (`error: …`) when the model written is degenerate (parameters
+    /// outside their physical range, or free ones on a range bound of the structure file,
+    /// after the fit's restarts elsewhere); without it, a warning line on stderr.
+    #[arg(long)]
+    pub strict: bool,
     /// No progress on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -97,7 +102,8 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
     crate::output::print(&format!(
         "model: {}\n",
         args.out.join(files::MODEL_9DOF).display()
-    ))
+    ))?;
+    stages::judge_degenerate(summary.fit.as_ref(), &args.out, args.strict)
 }
 
 /// The dumps `inputs` stand for: files as given, folders by the `*.bin` files directly in

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::anyhow;
 use sysid::document::FrfDocument;
+use sysid::fit::degenerate::describe as describe_degenerate;
 use sysid::fit::equation_error::equation_error_start;
 use sysid::fit::modes::{mode_records, poles_at_origin};
 use sysid::fit::plausible::{implausible_parameters, HeldParameter};
@@ -260,10 +261,16 @@ impl Pipeline<'_> {
         let mut summary = fit_summary(&result, six.average_cost);
         summary.priors = prior_summaries(&result, &self.vehicle.file_constants()?);
         let line = format!(
-            "{}: J_ave {:.1}, {} reduction step(s)",
+            "{}: J_ave {:.1}, {} reduction step(s){}{}",
             result.structure.name,
             result.average_cost,
-            result.reduction.len()
+            result.reduction.len(),
+            restarts_text(&result),
+            if result.degenerate.is_empty() {
+                String::new()
+            } else {
+                format!("; DEGENERATE: {}", describe_degenerate(&result.degenerate))
+            }
         );
         Ok((result, summary, line))
     }
@@ -325,6 +332,35 @@ impl Pipeline<'_> {
 /// with 8 starts (`docs/decisions/2026-11-24-6dof-marquardt-scaling.md`).
 const SIX_DOF_MAX_STARTS: usize = 16;
 
+/// After a run of `identify` or `campaign` wrote everything: when the final model
+/// (`fit`, `model9.json` in `dir`) is degenerate, an error with `--strict` (`strict`),
+/// else a warning line on stderr. The 6-DOF model is a start only and not judged here
+/// (its `outside_physical_range` says what is wrong with it).
+pub fn judge_degenerate(fit: Option<&FitSummary>, dir: &Path, strict: bool) -> anyhow::Result<()> {
+    let Some(fit) = fit.filter(|fit| !fit.degenerate.is_empty()) else {
+        return Ok(());
+    };
+    let text = format!(
+        "{} is degenerate: {}",
+        dir.join(&fit.model_file).display(),
+        describe_degenerate(&fit.degenerate)
+    );
+    if strict {
+        anyhow::bail!("{text} (--strict)");
+    }
+    crate::note!("warning: {text}; it passes no bar");
+    Ok(())
+}
+
+/// `; N restart(s) elsewhere (degenerate minimum)` when the fit ran its search again
+/// because its model was degenerate, else nothing.
+pub fn restarts_text(result: &FitResult) -> String {
+    match result.degenerate_restarts.len() {
+        0 => String::new(),
+        n => format!("; {n} restart(s) elsewhere (degenerate minimum)"),
+    }
+}
+
 /// The model file a fit writes (`--out`).
 fn out_path(args: &FitArgs) -> anyhow::Result<PathBuf> {
     args.out
@@ -381,6 +417,7 @@ fn fit_summary(result: &FitResult, start_cost_ave: f64) -> FitSummary {
         trim: result.trim.clone(),
         // The caller adds them (it knows the aircraft file).
         priors: Vec::new(),
+        degenerate: result.degenerate.clone(),
     }
 }
 

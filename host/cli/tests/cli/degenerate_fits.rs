@@ -137,3 +137,127 @@ fn the_six_dof_from_an_equation_error_start_with_trim_points_is_recovered_or_ref
     assert!(stderr.contains("(|value| <= "), "{stderr}");
     assert!(!refused.exists());
 }
+
+/// The shipped TREX 700L's aircraft file with its servo's natural frequency put on the
+/// upper bound of its structure's `servo_omega` (1000 rad/s) with a σ of 0.01 rad/s: the
+/// prior holds the estimate on the bound from any start, so the 9-DOF model stays
+/// degenerate after its restarts elsewhere (a model no search can bring off the bound).
+fn servo_on_its_bound() -> String {
+    let shipped = aircraft::SHIPPED
+        .iter()
+        .find(|(name, _)| *name == "trex700l")
+        .expect("the TREX 700L is shipped")
+        .1;
+    let from = "natural_frequency = \"60 rad/s\"";
+    assert!(
+        shipped.contains(from),
+        "the shipped file's servo line moved"
+    );
+    shipped.replace(from, "natural_frequency = \"1000 +- 0.01 rad/s\"")
+}
+
+#[test]
+fn a_degenerate_model_is_marked_and_strict_runs_exit_non_zero() {
+    let dir = TempDir::new("strict");
+    let priors = dir.0.join("servo-on-bound.toml");
+    std::fs::write(&priors, servo_on_its_bound()).unwrap();
+    let campaign = |out: &Path, strict: bool| {
+        let mut args = vec![
+            "campaign",
+            "--vehicle",
+            "trex700l",
+            "--priors",
+            priors.to_str().unwrap(),
+            "--quick",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if strict {
+            args.push("--strict");
+        }
+        sweephold(&args)
+    };
+
+    // Without --strict: written, marked in model9.json, summary.json and the report, and
+    // one warning line.
+    let out = dir.0.join("c");
+    let run = campaign(&out, false);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("warning: ")
+            && stderr.contains(
+                "model9.json is degenerate: `servo_omega` = 1000 on its upper bound 1000"
+            ),
+        "{stderr}"
+    );
+    let read = |path: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    };
+    let model = read(&out.join("model9.json"));
+    let reasons = model["degenerate"]
+        .as_array()
+        .expect("model9.json `degenerate`");
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    assert_eq!(reasons[0]["parameter"], "servo_omega");
+    assert_eq!(reasons[0]["reason"], "on_upper_bound");
+    assert_eq!(reasons[0]["limit"], 1000.0);
+    // The search ran again elsewhere before giving up, with the seeds recorded.
+    assert_eq!(model["degenerate_restarts"].as_array().unwrap().len(), 3);
+    let summary = read(&out.join("summary.json"));
+    assert_eq!(summary["fit"]["degenerate"], model["degenerate"]);
+    // The report: the degenerate row, and no bar of the model marked met.
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("degenerate minimum"), "no degenerate row");
+    let bars = report
+        .split("id=\"campaign-summary\"")
+        .nth(1)
+        .expect("the campaign summary section");
+    let model_bars = &bars
+        [bars.find("degenerate minimum").unwrap()..bars.find("wall time of the campaign").unwrap()];
+    assert!(model_bars.contains("J_ave"), "{model_bars}");
+    assert!(!model_bars.contains("class=\"good\""), "{model_bars}");
+
+    // With --strict: the same files, exit 1 with one `error:` line.
+    let strict = dir.0.join("strict");
+    let run = campaign(&strict, true);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("error: ")
+            && stderr.contains("is degenerate")
+            && stderr.contains("--strict"),
+        "{stderr}"
+    );
+    assert!(strict.join("model9.json").is_file());
+
+    // identify on the campaign's dumps with the same aircraft file: the same model,
+    // marked; --strict exits 1.
+    let logs: Vec<String> = ["fly-cah", "verify-doublet"]
+        .iter()
+        .map(|d| out.join(d).to_str().unwrap().to_string())
+        .collect();
+    let identify = |out: &Path, strict: bool| {
+        let mut args = vec!["identify", logs[0].as_str(), logs[1].as_str()];
+        args.extend(["--vehicle", priors.to_str().unwrap(), "-q", "--out"]);
+        args.push(out.to_str().unwrap());
+        if strict {
+            args.push("--strict");
+        }
+        sweephold(&args)
+    };
+    let identified = dir.0.join("i");
+    let run = identify(&identified, false);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("warning: "), "{stderr}");
+    let summary = read(&identified.join("summary.json"));
+    assert_eq!(summary["fit"]["degenerate"][0]["parameter"], "servo_omega");
+    let run = identify(&dir.0.join("i-strict"), true);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+}

@@ -7,7 +7,7 @@ use super::options::FitOptions;
 use super::result::{FitResult, SkippedPair, StartSetOutcome};
 use super::search::{finish_fit, fit_on_grids, search_minima, StartSearch};
 use super::structure::{self, ModelStructure, ParameterKind};
-use super::{plausible, reduce, trim};
+use super::{degenerate, plausible, reduce, trim};
 use crate::document::FrfDocument;
 
 /// Fit `structure` to the responses in `data`.
@@ -23,7 +23,7 @@ pub fn fit(
         });
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
-    let run = |held: &[String]| {
+    let run = |held: &[String], options: &FitOptions| {
         let structure = held_at_start(&usable, held);
         let result = fit_on_grids(&structure, &grids, &without_balances(options))?;
         if degenerate_before_trim(&result, &structure, options)? {
@@ -31,11 +31,7 @@ pub fn fit(
         }
         Ok((settle_and_release(result, &structure, &grids, options)?, ()))
     };
-    let (mut result, ()) = if options.recover_implausible {
-        recover_plausible(&usable, run(&[])?, run)
-    } else {
-        run(&[])?
-    };
+    let (mut result, ()) = restart_then_recover(&usable, options, run)?;
     result.skipped_pairs = skipped;
     Ok(result)
 }
@@ -65,7 +61,7 @@ pub fn fit_from_alternative_starts(
         });
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
-    let run = |held: &[String]| {
+    let run = |held: &[String], options: &FitOptions| {
         let starts: Vec<(String, ModelStructure)> = starts
             .iter()
             .map(|(label, structure)| (label.clone(), held_at_start(structure, held)))
@@ -79,13 +75,77 @@ pub fn fit_from_alternative_starts(
             outcomes,
         ))
     };
-    let (mut result, outcomes) = if options.recover_implausible {
-        recover_plausible(first, run(&[])?, run)
-    } else {
-        run(&[])?
-    };
+    let (mut result, outcomes) = restart_then_recover(first, options, run)?;
     result.skipped_pairs = skipped;
     Ok((result, outcomes))
+}
+
+/// Most searches run again from other starts when the fit's model is degenerate
+/// ([`restart_then_recover`]).
+pub const DEGENERATE_RESTARTS: usize = 3;
+
+/// The seed of the `round`-th search run again elsewhere (1, 2, …): a SplitMix64 step
+/// from the fit's seed, so that the same seed gives the same restarts and no restart
+/// repeats the fit's own perturbations.
+pub fn restart_seed(seed: u64, round: usize) -> u64 {
+    let mut random = crate::random::SplitMix64::new(seed);
+    let mut next = seed;
+    for _ in 0..round {
+        next = random.next_u64();
+    }
+    next
+}
+
+/// The whole fit `run(held, options)` with the fit's options; when its model is
+/// degenerate ([`degenerate`]: a parameter outside its physical range or a free one on a
+/// range bound of the structure file), run again from other starts: the same search
+/// with another seed ([`restart_seed`]: other perturbations, other box draws), up to
+/// [`DEGENERATE_RESTARTS`] times, keeping the first model that is not degenerate. Only
+/// when none is, the parameters outside their range are held ([`recover_plausible`])
+/// from the original run. The result records the restarts' seeds and, when it is still
+/// degenerate, why ([`FitResult::degenerate`]). A restart that fails is skipped. A fit
+/// whose model is not degenerate runs exactly as before; without
+/// [`FitOptions::recover_implausible`] its model is taken as it is, unjudged.
+fn restart_then_recover<X>(
+    structure: &ModelStructure,
+    options: &FitOptions,
+    mut run: impl FnMut(&[String], &FitOptions) -> Result<(FitResult, X), FitError>,
+) -> Result<(FitResult, X), FitError> {
+    let judge =
+        |result: &FitResult| degenerate::degenerate_reasons(&result.structure, &result.values);
+    let first = run(&[], options)?;
+    if !options.recover_implausible {
+        return Ok(first);
+    }
+    let mut reasons = judge(&first.0);
+    if reasons.is_empty() {
+        return Ok(first);
+    }
+    let mut seeds = Vec::new();
+    for round in 1..=DEGENERATE_RESTARTS {
+        let seed = restart_seed(options.seed, round);
+        seeds.push(seed);
+        let elsewhere = FitOptions {
+            seed,
+            ..options.clone()
+        };
+        let Ok(mut next) = run(&[], &elsewhere) else {
+            continue;
+        };
+        if judge(&next.0).is_empty() {
+            next.0.degenerate_restarts = seeds;
+            return Ok(next);
+        }
+    }
+    let mut result = recover_plausible(structure, first, |held| run(held, options));
+    reasons = if result.0.implausible_held.is_empty() {
+        reasons
+    } else {
+        judge(&result.0)
+    };
+    result.0.degenerate = reasons;
+    result.0.degenerate_restarts = seeds;
+    Ok(result)
 }
 
 /// The search of [`fit_from_alternative_starts`] over its start sets, before the trim

@@ -15,6 +15,7 @@
 
 pub mod accuracy;
 pub mod cost;
+pub mod degenerate;
 mod driver;
 pub mod equation_error;
 pub mod error;
@@ -42,7 +43,9 @@ pub(crate) mod test_support;
 
 pub use accuracy::{AccuracyAnalysis, ParameterAccuracy};
 pub use cost::{cost_between_models, ModelComparison, PairBand, PairGrid};
-pub use driver::{fit, fit_from_alternative_starts, usable_pairs};
+pub use driver::{
+    fit, fit_from_alternative_starts, restart_seed, usable_pairs, DEGENERATE_RESTARTS,
+};
 pub use error::{FitError, StructureError, StructureProblem};
 pub use measured::{measured_outputs, reduce_to_measured};
 pub use model::Model;

@@ -82,9 +82,12 @@ pub struct FitOptions {
     /// How the trim points enter the fit ([`trim::TrimBalance`]; default: held, status
     /// `trim`, as the paper fixes its speed derivatives).
     pub trim_balance: trim::TrimBalance,
-    /// Whether a fit whose parameters land outside their physical range is run again with
-    /// them held at their start values ([`plausible`](super::plausible); the driver's recovery). Off only
-    /// where the fit gives start values and nothing else (the campaign's 6-DOF stage).
+    /// Whether a fit whose model is degenerate ([`degenerate`](super::degenerate)) is run
+    /// again elsewhere (other seeds) and, failing that, with the parameters outside their
+    /// physical range held at their start values ([`plausible`](super::plausible); the
+    /// driver's recovery), the reasons it is still degenerate recorded. Off only where the
+    /// fit gives start values and nothing else (the campaign's 6-DOF stage): its minimum
+    /// is then taken as it is.
     pub recover_implausible: bool,
 }
 

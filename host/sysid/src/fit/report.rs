@@ -142,6 +142,15 @@ pub struct ModelDocument {
     /// only starts the hybrid; [`super::plausible`]). Left out when there are none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub outside_physical_range: Vec<super::plausible::HeldParameter>,
+    /// Why this model is degenerate ([`super::degenerate`]): parameters outside their
+    /// physical range or free parameters on a range bound of the structure file, after
+    /// the fit's restarts elsewhere. Never a usable model; left out when there are none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub degenerate: Vec<super::degenerate::DegenerateReason>,
+    /// The seeds of the searches the fit ran again because its minimum was degenerate
+    /// ([`super::degenerate`]); left out when there were none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub degenerate_restarts: Vec<u64>,
 }
 
 /// `model.json` with its optional `truth` section and the model's `modes`: the
@@ -272,6 +281,8 @@ impl ModelDocument {
             skipped_pairs: result.skipped_pairs.clone(),
             trim: result.trim.clone(),
             implausible_held: result.implausible_held.clone(),
+            degenerate: result.degenerate.clone(),
+            degenerate_restarts: result.degenerate_restarts.clone(),
             outside_physical_range: Vec::new(),
         }
     }

@@ -206,6 +206,12 @@ pub struct FitResult {
     /// it gave them; the fit was repeated with them held at their start values
     /// ([`super::plausible`]; empty when none).
     pub implausible_held: Vec<super::plausible::HeldParameter>,
+    /// Why the model is degenerate ([`super::degenerate`]), after the fit's restarts
+    /// elsewhere and recovery: empty for a model that is not.
+    pub degenerate: Vec<super::degenerate::DegenerateReason>,
+    /// The restarts elsewhere the fit made because its minimum was degenerate: the
+    /// seeds of the searches run again, in order (empty when none was needed).
+    pub degenerate_restarts: Vec<u64>,
     /// The trim balances' share of the cost, Σ e² ([`trim::joint`]; 0 when the cost does
     /// not carry them).
     pub balance_cost: f64,

@@ -370,6 +370,8 @@ pub(super) fn finish_fit(
         skipped_pairs: Vec::new(),
         trim: None,
         implausible_held: Vec::new(),
+        degenerate: Vec::new(),
+        degenerate_restarts: Vec::new(),
         balance_cost,
     })
 }

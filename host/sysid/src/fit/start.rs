@@ -251,6 +251,8 @@ mod tests {
             skipped_pairs: Vec::new(),
             trim: None,
             implausible_held: Vec::new(),
+            degenerate: Vec::new(),
+            degenerate_restarts: Vec::new(),
             outside_physical_range: Vec::new(),
         }
     }

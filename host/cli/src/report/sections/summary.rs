@@ -7,7 +7,7 @@ use sysid::fit::modes::{HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT};
 use super::{fmt, mode_of, KEY_PARAMETERS};
 use crate::artifacts::stage::Stage;
 use crate::artifacts::summary::{FitSummary, ParameterSummary, ANGULAR_RATES};
-use crate::report::html::{escape, note, section, table, Cell};
+use crate::report::html::{escape, note, section, table, Cell, Mark};
 use crate::report::inputs::ReportInputs;
 
 /// The paper's averaged lat–lon cross-control coherence of the lateral sweeps.
@@ -92,7 +92,12 @@ folder (`sweephold report DIR` redraws it).",
             (mode == "cah").then_some(m.aborts == 0),
         ));
     }
+    // A degenerate model meets no bar of the model's (its fit's and its verification's):
+    // its figures are drawn, each marked not met.
+    let degenerate = s.fit.as_ref().is_some_and(|fit| !fit.degenerate.is_empty());
+    let model_rows_from = rows.len();
     if let Some(fit) = &s.fit {
+        rows.extend(degenerate_row(fit));
         rows.extend(fit_bar_rows(fit));
     }
     if let Some(verify) = &s.verify {
@@ -128,6 +133,13 @@ folder (`sweephold report DIR` redraws it).",
             None,
         ));
     }
+    if degenerate {
+        for row in &mut rows[model_rows_from..] {
+            if matches!(row[1].mark, Mark::Good) {
+                row[1].mark = Mark::Bad;
+            }
+        }
+    }
     if let Some(total) = s.timings_s.get("total") {
         rows.push(bar_row(
             "wall time of the campaign",
@@ -162,6 +174,19 @@ fn stage_order(timings: &std::collections::BTreeMap<String, f64>) -> Vec<(String
             .map(|(k, v)| (k.clone(), *v)),
     );
     rows
+}
+
+/// The row saying the model is degenerate (`degenerate` of the summary), red; none when
+/// it is not.
+fn degenerate_row(fit: &FitSummary) -> Option<Vec<Cell>> {
+    (!fit.degenerate.is_empty()).then(|| {
+        bar_row(
+            &format!("{}: degenerate minimum", fit.structure),
+            sysid::fit::degenerate::describe(&fit.degenerate),
+            "not degenerate (no bar of a degenerate model is met)",
+            Some(false),
+        )
+    })
 }
 
 fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
@@ -291,7 +316,6 @@ mod tests {
     use super::super::modes::modes_section;
     use super::super::test_support::{fit_with_modes, inputs_with_fit, mode};
     use super::*;
-    use crate::report::html::Mark;
     use sysid::fit::modes::{HoverModeScore, TruthModeRecord};
 
     #[test]
@@ -412,5 +436,37 @@ mod tests {
             ..missing
         };
         assert!(hover_mode_bar(&unscored).is_none());
+    }
+
+    /// A degenerate model: a red row naming it, and none of its bars met, the J_ave
+    /// (16, within 50) and the hover modes (all matched) included.
+    #[test]
+    fn a_degenerate_model_meets_no_bar() {
+        use sysid::fit::degenerate::{DegenerateKind, DegenerateReason};
+        let hover = HoverModeScore {
+            matched: 1,
+            of: 1,
+            worst_error_percent: Some(6.3),
+        };
+        let passing = fit_with_modes(Vec::new(), Vec::new(), hover, 0);
+        let good = summary_section(&inputs_with_fit(passing.clone()));
+        assert!(good.contains(r#"<td class="good">16.0</td>"#), "{good}");
+        assert!(!good.contains("degenerate minimum"), "{good}");
+        let degenerate = FitSummary {
+            degenerate: vec![DegenerateReason {
+                parameter: "tau_f".into(),
+                value: 0.005,
+                reason: DegenerateKind::OnLowerBound,
+                limit: 0.005,
+            }],
+            ..passing
+        };
+        let html = summary_section(&inputs_with_fit(degenerate));
+        assert!(
+            html.contains(r#"<td class="bad">`tau_f` = 0.005 on its lower bound 0.005</td>"#),
+            "{html}"
+        );
+        assert!(html.contains(r#"<td class="bad">16.0</td>"#), "{html}");
+        assert!(!html.contains(r#"class="good""#), "{html}");
     }
 }

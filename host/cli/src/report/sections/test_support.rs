@@ -72,5 +72,6 @@ pub fn fit_with_modes(
         speed_derivatives: Vec::new(),
         trim: None,
         priors: Vec::new(),
+        degenerate: Vec::new(),
     }
 }
