@@ -81,7 +81,7 @@ pub fn fit_from_alternative_starts(
 }
 
 /// Most searches run again from other starts when the fit's model is degenerate
-/// ([`restart_then_recover`]).
+/// (`restart_then_recover`).
 pub const DEGENERATE_RESTARTS: usize = 3;
 
 /// The seed of the `round`-th search run again elsewhere (1, 2, …): a SplitMix64 step
