@@ -13,7 +13,6 @@
 //! (`cargo xtask import-cycles`).
 
 pub mod stages;
-pub mod summary;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -27,6 +26,7 @@ use sysid::frf::Record;
 use sysid::records::check_one_origin;
 
 use crate::artifacts::files;
+use crate::artifacts::identify_summary::IdentifySummary;
 use crate::artifacts::summary::StageFailure;
 use crate::dump_tests::{excitation_records, UsedTest};
 use crate::fit::TrimBalanceArg;
@@ -34,7 +34,6 @@ use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json, Stag
 use crate::structures::TrimAttitude;
 use crate::vehicle::Vehicle;
 use stages::Pipeline;
-use summary::IdentifySummary;
 
 /// Arguments of `sweephold identify`.
 #[derive(Args, Debug, Clone)]
