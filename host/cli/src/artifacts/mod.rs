@@ -4,11 +4,13 @@
 //! the stage names `summary.json` keys its timings by ([`stage`]), where each file lies
 //! ([`files`]), and what the report draws from the dumps ([`flown`]), which a campaign
 //! hands over as it decoded it; `model9.json`'s aircraft constants with their σ
-//! ([`aircraft_constants`]).
+//! ([`aircraft_constants`]). `sweephold identify` writes a folder of the same documents
+//! without the truth, its own `summary.json` ([`identify_summary`]).
 
 pub mod aircraft_constants;
 pub mod files;
 pub mod flown;
+pub mod identify_summary;
 pub mod priors;
 pub mod stage;
 pub mod summary;

@@ -3,7 +3,8 @@
 //! frequency responses of the sweeps, the 6-DOF then the 9-DOF hybrid fit of the aircraft
 //! file's structure reduced to the outputs the logs hold, with the file's a-priori
 //! constants and trim balance, the verification on the held-out tests (doublets,
-//! 3-2-1-1), and `summary.json`.
+//! 3-2-1-1), `summary.json`, and last `report.html` drawn from the folder's files (the
+//! report's page of an identify folder: no truth in it).
 //!
 //! The stages are the campaign's own ([`stages`]: `campaign` runs them on what it flew):
 //! one pipeline. Where the campaign asks the simulator — its steady flights for the trim
@@ -13,7 +14,6 @@
 //! (`cargo xtask import-cycles`).
 
 pub mod stages;
-pub mod summary;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -27,6 +27,7 @@ use sysid::frf::Record;
 use sysid::records::check_one_origin;
 
 use crate::artifacts::files;
+use crate::artifacts::identify_summary::IdentifySummary;
 use crate::artifacts::summary::StageFailure;
 use crate::dump_tests::{excitation_records, UsedTest};
 use crate::fit::TrimBalanceArg;
@@ -34,7 +35,6 @@ use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json, Stag
 use crate::structures::TrimAttitude;
 use crate::vehicle::Vehicle;
 use stages::Pipeline;
-use summary::IdentifySummary;
 
 /// Arguments of `sweephold identify`.
 #[derive(Args, Debug, Clone)]
@@ -45,8 +45,9 @@ for the dumps (*.bin) directly in it. Sweep tests give the frequency responses (
 order lat, lon, ped, col, each axis's tests in the order given), every other test (doublet, \
 3-2-1-1) is held out for the verification (in the same order). Aborted tests and tests cut off by the end of \
 a file are left out unless --include-aborted. Writes into DIR: frf.json, model6.json, \
-model9.json, verify.json (when there are held-out tests) and summary.json (layout in \
-docs/formats.md). The run is built in DIR.partial and replaces DIR only when it completes; \
+model9.json, verify.json (when there are held-out tests), summary.json (layout in \
+docs/formats.md) and last report.html, drawn from these files alone (`sweephold report DIR` \
+redraws it byte for byte). The run is built in DIR.partial and replaces DIR only when it completes; \
 a failing stage leaves DIR as it was, keeps the failed run's files in DIR.failed and exits \
 with status 1. DIR must be new, empty or an earlier run's folder."
 )]
@@ -380,10 +381,16 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
             Ok(((), line))
         })?;
     }
-    run.stage("complete", |run| {
+    // The report is drawn from the folder's files, the summary included: written first
+    // and not again, so that `sweephold report DIR` redraws the same page.
+    run.stage("report", |run| {
         let total = run.started.elapsed().as_secs_f64();
         run.summary.timings_s.insert("total".to_string(), total);
         write_json(&run.dir().join(files::SUMMARY), &run.summary)?;
+        crate::report::write_report(run.dir())?;
+        Ok(((), files::REPORT.to_string()))
+    })?;
+    run.stage("complete", |run| {
         let staged = run
             .staged
             .take()

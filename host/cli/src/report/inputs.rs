@@ -3,6 +3,11 @@
 //! `margins-loops.json`, and what it draws from the dumps (the
 //! sweep time history and the cross-control coherence curves): handed over by the
 //! campaign, or decoded from the dumps when the report is made from the folder alone.
+//!
+//! A folder `sweephold identify` wrote is told apart by its `summary.json`
+//! ([`FolderSummary`]): it holds `tests` (every test of the logs read) where a
+//! campaign's holds `modes`. Such a folder has neither truth nor flights of its own: the
+//! report reads only its documents, and nothing from the dumps.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -15,7 +20,8 @@ use sysid::records::{load_dump, Record};
 
 use crate::artifacts::files;
 use crate::artifacts::flown::{lateral_coherence, FlownRecords, ModeCoherence, LATERAL};
-use crate::artifacts::summary::CampaignSummary;
+use crate::artifacts::identify_summary::IdentifySummary;
+use crate::artifacts::summary::{CampaignSummary, FitSummary, VerifySummary};
 use crate::artifacts::truth_model::TruthModelDocument;
 use crate::artifacts::verification::VerifyDocument;
 use crate::margins::ExportedLoops;
@@ -104,14 +110,86 @@ impl FittedModel {
     }
 }
 
+/// The `summary.json` of the folder, which says what kind of folder it is.
+#[derive(Clone, Debug)]
+pub enum FolderSummary {
+    /// Written by `sweephold campaign`: flights in the simulator, scored against its truth.
+    Campaign(CampaignSummary),
+    /// Written by `sweephold identify`: logs alone, no truth.
+    Identify(IdentifySummary),
+}
+
+impl FolderSummary {
+    /// The final fit's section, once fitted.
+    pub fn fit(&self) -> Option<&FitSummary> {
+        match self {
+            FolderSummary::Campaign(s) => s.fit.as_ref(),
+            FolderSummary::Identify(s) => s.fit.as_ref(),
+        }
+    }
+
+    /// The verification's section, once verified.
+    pub fn verify(&self) -> Option<&VerifySummary> {
+        match self {
+            FolderSummary::Campaign(s) => s.verify.as_ref(),
+            FolderSummary::Identify(s) => s.verify.as_ref(),
+        }
+    }
+
+    /// The campaign's summary; `None` for an identify folder.
+    pub fn campaign(&self) -> Option<&CampaignSummary> {
+        match self {
+            FolderSummary::Campaign(s) => Some(s),
+            FolderSummary::Identify(_) => None,
+        }
+    }
+
+    /// Whether the folder's model is compared with a truth (a campaign's, whether or not
+    /// its truth stage completed): the sections draw their truth columns, curves and
+    /// notes only then.
+    pub fn has_truth(&self) -> bool {
+        matches!(self, FolderSummary::Campaign(_))
+    }
+
+    /// Read `summary.json` at `path`: an identify folder's when it holds `tests` and no
+    /// `modes`, else a campaign's.
+    fn read(path: &Path) -> Result<FolderSummary, ReportError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ReportError::Unreadable {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let parse_error = |e: serde_json::Error| ReportError::Corrupt {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let is_identify = serde_json::from_str::<serde_json::Value>(&text)
+            .ok()
+            .and_then(|value| {
+                value
+                    .as_object()
+                    .map(|o| o.contains_key("tests") && !o.contains_key("modes"))
+            })
+            .unwrap_or(false);
+        if is_identify {
+            serde_json::from_str(&text)
+                .map(FolderSummary::Identify)
+                .map_err(parse_error)
+        } else {
+            serde_json::from_str(&text)
+                .map(FolderSummary::Campaign)
+                .map_err(parse_error)
+        }
+    }
+}
+
 /// The report's inputs. Files of stages that did not complete are `None` (the sections
 /// say so); files that exist but do not parse are an error.
 #[derive(Clone, Debug)]
 pub struct ReportInputs {
-    /// The campaign folder.
+    /// The campaign (or identify) folder.
     pub dir: PathBuf,
     /// `summary.json`.
-    pub summary: CampaignSummary,
+    pub summary: FolderSummary,
     /// `frf.json`.
     pub frf: Option<FrfDocument>,
     /// `model9.json` (the parts drawn).
@@ -183,7 +261,7 @@ impl ReportInputs {
     /// Read the documents of the campaign folder `dir`; the dump-derived inputs are
     /// `flown` when given, else decoded from its dumps.
     pub fn read(dir: &Path, flown: Option<FlownRecords>) -> Result<ReportInputs, ReportError> {
-        let summary: CampaignSummary = read_json(&dir.join(files::SUMMARY))?;
+        let summary = FolderSummary::read(&dir.join(files::SUMMARY))?;
         let frf = read_optional(&dir.join(files::FRF))?;
         let model: Option<FittedModel> = read_optional(&dir.join(files::MODEL_9DOF))?;
         if let Some(fitted) = &model {
@@ -194,8 +272,13 @@ impl ReportInputs {
                 ));
             }
         }
-        let truth_model: Option<TruthModelDocument> =
-            read_optional(&dir.join(files::TRUTH_MODEL_9DOF))?;
+        // An identify folder's report draws only what identify writes.
+        let campaign = summary.has_truth();
+        let truth_model: Option<TruthModelDocument> = if campaign {
+            read_optional(&dir.join(files::TRUTH_MODEL_9DOF))?
+        } else {
+            None
+        };
         if let Some(truth) = &truth_model {
             if truth.model().is_none() {
                 return Err(corrupt(
@@ -205,14 +288,24 @@ impl ReportInputs {
             }
         }
         let verify = read_optional(&dir.join(files::VERIFY))?;
-        let margins: Option<MarginsFile> = read_optional(&dir.join(files::MARGINS))?;
+        let margins: Option<MarginsFile> = if campaign {
+            read_optional(&dir.join(files::MARGINS))?
+        } else {
+            None
+        };
         if let Some(Err(why)) = margins.as_ref().map(MarginsFile::check) {
             return Err(corrupt(&dir.join(files::MARGINS), why));
         }
-        let margins_loops = read_optional(&dir.join(files::MARGINS_LOOPS))?;
-        let flown = match flown {
-            Some(flown) => flown,
-            None => decode_flown(dir, &summary)?,
+        let margins_loops = if campaign {
+            read_optional(&dir.join(files::MARGINS_LOOPS))?
+        } else {
+            None
+        };
+        let flown = match (flown, &summary) {
+            (Some(flown), _) => flown,
+            (None, FolderSummary::Campaign(campaign)) => decode_flown(dir, campaign)?,
+            // Nothing is drawn from an identify folder's dumps: they lie outside it.
+            (None, FolderSummary::Identify(_)) => FlownRecords::default(),
         };
         Ok(ReportInputs {
             dir: dir.to_path_buf(),
@@ -257,4 +350,43 @@ fn decode_flown(dir: &Path, summary: &CampaignSummary) -> Result<FlownRecords, R
         });
     }
     Ok(flown)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kind of a folder is read from its summary.json: `tests` without `modes` is an
+    /// identify folder's; anything else is read as a campaign's, with its errors.
+    #[test]
+    fn the_summary_tells_an_identify_folder_from_a_campaign() {
+        let dir =
+            std::env::temp_dir().join(format!("sweephold-folder-kind-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("summary.json");
+        let read = |text: &str| {
+            std::fs::write(&path, text).unwrap();
+            FolderSummary::read(&path)
+        };
+        let identify = r#"{"vehicle": "trex700l", "seed": 1, "tests": [], "sweeps": [],
+            "held_out": [], "captured_trim_rad": null, "trim_points": null, "notes": [],
+            "fit": null, "verify": null, "timings_s": {}, "error": null}"#;
+        assert!(matches!(read(identify), Ok(FolderSummary::Identify(_))));
+        let campaign = r#"{"vehicle": "bo105", "link": "in-process", "seed": 1,
+            "verification_seed": 2, "t_rec_s": 90.0, "quick": false,
+            "modes": {"cah": null, "standard": null, "noise": null},
+            "fit": null, "verify": null, "timings_s": {}, "error": null}"#;
+        let read_campaign = read(campaign).unwrap();
+        assert!(matches!(read_campaign, FolderSummary::Campaign(_)));
+        assert!(read_campaign.has_truth());
+        // Broken either way: the kind's own parse error.
+        let error = read(r#"{"tests": 3}"#).unwrap_err().to_string();
+        assert!(
+            error.contains("is corrupt") && error.contains("sequence"),
+            "{error}"
+        );
+        let error = read(r#"{"modes": 3}"#).unwrap_err().to_string();
+        assert!(error.contains("is corrupt"), "{error}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

@@ -4,6 +4,11 @@
 //! ([`crate::artifacts`]) and computes nothing the campaign has: within a campaign, what
 //! it draws from the dumps is handed over as the campaign decoded it; on its own, it
 //! decodes the dumps.
+//!
+//! A folder `sweephold identify` wrote (told apart by its `summary.json`,
+//! [`FolderSummary`]) gets its own page from the same sections without their truth
+//! parts, drawn from its documents alone: identify writes it as its last stage, and
+//! `report DIR` redraws it byte for byte.
 
 pub mod curves;
 pub mod html;
@@ -17,18 +22,21 @@ use clap::Args;
 
 use crate::artifacts::files;
 use crate::artifacts::flown::FlownRecords;
-pub use inputs::{ReportError, ReportInputs};
+use crate::artifacts::identify_summary::IdentifySummary;
+pub use inputs::{FolderSummary, ReportError, ReportInputs};
 
 /// Arguments of `sweephold report`.
 #[derive(Args, Debug, Clone)]
 #[command(
-    after_help = "DIR is a folder written by `sweephold campaign`. Sections whose \
+    after_help = "DIR is a folder written by `sweephold campaign` or `sweephold identify` \
+(told apart by its summary.json; an identify folder's page has no truth in it and is drawn \
+from its files alone, as identify drew it). Sections whose \
 stage did not complete say so; a file that exists but does not parse is an error. The \
 report holds DIR.lock while it runs, as campaign and fly do: it is refused while a run \
 writes DIR, and a run on DIR is refused while it runs."
 )]
 pub struct ReportArgs {
-    /// The campaign folder.
+    /// The campaign or identify folder.
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
 }
@@ -102,9 +110,12 @@ fn refuse_link_into_folder(dir: &Path, report: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The whole page.
+/// The whole page: a campaign's, or an identify folder's ([`identify_page`]).
 pub fn render(inputs: &ReportInputs) -> String {
-    let summary = &inputs.summary;
+    let summary = match &inputs.summary {
+        FolderSummary::Campaign(summary) => summary,
+        FolderSummary::Identify(summary) => return identify_page(inputs, summary),
+    };
     let title = format!(
         "sweephold campaign: {} seed {}",
         summary.vehicle, summary.seed
@@ -116,7 +127,7 @@ Kim): the firmware flown in the loop with the nonlinear simulator, frequency res
 6-DOF then 9-DOF hybrid state-space fit, verification on held-out doublets, and comparison \
 with the simulator's truth.",
     );
-    body += &sections::summary::summary_section(inputs);
+    body += &sections::summary::summary_section(inputs, summary);
     body += &sections::sweep::sweep_input_section(inputs);
     body += &sections::coherence::coherence_section(inputs);
     body += &sections::bode::bode_section(inputs);
@@ -125,5 +136,28 @@ with the simulator's truth.",
     body += &sections::costs::cost_section(inputs);
     body += &sections::verification::verification_section(inputs);
     body += &sections::loops::loops_section(inputs);
+    html::page(&title, &body)
+}
+
+/// The page of an identify folder: the tests read, then the campaign's sections of the
+/// model without their truth parts. No sweep time history nor coherence curves (they
+/// come from dumps outside the folder) and no loops (identify computes no margins).
+fn identify_page(inputs: &ReportInputs, summary: &IdentifySummary) -> String {
+    let title = format!(
+        "sweephold identify: {} seed {}",
+        summary.vehicle, summary.seed
+    );
+    let mut body = format!("<h1>{}</h1>\n", html::escape(&title));
+    body += &html::note(
+        "Frequency-sweep system identification from flight logs: the frequency responses of \
+the sweep tests, 6-DOF then 9-DOF hybrid state-space fit with the aircraft file's priors, \
+verification on the held-out tests.",
+    );
+    body += &sections::identify_summary::identify_summary_section(summary);
+    body += &sections::bode::bode_section(inputs);
+    body += &sections::parameters::parameter_section(inputs);
+    body += &sections::modes::modes_section(inputs);
+    body += &sections::costs::cost_section(inputs);
+    body += &sections::verification::verification_section(inputs);
     html::page(&title, &body)
 }

@@ -253,6 +253,7 @@ fn identify_fits_and_verifies_a_board_log_with_every_test_listed_and_no_truth() 
         "model9.json",
         "verify.json",
         "summary.json",
+        "report.html",
     ] {
         assert!(out.join(file).is_file(), "{file}\n{stderr}");
     }
@@ -466,5 +467,142 @@ fn identify_refuses_bad_inputs_in_one_line_and_keeps_the_previous_results() {
     assert_eq!(output.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("nope"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The text of the report's section `id` (from its tag to the next section's).
+fn report_section<'a>(report: &'a str, id: &str) -> &'a str {
+    let start = report
+        .find(&format!("<section id=\"{id}\">"))
+        .unwrap_or_else(|| panic!("no section {id}"));
+    let end = report[start..]
+        .find("</section>")
+        .map_or(report.len(), |e| start + e);
+    &report[start..end]
+}
+
+#[test]
+fn identify_writes_a_report_without_truth_that_report_redraws_byte_for_byte() {
+    let dir = scratch("report");
+    let sweeps = dir.join("sweeps");
+    fly(
+        &sweeps,
+        &["--vehicle", "trex700l", "--seed", "3", "--t-rec", "20"],
+    );
+    let doublets = dir.join("doublets");
+    fly(
+        &doublets,
+        &[
+            "--vehicle",
+            "trex700l",
+            "--seed",
+            "4",
+            "--axes",
+            "lat,lon",
+            "--input",
+            "doublet",
+        ],
+    );
+    let out = dir.join("identified");
+    let (stdout, _) = ok(&[
+        "identify",
+        s(&sweeps),
+        s(&doublets),
+        "--vehicle",
+        "trex700l",
+        "--out",
+        s(&out),
+        "-q",
+    ]);
+    assert_eq!(stdout, format!("model: {}\n", s(&out.join("model9.json"))));
+    let written = std::fs::read(out.join("report.html")).unwrap();
+    let report = String::from_utf8(written.clone()).unwrap();
+    assert!(
+        !report.to_lowercase().contains("truth"),
+        "the report of an identify folder names a truth"
+    );
+    assert!(!report.contains("sweephold campaign"));
+    // Every test read, with its verdict.
+    let summary = report_section(&report, "identify-summary");
+    for test in ["lat-1.bin", "col-2.bin"] {
+        assert!(
+            summary.contains(&s(&sweeps.join(test)).to_string()),
+            "{test}"
+        );
+    }
+    assert!(summary.contains(s(&doublets.join("lon-1.bin"))));
+    // The parameter table: the key parameters with their Cramér–Rao bounds, and the
+    // priors.
+    let fitted = json(&out.join("summary.json"));
+    let parameters = report_section(&report, "parameters");
+    assert!(
+        parameters.contains("<th>CR %</th>") && parameters.contains("<th>flags</th>"),
+        "{parameters}"
+    );
+    for name in ["Lb1s", "Mb1c", "tau_f", "servo_omega"] {
+        let row = format!("<td class=\"name\">{name}</td>");
+        assert!(parameters.contains(&row), "{name}: {parameters}");
+    }
+    let lb1s = fitted["fit"]["params"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "Lb1s")
+        .unwrap();
+    let value = format!("<td>{:.5}</td>", lb1s["value"].as_f64().unwrap());
+    let cr = format!("<td>{:.2}</td>", lb1s["cr_percent"].as_f64().unwrap());
+    assert!(
+        parameters.contains(&value) && parameters.contains(&cr),
+        "{lb1s}"
+    );
+    assert!(parameters.contains("<th>moved σ</th>"), "the priors table");
+    // A Bode plot of every fitted pair, data and model.
+    let bode = report_section(&report, "bode");
+    let pairs = fitted["fit"]["pairs"].as_array().unwrap();
+    assert!(!pairs.is_empty());
+    assert_eq!(
+        bode.matches("<svg").count(),
+        pairs.len(),
+        "one plot per pair"
+    );
+    assert!(bode.contains("p/lat Bode plot") || bode.contains("p/lat magnitude"));
+    // The verification on the held-out doublets: their TIC and time histories.
+    let verification = report_section(&report, "verification");
+    let records = json(&out.join("verify.json"))["records"]
+        .as_array()
+        .unwrap()
+        .len();
+    assert_eq!(records, 2);
+    assert_eq!(verification.matches("<svg").count(), records);
+    assert!(verification.contains("TIC"), "{verification}");
+    // No campaign section: no flights, no loops.
+    for campaign_only in [
+        "sweep-input",
+        "cross-coherence",
+        "loops",
+        "campaign-summary",
+    ] {
+        assert!(!report.contains(&format!("<section id=\"{campaign_only}\">")));
+    }
+
+    // `report DIR` redraws the same page from the folder alone, and changes nothing else.
+    let summary_bytes = std::fs::read(out.join("summary.json")).unwrap();
+    std::fs::remove_file(out.join("report.html")).unwrap();
+    let (stdout, _) = ok(&["report", s(&out)]);
+    assert_eq!(stdout, format!("report: {}\n", s(&out.join("report.html"))));
+    assert!(
+        std::fs::read(out.join("report.html")).unwrap() == written,
+        "report DIR drew another page"
+    );
+    assert_eq!(
+        std::fs::read(out.join("summary.json")).unwrap(),
+        summary_bytes
+    );
+    // An identify summary that does not parse is an error in one line, naming it.
+    let broken = dir.join("broken");
+    std::fs::create_dir_all(&broken).unwrap();
+    std::fs::write(broken.join("summary.json"), r#"{"tests": 3}"#).unwrap();
+    let error = one_line_error(&["report", s(&broken)]);
+    assert!(error.contains("summary.json is corrupt"), "{error}");
     std::fs::remove_dir_all(&dir).ok();
 }

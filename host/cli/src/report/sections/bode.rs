@@ -1,5 +1,5 @@
 //! Bode magnitude and phase with coherence for every fitted pair: data, identified model
-//! and truth (paper Fig. 10).
+//! and, in a campaign, truth (paper Fig. 10).
 
 use super::HALF_WIDTH;
 use crate::plot::{colors, Figure, LegendEntry, Panel, Scale, Series};
@@ -23,6 +23,7 @@ pub fn bode_section(inputs: &ReportInputs) -> String {
             &note("model9.json's matrices do not match its names."),
         );
     };
+    let with_truth = inputs.summary.has_truth();
     let truth = inputs.truth_model.as_ref().and_then(|t| t.model());
     let mut figures = String::new();
     for fitted in &model_document.pairs {
@@ -94,8 +95,11 @@ pub fn bode_section(inputs: &ReportInputs) -> String {
         fig.legend = vec![
             LegendEntry::new("data", colors::DATA),
             LegendEntry::new("identified", colors::MODEL),
-            LegendEntry::new("truth", colors::TRUTH).dashed(),
         ];
+        if with_truth {
+            fig.legend
+                .push(LegendEntry::new("truth", colors::TRUTH).dashed());
+        }
         fig.width = HALF_WIDTH;
         figures += &figure(
             fig.to_html(),
@@ -105,16 +109,20 @@ pub fn bode_section(inputs: &ReportInputs) -> String {
             ),
         );
     }
-    let content = note(
-        "Composite MISO-conditioned responses of the cah records (black), the identified \
+    let (explained, heading) = if with_truth {
+        (
+            "Composite MISO-conditioned responses of the cah records (black), the identified \
 9-DOF hybrid model (blue) and the same structure at the simulator's truth values (red, \
 dashed), for every fitted pair. Shaded: the pair's fit range.",
-    ) + "<div class=\"grid\">\n"
-        + &figures
-        + "</div>\n";
-    section(
-        "bode",
-        "Frequency responses: data, identified model, truth (paper Fig. 10)",
-        &content,
-    )
+            "Frequency responses: data, identified model, truth (paper Fig. 10)",
+        )
+    } else {
+        (
+            "Composite MISO-conditioned responses of the sweep tests (black) and the \
+identified 9-DOF hybrid model (blue), for every fitted pair. Shaded: the pair's fit range.",
+            "Frequency responses: data and identified model (paper Fig. 10)",
+        )
+    };
+    let content = note(explained) + "<div class=\"grid\">\n" + &figures + "</div>\n";
+    section("bode", heading, &content)
 }

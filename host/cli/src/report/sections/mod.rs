@@ -5,10 +5,15 @@
 //! of the identified model beside the truth's ([`modes`]), the cost table ([`costs`]), and
 //! the verification time histories ([`verification`]), and the board's loops on the
 //! identified model: Bode plots with margins, the ADS-33 charts ([`loops`]).
+//!
+//! An identify folder's page has its own summary ([`identify_summary`]: the tests read
+//! and what became of each) and the model's sections without their truth parts
+//! ([`ReportInputs::summary`]'s `has_truth`), nothing from the flights or the loops.
 
 pub mod bode;
 pub mod coherence;
 pub mod costs;
+pub mod identify_summary;
 pub mod loops;
 pub mod modes;
 pub mod parameters;
@@ -44,11 +49,22 @@ fn fmt(value: Option<f64>, digits: usize) -> String {
     super::html::number(value, digits)
 }
 
+/// What a section without a fit says.
+fn no_fit(inputs: &ReportInputs) -> &'static str {
+    if inputs.summary.has_truth() {
+        "No fit in this campaign."
+    } else {
+        "No fit in this folder (the fit did not complete)."
+    }
+}
+
 /// The summary of the mode called `mode` (`cah`, `standard`, `noise`), when flown.
+/// None in an identify folder.
 fn mode_of<'a>(inputs: &'a ReportInputs, mode: &str) -> Option<&'a ModeSummary> {
+    let modes = &inputs.summary.campaign()?.modes;
     match mode {
-        "cah" => inputs.summary.modes.cah.as_ref(),
-        "standard" => inputs.summary.modes.standard.as_ref(),
-        _ => inputs.summary.modes.noise.as_ref(),
+        "cah" => modes.cah.as_ref(),
+        "standard" => modes.standard.as_ref(),
+        _ => modes.noise.as_ref(),
     }
 }

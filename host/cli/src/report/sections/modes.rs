@@ -1,5 +1,6 @@
 //! The modes of the identified model beside the truth's: one row per identified mode with
-//! the truth mode paired with it, then the truth modes left without a counterpart.
+//! the truth mode paired with it, then the truth modes left without a counterpart. In an
+//! identify folder, the identified modes alone.
 
 use crate::mode_text::hover_summary;
 use sysid::fit::modes::{
@@ -7,16 +8,21 @@ use sysid::fit::modes::{
     ORIGIN_LIMIT_RAD_S,
 };
 
-use super::fmt;
+use super::{fmt, no_fit};
 use crate::report::html::{note, section, table, Cell};
 use crate::report::inputs::ReportInputs;
 
 /// The identified model's modes beside the truth's: one row per identified mode with the
 /// truth mode paired with it, then the truth modes left without a counterpart.
 pub fn modes_section(inputs: &ReportInputs) -> String {
-    let title = "Modes: identified vs truth";
-    let Some(fit) = &inputs.summary.fit else {
-        return section("modes", title, &note("No fit in this campaign."));
+    let with_truth = inputs.summary.has_truth();
+    let title = if with_truth {
+        "Modes: identified vs truth"
+    } else {
+        "Modes of the identified model"
+    };
+    let Some(fit) = inputs.summary.fit() else {
+        return section("modes", title, &note(no_fit(inputs)));
     };
     if fit.modes.is_empty() {
         return section(
@@ -48,7 +54,7 @@ were, or a model without eigenvalues).",
                 }
                 (e, _) => Cell::plain(fmt(e, 1)),
             };
-            vec![
+            let mut row = vec![
                 if origin {
                     Cell::judged(mode.name.clone(), false)
                 } else {
@@ -59,12 +65,23 @@ were, or a model without eigenvalues).",
                 Cell::plain(fmt(mode.zeta, 3)),
                 Cell::plain(time(mode.time_to_double_s, mode.time_to_half_s)),
                 Cell::plain(mode.shape()),
-                Cell::plain(mode.truth_name.clone().unwrap_or_else(|| "-".into())),
-                Cell::plain(mode.truth.map_or("-".to_string(), eigenvalue_text)),
-                error,
-            ]
+            ];
+            if with_truth {
+                row.extend([
+                    Cell::plain(mode.truth_name.clone().unwrap_or_else(|| "-".into())),
+                    Cell::plain(mode.truth.map_or("-".to_string(), eigenvalue_text)),
+                    error,
+                ]);
+            }
+            row
         })
         .collect();
+    if !with_truth {
+        let content = note(&format!(
+            "{IDENTIFIED_MODES}. A pole at the origin (|λ| < 1e−6 rad/s) is red."
+        )) + &table(&IDENTIFIED_HEADERS, &rows);
+        return section("modes", title, &content);
+    }
     for truth in fit.truth_modes.iter().filter(|t| t.identified.is_none()) {
         rows.push(vec![
             // A truth hover mode the identified model lacks is a miss.
@@ -88,23 +105,18 @@ were, or a model without eigenvalues).",
         _ => String::new(),
     };
     let content = note(&format!(
-        "Eigenvalues λ of A = M⁻¹F of the identified model, one row per real pole or \
-complex pair (its Im > 0 member), sorted by |λ|; ω_n = |λ|, ζ = −Re λ/|λ|, time to double \
-(ln 2/Re λ) or to half (ln 2/−Re λ) the amplitude (of the envelope for a pair). Each mode is \
-named from its eigenvector (shape: the largest shares, rates divided by ω_s = max(|λ|, 0.1 \
-rad/s) and speeds multiplied by ω_s/g so that each reads as the attitude it amounts to; rules \
-in sysid::fit::modes) and paired with a mode of the truth model (the same structure at the \
+        "{IDENTIFIED_MODES} and paired with a mode of the truth model (the same structure at the \
 simulator's truth values): same name first, then the nearest eigenvalue. Error = \
 100·|λ − λ_truth|/|λ_truth|, green/red against 25 % for the truth's hover modes (|λ| < 3 \
 rad/s); a pole at the origin (|λ| < 1e−6 rad/s) is red.{verdict}"
     )) + &table(
         &[
-            "identified mode",
-            "λ [rad/s]",
-            "ω_n [rad/s]",
-            "ζ",
-            "t2 / t½ [s]",
-            "shape",
+            IDENTIFIED_HEADERS[0],
+            IDENTIFIED_HEADERS[1],
+            IDENTIFIED_HEADERS[2],
+            IDENTIFIED_HEADERS[3],
+            IDENTIFIED_HEADERS[4],
+            IDENTIFIED_HEADERS[5],
             "truth mode",
             "truth λ [rad/s]",
             "error %",
@@ -113,3 +125,21 @@ rad/s); a pole at the origin (|λ| < 1e−6 rad/s) is red.{verdict}"
     );
     section("modes", title, &content)
 }
+
+/// The columns of an identified mode.
+const IDENTIFIED_HEADERS: [&str; 6] = [
+    "identified mode",
+    "λ [rad/s]",
+    "ω_n [rad/s]",
+    "ζ",
+    "t2 / t½ [s]",
+    "shape",
+];
+
+/// How the identified modes are computed and named (without a truth to pair them with).
+const IDENTIFIED_MODES: &str = "Eigenvalues λ of A = M⁻¹F of the identified model, one row \
+per real pole or complex pair (its Im > 0 member), sorted by |λ|; ω_n = |λ|, ζ = −Re λ/|λ|, \
+time to double (ln 2/Re λ) or to half (ln 2/−Re λ) the amplitude (of the envelope for a pair). \
+Each mode is named from its eigenvector (shape: the largest shares, rates divided by ω_s = \
+max(|λ|, 0.1 rad/s) and speeds multiplied by ω_s/g so that each reads as the attitude it \
+amounts to; rules in sysid::fit::modes)";

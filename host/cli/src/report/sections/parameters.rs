@@ -1,18 +1,16 @@
-//! The parameter table (paper Table 3) with the truth, the errors and the accuracy flags.
+//! The parameter table (paper Table 3) with the accuracy flags and, in a campaign, the
+//! truth and the errors.
 
-use super::{fmt, KEY_PARAMETERS};
+use super::{fmt, no_fit, KEY_PARAMETERS};
 use crate::artifacts::priors::{PriorSummary, MOVED_WARNING_SIGMA};
 use crate::report::html::{note, section, table, Cell, Mark};
 use crate::report::inputs::ReportInputs;
 
-/// The parameter table (paper Table 3) with truth and flags.
+/// The parameter table (paper Table 3) with flags, and the truth in a campaign.
 pub fn parameter_section(inputs: &ReportInputs) -> String {
-    let Some(fit) = &inputs.summary.fit else {
-        return section(
-            "parameters",
-            "Identified parameters",
-            &note("No fit in this campaign."),
-        );
+    let with_truth = inputs.summary.has_truth();
+    let Some(fit) = inputs.summary.fit() else {
+        return section("parameters", "Identified parameters", &note(no_fit(inputs)));
     };
     let rows: Vec<Vec<Cell>> = fit
         .params
@@ -26,8 +24,8 @@ pub fn parameter_section(inputs: &ReportInputs) -> String {
                 (Some(e), true) => Cell::judged(format!("{e:+.1}"), e.abs() <= 10.0),
                 (e, _) => Cell::plain(e.map_or("-".to_string(), |e| format!("{e:+.1}"))),
             };
-            vec![
-                Cell::name(if key {
+            let mut row = vec![
+                Cell::name(if key && with_truth {
                     format!("{} *", p.name)
                 } else {
                     p.name.clone()
@@ -45,8 +43,11 @@ pub fn parameter_section(inputs: &ReportInputs) -> String {
                         Mark::Plain
                     },
                 ),
-                Cell::plain(fmt(p.truth, 5)),
-                error_cell,
+            ];
+            if with_truth {
+                row.extend([Cell::plain(fmt(p.truth, 5)), error_cell]);
+            }
+            row.extend([
                 Cell::plain(p.status.clone()),
                 Cell::marked(
                     p.flags.join(", "),
@@ -56,28 +57,24 @@ pub fn parameter_section(inputs: &ReportInputs) -> String {
                         Mark::Flag
                     },
                 ),
-            ]
+            ]);
+            row
         })
         .collect();
-    let content = note(&format!(
+    let mut explained = format!(
         "{} after reduction. CR: Cramér–Rao bound, insensitivity: both in % of |value| \
-(guidelines ≤ 20 % and ≤ 10 %; orange: beyond). Truth: the simulator's linearization at hover \
-mapped onto the structure; error = 100·(value − truth)/|truth|. * marks the parameters the \
-fit issue requires within 10 % of the truth (green/red).",
+(guidelines ≤ 20 % and ≤ 10 %; orange: beyond).",
         fit.structure
-    )) + &table(
-        &[
-            "parameter",
-            "value",
-            "CR %",
-            "insens. %",
-            "truth",
-            "error %",
-            "status",
-            "flags",
-        ],
-        &rows,
-    ) + &priors_table(&fit.priors);
+    );
+    let mut headers = vec!["parameter", "value", "CR %", "insens. %"];
+    if with_truth {
+        explained += " Truth: the simulator's linearization at hover mapped onto the \
+structure; error = 100·(value − truth)/|truth|. * marks the parameters the fit issue requires \
+within 10 % of the truth (green/red).";
+        headers.extend(["truth", "error %"]);
+    }
+    headers.extend(["status", "flags"]);
+    let content = note(&explained) + &table(&headers, &rows) + &priors_table(&fit.priors);
     section(
         "parameters",
         "Identified parameters (paper Table 3)",

@@ -1,12 +1,15 @@
 //! The campaign summary: the setup, the issues' bars with pass/fail, the wall time per
-//! stage.
+//! stage. The model's bars ([`model_rows`]) and the timings ([`timing_table`]) serve the
+//! identify folder's summary too, there without the truth's bars.
 
 use crate::mode_text::origin_text;
 use sysid::fit::modes::{HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT};
 
 use super::{fmt, mode_of, KEY_PARAMETERS};
 use crate::artifacts::stage::Stage;
-use crate::artifacts::summary::{FitSummary, ParameterSummary, ANGULAR_RATES};
+use crate::artifacts::summary::{
+    CampaignSummary, FitSummary, ParameterSummary, VerifySummary, ANGULAR_RATES,
+};
 use crate::report::html::{escape, note, section, table, Cell, Mark};
 use crate::report::inputs::ReportInputs;
 
@@ -18,7 +21,7 @@ const PAPER_COHERENCE: [(&str, Option<f64>); 3] = [
 ];
 
 /// One row of the bars table: what, measured, bar, met.
-fn bar_row(what: &str, measured: String, bar: &str, met: Option<bool>) -> Vec<Cell> {
+pub(super) fn bar_row(what: &str, measured: String, bar: &str, met: Option<bool>) -> Vec<Cell> {
     vec![
         Cell::name(what),
         match met {
@@ -29,9 +32,9 @@ fn bar_row(what: &str, measured: String, bar: &str, met: Option<bool>) -> Vec<Ce
     ]
 }
 
-/// The campaign summary: setup, the issues' bars with pass/fail, timings.
-pub fn summary_section(inputs: &ReportInputs) -> String {
-    let s = &inputs.summary;
+/// The campaign summary (`s`, the folder's `summary.json`): setup, the issues' bars with
+/// pass/fail, timings.
+pub fn summary_section(inputs: &ReportInputs, s: &CampaignSummary) -> String {
     let mut content = note(&format!(
         "Vehicle {}, seed {} (held-out doublets: seed {}), sweep records {:.0} s{}. \
 Green: the bar is met; red: it is not. Every figure below is drawn from the files in this \
@@ -92,20 +95,50 @@ folder (`sweephold report DIR` redraws it).",
             (mode == "cah").then_some(m.aborts == 0),
         ));
     }
+    rows.extend(model_rows(s.fit.as_ref(), s.verify.as_ref(), true));
+    if let Some(total) = s.timings_s.get("total") {
+        rows.push(bar_row(
+            "wall time of the campaign",
+            format!("{total:.1} s"),
+            "≤ 30 s (default campaign)",
+            (!s.quick).then_some(*total <= 30.0),
+        ));
+    }
+    content += &table(&["check", "measured", "bar"], &rows);
+
+    let mut order = Stage::ALL.map(Stage::name).to_vec();
+    order.push("total");
+    content += &timing_table(&s.timings_s, &order);
+    section("campaign-summary", "Campaign summary", &content)
+}
+
+/// The bars of the model: whether it is degenerate, its fit's bars (those against the
+/// truth only `with_truth`) and its verification's.
+pub(super) fn model_rows(
+    fit: Option<&FitSummary>,
+    verify: Option<&VerifySummary>,
+    with_truth: bool,
+) -> Vec<Vec<Cell>> {
     // A degenerate model meets no bar of the model's (its fit's and its verification's):
     // its figures are drawn, each marked not met.
-    let degenerate = s.fit.as_ref().is_some_and(|fit| !fit.degenerate.is_empty());
-    let model_rows_from = rows.len();
-    if let Some(fit) = &s.fit {
+    let degenerate = fit.is_some_and(|fit| !fit.degenerate.is_empty());
+    let mut rows = Vec::new();
+    if let Some(fit) = fit {
         rows.extend(degenerate_row(fit));
-        rows.extend(fit_bar_rows(fit));
+        rows.extend(fit_bar_rows(fit, with_truth));
     }
-    if let Some(verify) = &s.verify {
+    if let Some(verify) = verify {
+        // A campaign's held-out tests are its doublets.
+        let held_out = if with_truth {
+            "the doublets"
+        } else {
+            "the held-out tests"
+        };
         for output in ANGULAR_RATES {
             if let Some(tic) = verify.tic.get(output) {
                 rows.push(bar_row(
                     &format!(
-                        "verification TIC, {output} (mean over the doublets, {} bias)",
+                        "verification TIC, {output} (mean over {held_out}, {} bias)",
                         verify.bias
                     ),
                     format!("{tic:.3}"),
@@ -134,35 +167,21 @@ folder (`sweephold report DIR` redraws it).",
         ));
     }
     if degenerate {
-        for row in &mut rows[model_rows_from..] {
+        for row in &mut rows {
             if matches!(row[1].mark, Mark::Good) {
                 row[1].mark = Mark::Bad;
             }
         }
     }
-    if let Some(total) = s.timings_s.get("total") {
-        rows.push(bar_row(
-            "wall time of the campaign",
-            format!("{total:.1} s"),
-            "≤ 30 s (default campaign)",
-            (!s.quick).then_some(*total <= 30.0),
-        ));
-    }
-    content += &table(&["check", "measured", "bar"], &rows);
-
-    let timing_rows: Vec<Vec<Cell>> = stage_order(&s.timings_s)
-        .into_iter()
-        .map(|(stage, seconds)| vec![Cell::name(stage), Cell::plain(format!("{seconds:.2}"))])
-        .collect();
-    content += "<h3>Wall time per stage [s]</h3>\n";
-    content += &table(&["stage", "seconds"], &timing_rows);
-    section("campaign-summary", "Campaign summary", &content)
+    rows
 }
 
-/// Stages in run order, `total` last.
-fn stage_order(timings: &std::collections::BTreeMap<String, f64>) -> Vec<(String, f64)> {
-    let mut order = Stage::ALL.map(Stage::name).to_vec();
-    order.push("total");
+/// The table of the wall time per stage, under its heading: the stages of `order` in
+/// that order, then the others by name.
+pub(super) fn timing_table(
+    timings: &std::collections::BTreeMap<String, f64>,
+    order: &[&str],
+) -> String {
     let mut rows: Vec<(String, f64)> = order
         .iter()
         .filter_map(|name| timings.get(*name).map(|v| (name.to_string(), *v)))
@@ -173,7 +192,11 @@ fn stage_order(timings: &std::collections::BTreeMap<String, f64>) -> Vec<(String
             .filter(|(k, _)| !order.contains(&k.as_str()))
             .map(|(k, v)| (k.clone(), *v)),
     );
-    rows
+    let rows: Vec<Vec<Cell>> = rows
+        .into_iter()
+        .map(|(stage, seconds)| vec![Cell::name(stage), Cell::plain(format!("{seconds:.2}"))])
+        .collect();
+    "<h3>Wall time per stage [s]</h3>\n".to_string() + &table(&["stage", "seconds"], &rows)
 }
 
 /// The row saying the model is degenerate (`degenerate` of the summary), red; none when
@@ -189,7 +212,9 @@ fn degenerate_row(fit: &FitSummary) -> Option<Vec<Cell>> {
     })
 }
 
-fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
+/// The fit's bars; those against the truth (key parameters, hover modes, speed
+/// derivatives, J against the truth model) only `with_truth`.
+fn fit_bar_rows(fit: &FitSummary, with_truth: bool) -> Vec<Vec<Cell>> {
     let mut rows = vec![bar_row(
         &format!("{}: J_ave (paper's acceptable level 100)", fit.structure),
         format!("{:.1}", fit.cost_ave),
@@ -219,6 +244,9 @@ fn fit_bar_rows(fit: &FitSummary) -> Vec<Vec<Cell>> {
         "0 / 0",
         Some(over_cr == 0 && over_insensitivity == 0),
     ));
+    if !with_truth {
+        return rows;
+    }
     for name in KEY_PARAMETERS {
         if let Some(p) = fit.params.iter().find(|p| p.name == name) {
             rows.push(bar_row(
@@ -318,6 +346,12 @@ mod tests {
     use super::*;
     use sysid::fit::modes::{HoverModeScore, TruthModeRecord};
 
+    /// The summary section of a campaign whose summary holds only `fit`.
+    fn campaign_summary(fit: FitSummary) -> String {
+        let inputs = inputs_with_fit(fit);
+        summary_section(&inputs, inputs.summary.campaign().unwrap())
+    }
+
     #[test]
     fn a_needed_parameter_is_counted_apart_and_the_speed_derivatives_are_judged() {
         let parameter = |name: &str, flags: &[&str]| ParameterSummary {
@@ -354,7 +388,7 @@ mod tests {
                 error_percent: Some(40.0),
             },
         ];
-        let rows = fit_bar_rows(&fit);
+        let rows = fit_bar_rows(&fit, true);
         let find = |prefix: &str| {
             rows.iter()
                 .find(|row| row[0].text.starts_with(prefix))
@@ -449,7 +483,7 @@ mod tests {
             worst_error_percent: Some(6.3),
         };
         let passing = fit_with_modes(Vec::new(), Vec::new(), hover, 0);
-        let good = summary_section(&inputs_with_fit(passing.clone()));
+        let good = campaign_summary(passing.clone());
         assert!(good.contains(r#"<td class="good">16.0</td>"#), "{good}");
         assert!(!good.contains("degenerate minimum"), "{good}");
         let degenerate = FitSummary {
@@ -461,7 +495,7 @@ mod tests {
             }],
             ..passing
         };
-        let html = summary_section(&inputs_with_fit(degenerate));
+        let html = campaign_summary(degenerate);
         assert!(
             html.contains(r#"<td class="bad">`tau_f` = 0.005 on its lower bound 0.005</td>"#),
             "{html}"

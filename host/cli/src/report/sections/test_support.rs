@@ -3,14 +3,14 @@
 use sysid::fit::modes::{HoverModeScore, ModeRecord, TruthModeRecord};
 
 use crate::artifacts::summary::FitSummary;
-use crate::report::inputs::ReportInputs;
+use crate::report::inputs::{FolderSummary, ReportInputs};
 
 /// A report's inputs holding only a summary with `fit`.
 pub fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
     use crate::artifacts::summary::{CampaignSummary, Modes};
     ReportInputs {
         dir: std::path::PathBuf::from("campaign"),
-        summary: CampaignSummary {
+        summary: FolderSummary::Campaign(CampaignSummary {
             vehicle: "bo105".into(),
             link: "in-process".into(),
             seed: 1,
@@ -22,7 +22,7 @@ pub fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
             verify: None,
             timings_s: Default::default(),
             error: None,
-        },
+        }),
         frf: None,
         model: None,
         truth_model: None,
@@ -30,6 +30,35 @@ pub fn inputs_with_fit(fit: FitSummary) -> ReportInputs {
         margins: None,
         margins_loops: None,
         flown: Default::default(),
+    }
+}
+
+/// A report's inputs of an identify folder whose summary holds `fit` and one test read.
+pub fn identify_inputs_with_fit(fit: FitSummary) -> ReportInputs {
+    use crate::artifacts::identify_summary::IdentifySummary;
+    use crate::dump_tests::TestListing;
+    let campaign = inputs_with_fit(fit.clone());
+    ReportInputs {
+        dir: std::path::PathBuf::from("identified"),
+        summary: FolderSummary::Identify(IdentifySummary {
+            vehicle: "trex700l".into(),
+            seed: 1,
+            tests: vec![TestListing {
+                file: "log.bin".into(),
+                test: "test 1: lat Sweep, ConditionalAttitudeHold, 20.0 s, completed".into(),
+                verdict: "used".into(),
+            }],
+            sweeps: vec!["log.bin".into()],
+            held_out: Vec::new(),
+            captured_trim_rad: None,
+            trim_points: None,
+            notes: vec!["no held-out test (doublet, 3-2-1-1) in the logs: not verified".into()],
+            fit: Some(fit),
+            verify: None,
+            timings_s: Default::default(),
+            error: None,
+        }),
+        ..campaign
     }
 }
 

@@ -20,7 +20,12 @@ pub fn verification_section(inputs: &ReportInputs) -> String {
         return section(
             "verification",
             "Verification",
-            &note("No verification in this campaign."),
+            &note(if inputs.summary.has_truth() {
+                "No verification in this campaign."
+            } else {
+                "No verification in this folder (no held-out test in the logs, or the \
+verification did not complete)."
+            }),
         );
     };
     let mut outputs: Vec<String> = Vec::new();
@@ -60,11 +65,16 @@ pub fn verification_section(inputs: &ReportInputs) -> String {
         })
         .collect();
     let header_refs: Vec<&str> = headers.iter().map(String::as_str).collect();
+    let held_out = match inputs.summary.campaign() {
+        Some(campaign) => format!(
+            "held-out doublet records (seed {}, not used in the fit)",
+            campaign.verification_seed
+        ),
+        None => "the held-out tests of the logs (doublets, 3-2-1-1: not used in the fit)".into(),
+    };
     let mut content = note(&format!(
-        "The identified model simulated on the commands of held-out doublet records (seed {}, \
-not used in the fit){}; {}. TIC = rms(y − b − ŷ) / (rms(y − b) + rms(ŷ)): 0 perfect, \
-≤ 0.25 the bar for p, q, r.",
-        inputs.summary.verification_seed,
+        "The identified model simulated on the commands of {held_out}{}; {}. TIC = \
+rms(y − b − ŷ) / (rms(y − b) + rms(ŷ)): 0 perfect, ≤ 0.25 the bar for p, q, r.",
         match verify.segment_s {
             Some(s) => format!(", restarted from the measured state every {s} s"),
             None => ", open loop over each record".to_string(),
@@ -129,9 +139,10 @@ b = mean(y − ŷ) (fitted bias)",
         };
         content += &figure(fig.to_html(), &caption);
     }
-    section(
-        "verification",
-        "Verification on held-out doublets: measured vs predicted",
-        &content,
-    )
+    let heading = if inputs.summary.has_truth() {
+        "Verification on held-out doublets: measured vs predicted"
+    } else {
+        "Verification on the held-out tests: measured vs predicted"
+    };
+    section("verification", heading, &content)
 }

@@ -1,14 +1,20 @@
 //! `summary.json` of `sweephold identify` (layout in docs/formats.md, "Identify
 //! summary.json"): the tests read and what became of each, where the trim and the trim
 //! points came from, and the fit and verification sections the campaign writes too,
-//! without truth (identify has none: the truth fields of `fit` are null).
+//! without truth (identify has none: the truth fields of `fit` are null). Here, beside
+//! the campaign's documents, because the report reads it too.
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use crate::artifacts::summary::{FitSummary, StageFailure, VerifySummary};
+use super::summary::{FitSummary, StageFailure, VerifySummary};
 use crate::dump_tests::TestListing;
+
+/// The stages of `identify` as its `summary.json` names them (`timings_s`, `error`), in
+/// run order. The report (the last stage, `report`) is drawn from the summary written
+/// before it, so neither its time nor `total` counts it.
+pub const STAGES: [&str; 5] = ["frf", "fit-6dof", "fit-9dof", "verify", "report"];
 
 /// The whole `summary.json` of `identify`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
