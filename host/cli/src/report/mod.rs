@@ -110,7 +110,7 @@ fn refuse_link_into_folder(dir: &Path, report: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The whole page: a campaign's, or an identify folder's ([`identify_page`]).
+/// The whole page: a campaign's, or an identify folder's (`identify_page`).
 pub fn render(inputs: &ReportInputs) -> String {
     let summary = match &inputs.summary {
         FolderSummary::Campaign(summary) => summary,

@@ -1,7 +1,7 @@
 //! Bode magnitude and phase with coherence for every fitted pair: data, identified model
 //! and, in a campaign, truth (paper Fig. 10).
 
-use super::HALF_WIDTH;
+use super::shared::HALF_WIDTH;
 use crate::plot::{colors, Figure, LegendEntry, Panel, Scale, Series};
 use crate::report::curves::model_response;
 use crate::report::html::{figure, note, section};

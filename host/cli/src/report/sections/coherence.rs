@@ -3,7 +3,7 @@
 
 use plotters::style::RGBColor;
 
-use super::mode_of;
+use super::shared::mode_of;
 use crate::plot::{colors, BarChart, Figure, Panel, Scale, Series};
 use crate::report::html::{figure, note, section};
 use crate::report::inputs::ReportInputs;

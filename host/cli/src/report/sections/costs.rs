@@ -1,6 +1,6 @@
 //! The cost table: J per fitted pair, of the fit and (in a campaign) against the truth.
 
-use super::{fmt, no_fit};
+use super::shared::{fmt, no_fit};
 use crate::artifacts::summary::ANGULAR_RATES;
 use crate::report::html::{note, section, table, Cell};
 use crate::report::inputs::ReportInputs;

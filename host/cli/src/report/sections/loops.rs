@@ -5,7 +5,7 @@
 
 use nalgebra::Complex;
 
-use super::HALF_WIDTH;
+use super::shared::HALF_WIDTH;
 use crate::margins::ExportedResponse;
 use crate::plot::{colors, Figure, LegendEntry, Panel, Scale, Series};
 use crate::report::html::{figure, note, section, table, Cell};

@@ -8,7 +8,7 @@ use sysid::fit::modes::{
     ORIGIN_LIMIT_RAD_S,
 };
 
-use super::{fmt, no_fit};
+use super::shared::{fmt, no_fit};
 use crate::report::html::{note, section, table, Cell};
 use crate::report::inputs::ReportInputs;
 

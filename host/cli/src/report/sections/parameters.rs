@@ -1,7 +1,7 @@
 //! The parameter table (paper Table 3) with the accuracy flags and, in a campaign, the
 //! truth and the errors.
 
-use super::{fmt, no_fit, KEY_PARAMETERS};
+use super::shared::{fmt, no_fit, KEY_PARAMETERS};
 use crate::artifacts::priors::{PriorSummary, MOVED_WARNING_SIGMA};
 use crate::report::html::{note, section, table, Cell, Mark};
 use crate::report::inputs::ReportInputs;

@@ -1,11 +1,11 @@
 //! The campaign summary: the setup, the issues' bars with pass/fail, the wall time per
-//! stage. The model's bars ([`model_rows`]) and the timings ([`timing_table`]) serve the
+//! stage. The model's bars (`model_rows`) and the timings (`timing_table`) serve the
 //! identify folder's summary too, there without the truth's bars.
 
 use crate::mode_text::origin_text;
 use sysid::fit::modes::{HOVER_MODE_LIMIT_RAD_S, HOVER_MODE_TOLERANCE_PERCENT};
 
-use super::{fmt, mode_of, KEY_PARAMETERS};
+use super::shared::{fmt, mode_of, KEY_PARAMETERS};
 use crate::artifacts::stage::Stage;
 use crate::artifacts::summary::{
     CampaignSummary, FitSummary, ParameterSummary, VerifySummary, ANGULAR_RATES,

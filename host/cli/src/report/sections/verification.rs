@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use sysid::fit::verify::BiasMode;
 
-use super::fmt;
+use super::shared::fmt;
 use crate::artifacts::summary::{mean_tic, ANGULAR_RATES};
 use crate::plot::{colors, Figure, Panel, Scale, Series};
 use crate::report::html::{figure, note, section, table, Cell};
