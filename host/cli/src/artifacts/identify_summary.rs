@@ -14,7 +14,27 @@ use crate::dump_tests::TestListing;
 /// The stages of `identify` as its `summary.json` names them (`timings_s`, `error`), in
 /// run order. The report (the last stage, `report`) is drawn from the summary written
 /// before it, so neither its time nor `total` counts it.
-pub const STAGES: [&str; 5] = ["frf", "fit-6dof", "fit-9dof", "verify", "report"];
+pub const STAGES: [&str; 5] = [
+    stage::FRF,
+    stage::FIT_6DOF,
+    stage::FIT_9DOF,
+    stage::VERIFY,
+    stage::REPORT,
+];
+
+/// Each stage's name, as `identify` runs it and its `summary.json` records it.
+pub mod stage {
+    /// The frequency responses.
+    pub const FRF: &str = "frf";
+    /// The quasi-steady 6-DOF fit.
+    pub const FIT_6DOF: &str = "fit-6dof";
+    /// The 9-DOF hybrid fit.
+    pub const FIT_9DOF: &str = "fit-9dof";
+    /// The verification on the held-out tests.
+    pub const VERIFY: &str = "verify";
+    /// `report.html`.
+    pub const REPORT: &str = "report";
+}
 
 /// The whole `summary.json` of `identify`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -27,7 +27,7 @@ use sysid::frf::Record;
 use sysid::records::check_one_origin;
 
 use crate::artifacts::files;
-use crate::artifacts::identify_summary::IdentifySummary;
+use crate::artifacts::identify_summary::{stage, IdentifySummary};
 use crate::artifacts::summary::StageFailure;
 use crate::dump_tests::{excitation_records, UsedTest};
 use crate::fit::TrimBalanceArg;
@@ -365,9 +365,11 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
         held_out,
         trim,
     } = tests;
-    let frf = run.stage("frf", |run| run.pipeline().frequency_responses(sweeps))?;
-    let six = run.stage("fit-6dof", |run| run.pipeline().fit_6dof(&frf.document))?;
-    let nine = run.stage("fit-9dof", |run| {
+    let frf = run.stage(stage::FRF, |run| run.pipeline().frequency_responses(sweeps))?;
+    let six = run.stage(stage::FIT_6DOF, |run| {
+        run.pipeline().fit_6dof(&frf.document)
+    })?;
+    let nine = run.stage(stage::FIT_9DOF, |run| {
         let (result, fit, line) =
             run.pipeline()
                 .fit_9dof(trim, &frf.document, &six, &trim_points)?;
@@ -375,7 +377,7 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
         Ok((result, line))
     })?;
     if !held_out.is_empty() {
-        run.stage("verify", |run| {
+        run.stage(stage::VERIFY, |run| {
             let (verify, line) = run.pipeline().verify(&nine.model, &held_out)?;
             run.summary.verify = Some(verify);
             Ok(((), line))
@@ -383,7 +385,7 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
     }
     // The report is drawn from the folder's files, the summary included: written first
     // and not again, so that `sweephold report DIR` redraws the same page.
-    run.stage("report", |run| {
+    run.stage(stage::REPORT, |run| {
         let total = run.started.elapsed().as_secs_f64();
         run.summary.timings_s.insert("total".to_string(), total);
         write_json(&run.dir().join(files::SUMMARY), &run.summary)?;
