@@ -128,3 +128,28 @@ lon = "Mlon"
     );
     ModelStructure::parse(&text, "toy.toml").unwrap()
 }
+
+/// The shipped structure file `name`, parsed with its own constants.
+pub fn shipped(name: &str) -> ModelStructure {
+    crate::models::shipped(name)
+        .expect("shipped structure")
+        .parse()
+        .expect("parses")
+}
+
+/// The names of the shipped structures.
+pub const SHIPPED_NAMES: [&str; 4] = [
+    "bo105-6dof",
+    "bo105-9dof-hybrid",
+    "trex700l-6dof",
+    "trex700l-9dof-hybrid",
+];
+
+/// `structure`'s start values with the named parameters set to the given values.
+pub fn values_with(structure: &ModelStructure, changes: &[(&str, f64)]) -> Vec<f64> {
+    let mut values = structure.values();
+    for (name, value) in changes {
+        values[structure.parameter_index(name).expect("parameter")] = *value;
+    }
+    values
+}

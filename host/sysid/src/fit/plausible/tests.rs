@@ -1,29 +1,9 @@
 use super::*;
-use crate::models;
-
-fn shipped(name: &str) -> ModelStructure {
-    models::shipped(name)
-        .expect("shipped structure")
-        .parse()
-        .expect("parses")
-}
-
-fn values_with(structure: &ModelStructure, changes: &[(&str, f64)]) -> Vec<f64> {
-    let mut values = structure.values();
-    for (name, value) in changes {
-        values[structure.parameter_index(name).expect("parameter")] = *value;
-    }
-    values
-}
+use crate::fit::test_support::{shipped, values_with, SHIPPED_NAMES};
 
 #[test]
 fn every_shipped_structure_starts_inside_the_physical_ranges() {
-    for name in [
-        "bo105-6dof",
-        "bo105-9dof-hybrid",
-        "trex700l-6dof",
-        "trex700l-9dof-hybrid",
-    ] {
+    for name in SHIPPED_NAMES {
         let structure = shipped(name);
         let found = implausible_parameters(&structure, &structure.values());
         assert!(found.is_empty(), "{name}: {found:?}");
