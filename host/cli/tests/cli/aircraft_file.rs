@@ -5,18 +5,9 @@
 //! `--vehicle FILE`. What reaches the simulator, the flight controller's Header and the
 //! fit's priors is the file's.
 
-use std::process::{Command, Output};
-
 use serde_json::Value;
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn scratch() -> Scratch {
     Scratch::new("aircraft")

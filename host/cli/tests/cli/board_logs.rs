@@ -4,16 +4,8 @@
 //! measured outputs scored.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn ok(args: &[&str]) -> (String, String) {
     let output = sweephold(args);

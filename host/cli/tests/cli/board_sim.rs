@@ -4,18 +4,10 @@
 //! measured are in docs/board-application.md.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn scratch(name: &str) -> Scratch {
     Scratch::unmade(&format!("board-sim-{name}"))

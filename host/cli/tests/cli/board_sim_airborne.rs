@@ -6,18 +6,11 @@
 //! aircraft's vertical specific force answers), and with the trim collective it does not.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn scratch(name: &str) -> Scratch {
     Scratch::unmade(&format!("board-sim-air-{name}"))

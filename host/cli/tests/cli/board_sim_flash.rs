@@ -4,23 +4,16 @@
 //! reversed, 760 µs tail servo).
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
 use crate::support;
+use crate::support::sweephold;
 
 const FBL700: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../aircraft/vehicles/fbl700.toml"
 );
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 fn ok(args: &[&str]) -> String {
     let output = sweephold(args);

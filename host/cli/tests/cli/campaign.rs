@@ -8,14 +8,7 @@ use std::process::{Command, Output};
 use serde_json::Value;
 use sweephold::artifacts::stage::Stage;
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn scratch(name: &str) -> Scratch {
     Scratch::new(&format!("campaign-{name}"))

@@ -1,18 +1,11 @@
 //! `sweephold decode` as a user runs it: output, summary and every error path.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sweephold_protocol::{codec, synthetic, Event, Frame, ProtocolVersion, PROTOCOL_VERSION};
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
-}
+use crate::support::{sweephold, Scratch};
 
 struct TempDir(Scratch);
 

@@ -5,11 +5,10 @@
 //! inside the physical ranges; where that fails, one line names the worst parameters.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use sysid::fit::plausible::implausible_parameters;
 
-use crate::support::Scratch;
+use crate::support::{sweephold, Scratch};
 
 struct TempDir(Scratch);
 
@@ -17,13 +16,6 @@ impl TempDir {
     fn new(name: &str) -> Self {
         TempDir(Scratch::new(&format!("degenerate-{name}")))
     }
-}
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
 }
 
 /// The parameters of `model.json` at `path` outside the physical ranges of its shipped

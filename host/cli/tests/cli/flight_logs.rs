@@ -3,24 +3,16 @@
 //! (`host/sysid/tests/fixtures/logs/`, whose README says where each came from).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use sysid::document::FrfDocument;
 
-use crate::support::Scratch;
+use crate::support::{sweephold, Scratch};
 
 fn fixture(name: &str) -> String {
     format!(
         "{}/../sysid/tests/fixtures/logs/{name}",
         env!("CARGO_MANIFEST_DIR")
     )
-}
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
 }
 
 fn text(bytes: &[u8]) -> String {

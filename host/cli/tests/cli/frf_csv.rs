@@ -5,11 +5,11 @@
 //! one-line answers to a file read without them.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sysid::document::{FrfDocument, PairResponse};
 
-use crate::support::Scratch;
+use crate::support::{sweephold, Scratch};
 
 const X8ROLL: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -33,13 +33,6 @@ const X8_OPTIONS: [&str; 10] = [
 ];
 
 const DEG_PER_S: [&str; 2] = ["--units", "gx=deg/s"];
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
-}
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()

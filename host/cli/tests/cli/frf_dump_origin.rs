@@ -3,16 +3,9 @@
 //! exit status 1, and no document written. Dumps of one origin are still joined.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
-}
+use crate::support::{sweephold, Scratch};
 
 struct TempDir(Scratch);
 

@@ -4,23 +4,16 @@
 //! `make_two_input_csv.py` there), and readers refusing a damaged `frf.json`.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sysid::document::{FrfDocument, PairResponse};
 
-use crate::support::Scratch;
+use crate::support::{sweephold, Scratch};
 
 const TWO_INPUT_CSV: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../sysid/tests/data/two_input.csv"
 );
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
-}
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()

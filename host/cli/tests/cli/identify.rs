@@ -2,15 +2,8 @@
 //! `sweephold identify` (frequency responses, fits and verification with no simulator)
 //! on the records `fly --fc board-sim` writes, joined as a logger's file per power-up.
 
+use crate::support::sweephold;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 fn ok(args: &[&str]) -> (String, String) {
     let output = sweephold(args);

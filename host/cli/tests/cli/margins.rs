@@ -2,16 +2,8 @@
 //! on a second run, the model untouched; bad inputs end in one `error:` line.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../control/tests/fixtures/{name}"))

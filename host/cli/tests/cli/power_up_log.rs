@@ -3,18 +3,11 @@
 //! board's log of the power-up written as one file that `frf` reads test by test.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sweephold_protocol::{Decoder, Frame, Header};
 
-use crate::support::Scratch;
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{sweephold, Scratch};
 
 fn ok(args: &[&str]) -> String {
     let output = sweephold(args);

@@ -3,11 +3,10 @@
 //! error naming it and the line, and no input file is modified.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use sysid::fit::trim::TrimPoints;
 
-use crate::support::Scratch;
+use crate::support::{sweephold, Scratch};
 
 struct TempDir(Scratch);
 
@@ -20,13 +19,6 @@ impl TempDir {
         std::fs::write(&path, bytes).unwrap();
         path
     }
-}
-
-fn sweephold(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sweephold"))
-        .args(args)
-        .output()
-        .expect("run sweephold")
 }
 
 #[test]

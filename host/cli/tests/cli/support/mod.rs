@@ -5,3 +5,13 @@ pub mod scratch;
 pub mod signals;
 
 pub use scratch::Scratch;
+
+use std::process::{Command, Output};
+
+/// Run the `sweephold` binary under test with `args` and wait for it.
+pub fn sweephold(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sweephold"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
