@@ -30,8 +30,9 @@
 //! ([`super::board_test_list`]). A record whose test is an entry of the list is chosen
 //! in the air: the simulated transmitter's selector sits at that entry's slice when the
 //! test switch engages, and the board's own single test stays the preset's (the
-//! record's mode, noise seed and the other shared settings are the board's, one record
-//! per power-up). A record outside the list (another band, length or input) is the
+//! record's mode, noise seed and the other shared settings are the board's, set by the
+//! record that powers the board up: every record, or with `--power-up once` the first of
+//! the flight). A record outside the list (another band, length or input) is the
 //! board's single test, selector off, as before the list. With `--fc board-sim:FLASH`
 //! it boots the set saved in FLASH ([`BoardSetup::Stored`]) and only the record's test
 //! (axis, input, mode, seed, band, length, amplitude), the test list (the same as above:
