@@ -201,10 +201,7 @@ impl FlightControllerLink for BoardSimLink {
         self.board = None;
         let board = power_up::power_up(settings, config, once)?;
         if once && board.selector.is_none() {
-            anyhow::bail!(
-                "this record's test is not an entry of the board's test list: one power-up \
-                 flies only the list's tests"
-            );
+            anyhow::bail!("{}", power_up::NOT_IN_THE_LIST);
         }
         self.board = Some(board);
         self.power_ups += 1;

@@ -81,7 +81,7 @@ pub(super) fn power_up(
     let mut map = ChannelMap::flybarless_default();
     map.selector = stack_config.channel_map.selector;
     let app = stack_config.app;
-    let seed = 0xB0A2_D51A_u64 ^ u64::from(config.test.seed).rotate_left(23);
+    let seed = devices_seed(config.test.seed);
     let rotor_lines = settings
         .rotor_rpm
         .map_or(Imperfections::TREX700L_ROTOR_RUNNING, |[head, tail]| {
@@ -306,15 +306,10 @@ pub(super) fn next_test(
         ..record
     };
     let (_, position) = board_test_list::selection(&settings.test_list, &single, &flown)
-        .ok_or_else(|| {
-            anyhow::anyhow!(
-                "this record's test is not an entry of the board's test list: one power-up \
-                 flies only the list's tests"
-            )
-        })?;
+        .ok_or_else(|| anyhow::anyhow!("{NOT_IN_THE_LIST}"))?;
     board.selector = Some(position);
     board.record_ticks = 0;
-    let seed = 0xB0A2_D51A_u64 ^ u64::from(single.seed).rotate_left(23);
+    let seed = devices_seed(single.seed);
     hover_on_gimbal(
         board,
         settings,
@@ -329,4 +324,15 @@ pub(super) fn next_test(
         );
     }
     Ok(())
+}
+
+/// Why a record cannot be flown on one power-up: its test is no entry of the list.
+pub(super) const NOT_IN_THE_LIST: &str =
+    "this record's test is not an entry of the board's test list: one power-up flies only the \
+     list's tests";
+
+/// The seed of the emulated devices (the IMU's imperfections, the gimbal hover's
+/// simulator) of a board whose flight's noise seed is `test_seed`.
+fn devices_seed(test_seed: u32) -> u64 {
+    0xB0A2_D51A_u64 ^ u64::from(test_seed).rotate_left(23)
 }
