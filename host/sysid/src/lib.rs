@@ -41,3 +41,4 @@ pub mod frf;
 pub mod models;
 pub mod random;
 pub mod records;
+pub mod steady;
