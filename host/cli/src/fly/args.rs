@@ -226,6 +226,13 @@ pub struct FlyArgs {
     /// mode ends the power-up: the next one starts another) [default: per-record].
     #[arg(long = "power-up", value_enum, value_name = "HOW")]
     pub power_up: Option<PowerUpArg>,
+    /// `--fc board-sim`: fly no test but the steady flights of `sim trim-points` (hover,
+    /// 1 m/s forward, aft, right, left, 0.5 m/s climb and descent, ±0.1 rad/s turns), each
+    /// 8 s to settle and 10 s held, in the pilot mode on one power-up with the flight's
+    /// --seed and --gust; writes the board's log `log/power-up-1.bin` and the simulated
+    /// GNSS's `gnss.csv` (10 Hz, 0.1 m/s white noise per velocity; docs/formats.md).
+    #[arg(long = "steady-flights")]
+    pub steady_flights: bool,
 }
 
 /// `--power-up` on the command line.
@@ -419,6 +426,7 @@ impl FlyArgs {
                 ("--imu-fault", self.imu_fault.is_some()),
                 ("--fly-on", self.fly_on_s.is_some()),
                 ("--power-up", self.power_up.is_some()),
+                ("--steady-flights", self.steady_flights),
             ];
             if let Some((flag, _)) = board_only.iter().find(|(_, given)| *given) {
                 bail!("{flag} is for --fc board-sim only");

@@ -87,7 +87,7 @@ fn flight() -> (Vec<Sample>, Vec<GnssFix>) {
                 *v += 0.002 * rng.normal_pair().0;
             }
             samples.push(sample(tick, phase, rates, attitude, sticks));
-            if tick % 5 == 0 {
+            if tick.is_multiple_of(5) {
                 let mut noisy = velocity;
                 for v in &mut noisy {
                     *v += 0.1 * rng.normal_pair().0;
