@@ -438,6 +438,20 @@ impl FlyArgs {
                 self.rate_hz
             );
         }
+        if self.steady_flights {
+            let timed = [
+                ("--rc-loss", self.rc_loss_at_s.is_some()),
+                ("--fly-on", self.fly_on_s.is_some()),
+                ("--pilot-override", self.pilot_override_at_s.is_some()),
+                (
+                    "--imu-fault KIND@AT_S",
+                    self.imu_fault.is_some_and(|f| f.at_s.is_some()),
+                ),
+            ];
+            if let Some((flag, _)) = timed.iter().find(|(_, given)| *given) {
+                bail!("{flag} counts record time: --steady-flights flies no record");
+            }
+        }
         if let Some(t) = self.rc_loss_at_s {
             if !t.is_finite() || t < 0.0 {
                 bail!("--rc-loss {t}: expected a record time >= 0 s");

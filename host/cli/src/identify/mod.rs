@@ -8,8 +8,9 @@
 //!
 //! The stages are the campaign's own ([`stages`]: `campaign` runs them on what it flew):
 //! one pipeline. Where the campaign asks the simulator — its steady flights for the trim
-//! points — identify takes a file (`--trim-points`) or, without one, fits the hybrid's
-//! `trim_derived` parameters like the others and says so in `summary.json`. Nothing in
+//! points — identify takes a file (`--trim-points`), the steady flights of a log with a
+//! GNSS file ([`flight_trim`]), or, without either, fits the hybrid's `trim_derived`
+//! parameters like the others and flags it in `summary.json` and the report. Nothing in
 //! this folder imports the simulator (`rotorsim`) or its truth (`truth`); CI checks it
 //! (`cargo xtask import-cycles`).
 
@@ -46,7 +47,8 @@ for the dumps (*.bin) directly in it. Sweep tests give the frequency responses (
 order lat, lon, ped, col, each axis's tests in the order given), every other test (doublet, \
 3-2-1-1) is held out for the verification (in the same order). Aborted tests and tests cut off by the end of \
 a file are left out unless --include-aborted. Writes into DIR: frf.json, model6.json, \
-model9.json, verify.json (when there are held-out tests), summary.json (layout in \
+model9.json, verify.json (when there are held-out tests), trim-points.csv (with \
+--steady-flights), summary.json (layout in \
 docs/formats.md) and last report.html, drawn from these files alone (`sweephold report DIR` \
 redraws it byte for byte). The run is built in DIR.partial and replaces DIR only when it completes; \
 a failing stage leaves DIR as it was, keeps the failed run's files in DIR.failed and exits \

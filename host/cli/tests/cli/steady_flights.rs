@@ -336,5 +336,23 @@ fn steady_flights_are_for_the_board_sim_only() {
         stderr.contains("--steady-flights is for --fc board-sim only"),
         "{stderr}"
     );
+    let stderr = one_line_error(
+        &[
+            "fly",
+            "--fc",
+            "board-sim",
+            "--steady-flights",
+            "--rc-loss",
+            "5",
+            "--out",
+            s(&dir.join("out")),
+        ],
+        1,
+    );
+    assert!(
+        stderr.contains("--rc-loss counts record time: --steady-flights flies no record"),
+        "{stderr}"
+    );
+    assert!(!dir.join("out").exists());
     std::fs::remove_dir_all(&dir).ok();
 }

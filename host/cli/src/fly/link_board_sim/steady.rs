@@ -92,6 +92,10 @@ pub fn fly_steady_flights(
         let pedal = pedal_for(turn_rate, &pilot);
         let mut integral = [0.0_f64; 2];
         for _ in 0..ticks {
+            // A safe point every second of flight, as in a record.
+            if flown_ticks.is_multiple_of(u64::from(config.rate_hz).max(1)) {
+                crate::interrupt::check()?;
+            }
             let state = sim.state();
             let [phi, theta, psi] = state.attitude();
             let ned = body_to_ned(state.velocity(), phi, theta, psi);
