@@ -3,7 +3,8 @@
 
     cargo build --release -p sweephold
     python3 docs/bars.py --vehicle V --seeds 1-10 --out CAMPAIGNS -- --fc board-sim
-    python3 docs/identify_logs.py --vehicle V --campaigns CAMPAIGNS --seeds 1-10 --out DIR [--trim-points]
+    python3 docs/identify_logs.py --vehicle V --campaigns CAMPAIGNS --seeds 1-10 --out DIR \
+        [--trim-points | --flight-trim]
 
 For each seed N, the campaign folder CAMPAIGNS/NAME-N (NAME: the vehicle file's stem, as
 bars.py names it) holds the board's log of each power-up: `fly-cah/log/power-up-1.bin` (the
@@ -11,7 +12,9 @@ eight sweeps of the cah stage, one power-up) and `verify-doublet/log/power-up-1.
 four held-out doublets, another power-up). This script runs
 
     sweephold identify CAMPAIGN/fly-cah/log CAMPAIGN/verify-doublet/log --vehicle V --seed N
-        [--trim-points CAMPAIGN/trim-points.csv] --out DIR/NAME-N -q
+        [--trim-points CAMPAIGN/trim-points.csv]
+        [--steady-flights CAMPAIGN/fly-steady/log/power-up-1.bin --gnss CAMPAIGN/fly-steady/gnss.csv]
+        --out DIR/NAME-N -q
 
 and scores its model9 against the truth the campaign computed (identify has none: it never
 runs the simulator): the nine key parameters against `fit.params[].truth` of the campaign's
@@ -81,13 +84,18 @@ def main():
     parser.add_argument("--campaigns", required=True, help="the bars.py --out folder")
     parser.add_argument("--seeds", type=seeds, default=seeds("1-10"))
     parser.add_argument("--out", required=True)
-    parser.add_argument("--trim-points", action="store_true",
-                        help="pass the campaign's trim-points.csv (the simulator's trims)")
+    trims = parser.add_mutually_exclusive_group()
+    trims.add_argument("--trim-points", action="store_true",
+                       help="pass the campaign's trim-points.csv (the simulator's trims)")
+    trims.add_argument("--flight-trim", action="store_true",
+                       help="pass the campaign's steady flights (fly-steady/: the board's log "
+                            "and gnss.csv): trim points from the flight")
     args = parser.parse_args()
     name = os.path.splitext(os.path.basename(args.vehicle))[0]
     os.makedirs(args.out, exist_ok=True)
-    print(f"identify {args.vehicle} on board-sim logs, "
-          f"{'with' if args.trim_points else 'without'} trim points, seeds "
+    source = ("the simulator's trim points" if args.trim_points else
+              "trim points from the steady flights" if args.flight_trim else "no trim points")
+    print(f"identify {args.vehicle} on board-sim logs, {source}, seeds "
           f"{args.seeds.start}-{args.seeds.stop - 1}\n")
     print("| seed | key ≤10 % (worst) | hover ≤25 % (worst) | TIC p, q, r | J_ave | tests used |")
     print("|---|---|---|---|---|---|")
@@ -100,6 +108,10 @@ def main():
                    "--seed", str(seed), "--out", out, "-q"]
         if args.trim_points:
             command += ["--trim-points", os.path.join(campaign, "trim-points.csv")]
+        if args.flight_trim:
+            steady = os.path.join(campaign, "fly-steady")
+            command += ["--steady-flights", os.path.join(steady, "log", "power-up-1.bin"),
+                        "--gnss", os.path.join(steady, "gnss.csv")]
         run = subprocess.run(command, capture_output=True, text=True)
         if run.returncode != 0:
             print(f"| {seed} | identify failed: {run.stderr.strip().splitlines()[-1]} |")

@@ -52,7 +52,7 @@ const fn rule(folder: &'static str, enforced: bool, layers: &'static str) -> Cra
 /// states).
 #[rustfmt::skip]
 pub const CRATES: &[CrateRule] = &[
-    rule("host/sysid", true, "models > fit > frf > document, records, random"),
+    rule("host/sysid", true, "models, steady > fit > frf > document, records, random"),
     rule("shared", true, ""),
     rule("firmware", false, ""),
     rule("firmware/board", false, ""),

@@ -43,7 +43,7 @@ enum Task {
     ImportCycles,
     /// Inside a crate, imports go down: no module imports from an ancestor's file (it
     /// imports from the module that defines the item), and each crate with a stated
-    /// order of its top-level modules keeps it (sysid: `models > fit > frf > document,
+    /// order of its top-level modules keeps it (sysid: `models, steady > fit > frf > document,
     /// records, random`). Other crates' findings are listed, not enforced.
     Layers,
     /// No non-test source file over its size limit (600 lines, every crate).

@@ -13,11 +13,14 @@
 //! * [`fit`] — state-space model structures fitted to those responses, with their
 //!   accuracy, modes, trim-derived parameters and time-domain verification;
 //! * [`models`] — the structure files shipped with the crate, by name;
+//! * [`steady`] — trim points from a flight: the steady segments of a log with a GNSS
+//!   unit's velocities;
 //! * [`random`] — the one small deterministic generator (seeded restarts, test noise).
 //!
-//! Inside the crate the dependencies run one way, in layers: `models` > `fit` > `frf` >
-//! `document`, `records`, `random`. A module imports only the modules of the layers below
-//! its own: `models` → `fit` → `frf` → `records`, `fit` and `frf` → `document`, and any
+//! Inside the crate the dependencies run one way, in layers: `models`, `steady` > `fit` >
+//! `frf` > `document`, `records`, `random`. A module imports only the modules of the layers
+//! below its own: `models` and `steady` → `fit` → `frf` → `records`, `fit` and `frf` →
+//! `document`, and any
 //! of them → `random`; `document`, `records` and `random` import no other module of the
 //! crate. Inside each module too, imports go down: a module imports its siblings and
 //! their public items, never the internals of its parent's siblings, and never an item
@@ -41,3 +44,4 @@ pub mod frf;
 pub mod models;
 pub mod random;
 pub mod records;
+pub mod steady;

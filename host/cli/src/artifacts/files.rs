@@ -24,6 +24,8 @@ pub const MARGINS: &str = "margins.json";
 pub const MARGINS_LOOPS: &str = "margins-loops.json";
 /// Folder of the held-out doublets.
 pub const VERIFICATION_FOLDER: &str = "verify-doublet";
+/// The folder of the steady flights' log and GNSS file (`--fc board-sim` campaigns).
+pub const STEADY_FOLDER: &str = "fly-steady";
 
 /// Folder of the sweeps flown in `mode` (`cah`, `standard`, `noise`).
 pub fn fly_folder(mode: &str) -> String {

@@ -57,6 +57,18 @@ pub struct IdentifySummary {
     /// The trim points file the hybrid's `trim_derived` parameters came from; null when
     /// none was given (then they are fitted like the others).
     pub trim_points: Option<String>,
+    /// Where the trim points came from: `file` (`--trim-points`), `flight` (the steady
+    /// segments of `--steady-flights` with the velocities of `--gnss`) or `none`.
+    #[serde(default = "no_source")]
+    pub trim_points_source: String,
+    /// The steady segments the trim points were averaged over (`flight` only).
+    #[serde(default)]
+    pub steady_segments: Vec<SteadySegmentSummary>,
+    /// True without any velocity source (no trim points): the hover derivatives (the
+    /// hybrid's `trim_derived` parameters) are fitted from the responses alone, which
+    /// inform them poorly; the report flags it.
+    #[serde(default)]
+    pub hover_derivatives_unanchored: bool,
     /// What the run could not do and how it went on instead (no trim points, no
     /// held-out test…), one sentence each.
     pub notes: Vec<String>,
@@ -68,4 +80,24 @@ pub struct IdentifySummary {
     pub timings_s: BTreeMap<String, f64>,
     /// Null when every stage completed.
     pub error: Option<StageFailure>,
+}
+
+/// `trim_points_source` of a summary written before it existed.
+fn no_source() -> String {
+    "none".to_string()
+}
+
+/// One steady segment of `--steady-flights` (`summary.json` `steady_segments`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SteadySegmentSummary {
+    /// Its label in `trim-points.csv` (`steady N`).
+    pub label: String,
+    /// Ticks of its first and last Sample.
+    pub ticks: [u32; 2],
+    /// Its one-second blocks.
+    pub blocks: usize,
+    /// Body velocity u, v, w [m/s] and their standard errors.
+    pub velocity_m_s: [f64; 3],
+    /// Standard errors of `velocity_m_s`.
+    pub velocity_se_m_s: [f64; 3],
 }

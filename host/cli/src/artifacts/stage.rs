@@ -16,6 +16,9 @@ pub enum Stage {
     FlyNoise,
     /// Fly the held-out doublets (another seed) for the verification.
     FlyVerification,
+    /// `--fc board-sim` only: fly the steady flights (`fly --steady-flights`): the board's
+    /// log and the simulated GNSS's file, for `identify --steady-flights`.
+    FlySteady,
     /// Frequency responses of the `cah` records.
     Frf,
     /// Trim points (the simulator's steady flights), `trim-points.csv`.
@@ -36,12 +39,13 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in the order a campaign runs them.
-    pub const ALL: [Stage; 13] = [
+    pub const ALL: [Stage; 14] = [
         Stage::Setup,
         Stage::FlyCah,
         Stage::FlyStandard,
         Stage::FlyNoise,
         Stage::FlyVerification,
+        Stage::FlySteady,
         Stage::Frf,
         Stage::TrimPoints,
         Stage::Fit6Dof,
@@ -60,6 +64,7 @@ impl Stage {
             Stage::FlyStandard => "fly_standard",
             Stage::FlyNoise => "fly_noise",
             Stage::FlyVerification => "fly_verification",
+            Stage::FlySteady => "fly_steady",
             Stage::Frf => "frf",
             Stage::TrimPoints => "trim_points",
             Stage::Fit6Dof => "fit_6dof",
@@ -79,6 +84,7 @@ impl Stage {
             Stage::FlyStandard => "flying the sweeps, standard attitude hold",
             Stage::FlyNoise => "flying the sweeps, hold plus off-axis noise",
             Stage::FlyVerification => "flying the held-out doublets",
+            Stage::FlySteady => "flying the steady flights (board-sim)",
             Stage::Frf => "frequency responses of the cah records",
             Stage::TrimPoints => "trim points (steady flights)",
             Stage::Fit6Dof => "6-DOF quasi-steady fit (start values)",

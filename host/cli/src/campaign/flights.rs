@@ -189,6 +189,26 @@ impl Campaign<'_> {
 }
 
 impl Campaign<'_> {
+    /// The steady flights' stage (`--fc board-sim`): `fly --steady-flights` with the
+    /// flight's settings into `fly-steady/` (the board's log and `gnss.csv`).
+    pub(super) fn fly_steady(&mut self) -> anyhow::Result<((), String)> {
+        let mut args = self.fly_args(
+            ModeArg::Cah,
+            InputArg::Sweep,
+            self.args.seed,
+            files::STEADY_FOLDER,
+        )?;
+        args.steady_flights = true;
+        let fixes = fly::fly_steady_flights(&args, &args.out)?;
+        Ok((
+            (),
+            format!(
+                "{} steady flights, {fixes} GNSS fixes",
+                crate::sim::TRIM_FLIGHTS.len()
+            ),
+        ))
+    }
+
     /// Fly `args` on the campaign's flight controller (`--fc`).
     fn fly(&self, args: &FlyArgs) -> anyhow::Result<FlyOutcome> {
         match self.args.fc {

@@ -395,6 +395,9 @@ pub fn campaign(args: &CampaignArgs) -> Result<CampaignOutcome, CampaignError> {
         .stage(Stage::FlyNoise, |run| run.fly_sweeps(ModeArg::Noise))?
         .lateral_only();
     let doublets = run.stage(Stage::FlyVerification, Campaign::fly_doublets)?;
+    if matches!(args.fc, CampaignLink::BoardSim(_)) {
+        run.stage(Stage::FlySteady, Campaign::fly_steady)?;
+    }
     // The report's sweep time history, before the frequency responses take the records.
     let sweep = cah.lateral().next().cloned();
     let frf = run.stage(Stage::Frf, |run| {

@@ -226,6 +226,13 @@ pub struct FlyArgs {
     /// mode ends the power-up: the next one starts another) [default: per-record].
     #[arg(long = "power-up", value_enum, value_name = "HOW")]
     pub power_up: Option<PowerUpArg>,
+    /// `--fc board-sim`: fly no test but the steady flights of `sim trim-points` (hover,
+    /// 1 m/s forward, aft, right, left, 0.5 m/s climb and descent, ±0.1 rad/s turns), each
+    /// 8 s to settle and 10 s held, in the pilot mode on one power-up with the flight's
+    /// --seed and --gust; writes the board's log `log/power-up-1.bin` and the simulated
+    /// GNSS's `gnss.csv` (10 Hz, 0.1 m/s white noise per velocity; docs/formats.md).
+    #[arg(long = "steady-flights")]
+    pub steady_flights: bool,
 }
 
 /// `--power-up` on the command line.
@@ -419,6 +426,7 @@ impl FlyArgs {
                 ("--imu-fault", self.imu_fault.is_some()),
                 ("--fly-on", self.fly_on_s.is_some()),
                 ("--power-up", self.power_up.is_some()),
+                ("--steady-flights", self.steady_flights),
             ];
             if let Some((flag, _)) = board_only.iter().find(|(_, given)| *given) {
                 bail!("{flag} is for --fc board-sim only");
@@ -429,6 +437,20 @@ impl FlyArgs {
                  200, 250, 500 or 1000), not {}",
                 self.rate_hz
             );
+        }
+        if self.steady_flights {
+            let timed = [
+                ("--rc-loss", self.rc_loss_at_s.is_some()),
+                ("--fly-on", self.fly_on_s.is_some()),
+                ("--pilot-override", self.pilot_override_at_s.is_some()),
+                (
+                    "--imu-fault KIND@AT_S",
+                    self.imu_fault.is_some_and(|f| f.at_s.is_some()),
+                ),
+            ];
+            if let Some((flag, _)) = timed.iter().find(|(_, given)| *given) {
+                bail!("{flag} counts record time: --steady-flights flies no record");
+            }
         }
         if let Some(t) = self.rc_loss_at_s {
             if !t.is_finite() || t < 0.0 {

@@ -73,6 +73,9 @@ pub struct FlyOutcome {
 /// only when every record was written (see [`crate::output::StagedFolder`]).
 pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
     validate(args)?;
+    if args.steady_flights {
+        return run_steady_flights(args);
+    }
     // The board image is found (and checked) before anything is written.
     let image = match (&args.fc, &args.elf) {
         (FcArg::Qemu | FcArg::QemuUsart, elf) => {
@@ -151,6 +154,67 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The simulated GNSS's file in the output folder of `fly --steady-flights`.
+pub const GNSS_FILE: &str = "gnss.csv";
+
+/// `fly --steady-flights`: the steady flights into `OUT.partial`, swapped in when done.
+fn run_steady_flights(args: &FlyArgs) -> anyhow::Result<()> {
+    let staged = StagedFolder::begin(&args.out)?;
+    match fly_steady_flights(args, staged.path()) {
+        Ok(fixes) => {
+            staged.complete()?;
+            if !args.quiet {
+                crate::note!(
+                    "wrote {}/{} and {GNSS_FILE} ({fixes} fixes) to {}",
+                    link_board_sim::LOG_FOLDER,
+                    link_board_sim::power_up_log_name(1),
+                    args.out.display()
+                );
+            }
+            Ok(())
+        }
+        Err(error) => {
+            let kept = match staged.fail() {
+                Ok(failed) => format!("its files are in {}", failed.display()),
+                Err(e) => format!("{e:#}"),
+            };
+            Err(error.context(format!(
+                "fly failed ({kept}; {} is unchanged)",
+                args.out.display()
+            )))
+        }
+    }
+}
+
+/// Fly the steady flights of `sim trim-points` on the board-sim link set up for `args`
+/// (the first record's configuration powers it up) and write the board's log and the
+/// GNSS file into `folder`; returns the number of fixes.
+pub fn fly_steady_flights(args: &FlyArgs, folder: &std::path::Path) -> anyhow::Result<usize> {
+    let settings = board_sim_settings(args)?;
+    let plans = args.plans();
+    let plan = plans
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("no record to power the board up for"))?;
+    let config = record_config(&args.vehicle, plan, args.rate_hz);
+    let flights = link_board_sim::fly_steady_flights(
+        &settings,
+        &config,
+        &crate::sim::TRIM_FLIGHTS,
+        args.gust,
+    )?;
+    let logs = folder.join(link_board_sim::LOG_FOLDER);
+    std::fs::create_dir_all(&logs).with_context(|| format!("cannot create {}", logs.display()))?;
+    write_atomic(
+        &logs.join(link_board_sim::power_up_log_name(1)),
+        &flights.log,
+    )?;
+    write_atomic(
+        &folder.join(GNSS_FILE),
+        sysid::steady::gnss_csv(&flights.fixes).as_bytes(),
+    )?;
+    Ok(flights.fixes.len())
 }
 
 /// Fly `args` into `args.out` over the link `args.fc` names.

@@ -8,11 +8,13 @@
 //!
 //! The stages are the campaign's own ([`stages`]: `campaign` runs them on what it flew):
 //! one pipeline. Where the campaign asks the simulator — its steady flights for the trim
-//! points — identify takes a file (`--trim-points`) or, without one, fits the hybrid's
-//! `trim_derived` parameters like the others and says so in `summary.json`. Nothing in
+//! points — identify takes a file (`--trim-points`), the steady flights of a log with a
+//! GNSS file ([`flight_trim`]), or, without either, fits the hybrid's `trim_derived`
+//! parameters like the others and flags it in `summary.json` and the report. Nothing in
 //! this folder imports the simulator (`rotorsim`) or its truth (`truth`); CI checks it
 //! (`cargo xtask import-cycles`).
 
+pub mod flight_trim;
 pub mod stages;
 
 use std::collections::BTreeMap;
@@ -45,7 +47,8 @@ for the dumps (*.bin) directly in it. Sweep tests give the frequency responses (
 order lat, lon, ped, col, each axis's tests in the order given), every other test (doublet, \
 3-2-1-1) is held out for the verification (in the same order). Aborted tests and tests cut off by the end of \
 a file are left out unless --include-aborted. Writes into DIR: frf.json, model6.json, \
-model9.json, verify.json (when there are held-out tests), summary.json (layout in \
+model9.json, verify.json (when there are held-out tests), trim-points.csv (with \
+--steady-flights), summary.json (layout in \
 docs/formats.md) and last report.html, drawn from these files alone (`sweephold report DIR` \
 redraws it byte for byte). The run is built in DIR.partial and replaces DIR only when it completes; \
 a failing stage leaves DIR as it was, keeps the failed run's files in DIR.failed and exits \
@@ -70,8 +73,18 @@ pub struct IdentifyArgs {
     /// Trim points (`trim-points.csv`, as `fit --trim-points` reads them) to derive the
     /// hybrid's `trim_derived` parameters from; without them they are fitted like the
     /// others.
-    #[arg(long, value_name = "CSV")]
+    #[arg(long, value_name = "CSV", conflicts_with = "steady_flights")]
     pub trim_points: Option<PathBuf>,
+    /// A log holding steady flights (`fly --fc board-sim --steady-flights`, or a pilot's):
+    /// its steady segments (the rule in docs/cli.md), with the velocities of --gnss, are
+    /// averaged into trim points, written as DIR/trim-points.csv with their standard
+    /// errors and used as --trim-points is.
+    #[arg(long, value_name = "LOG", requires = "gnss")]
+    pub steady_flights: Option<PathBuf>,
+    /// The GNSS velocities and heading of the --steady-flights log, on its clock
+    /// (`gnss.csv`, docs/formats.md).
+    #[arg(long, value_name = "CSV", requires = "steady_flights")]
+    pub gnss: Option<PathBuf>,
     /// How the trim points enter the 9-DOF fit (as `fit --trim-balance`); default the
     /// aircraft file's `identification.trim_balance`.
     #[arg(long, value_enum, value_name = "HOW")]
@@ -320,6 +333,8 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
     let mut inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
     inputs.extend(dumps.iter().map(PathBuf::as_path));
     inputs.extend(args.trim_points.as_deref());
+    inputs.extend(args.steady_flights.as_deref());
+    inputs.extend(args.gnss.as_deref());
     refuse_inputs_as_outputs(&inputs, &[("--out", &args.out)])?;
     let mut summary = IdentifySummary {
         vehicle: args.vehicle.name().to_string(),
@@ -329,6 +344,9 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
         held_out: Vec::new(),
         captured_trim_rad: None,
         trim_points: args.trim_points.as_ref().map(|p| p.display().to_string()),
+        trim_points_source: "none".to_string(),
+        steady_segments: Vec::new(),
+        hover_derivatives_unanchored: false,
         notes: Vec::new(),
         fit: None,
         verify: None,
@@ -336,16 +354,40 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
         error: None,
     };
     let tests = read_tests(&dumps, args.include_aborted, &mut summary)?;
-    let trim_points = read_trim_points(args.trim_points.as_deref())?;
+    let mut trim_points = read_trim_points(args.trim_points.as_deref())?;
+    let mut flight_csv = None;
+    if trim_points.is_some() {
+        summary.trim_points_source = "file".to_string();
+    }
+    if let (Some(log), Some(gnss)) = (&args.steady_flights, &args.gnss) {
+        let rate_hz = tests.sweeps[0].sample_rate_hz;
+        let flight = flight_trim::flight_trim_points(log, gnss, rate_hz)?;
+        summary.trim_points_source = "flight".to_string();
+        summary.trim_points = Some(files::TRIM_POINTS.to_string());
+        summary.steady_segments = flight.segments;
+        trim_points = Some(flight.points);
+        flight_csv = Some(flight.csv);
+    }
     if !args.quiet {
         for listing in &summary.tests {
             crate::note!("{}", listing.line());
         }
+        if !summary.steady_segments.is_empty() {
+            crate::note!(
+                "trim points: {} steady segments of {}",
+                summary.steady_segments.len(),
+                args.steady_flights
+                    .as_deref()
+                    .map_or(String::new(), |p| p.display().to_string())
+            );
+        }
     }
     if trim_points.is_none() {
+        summary.hover_derivatives_unanchored = true;
         summary.notes.push(
-            "no trim points (--trim-points): the hybrid's trim_derived parameters are fitted \
-             like the others"
+            "no trim points (--trim-points) and no steady flights with a velocity source \
+             (--steady-flights with --gnss): the hybrid's trim_derived parameters (the hover \
+             derivatives) are fitted like the others, unanchored"
                 .to_string(),
         );
     }
@@ -360,6 +402,9 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
         started: Instant::now(),
         staged: Some(StagedFolder::begin(&args.out)?),
     };
+    if let Some(csv) = &flight_csv {
+        crate::output::write_atomic(&run.dir().join(files::TRIM_POINTS), csv.as_bytes())?;
+    }
     let Tests {
         sweeps,
         held_out,

@@ -44,6 +44,7 @@ mod signals;
 mod stderr_full;
 #[cfg(target_os = "linux")]
 mod stdout;
+mod steady_flights;
 mod structures_ticks;
 mod test_list;
 mod trim_points;

@@ -110,6 +110,7 @@
 mod board;
 mod power_up;
 mod settings;
+mod steady;
 
 use std::path::Path;
 
@@ -124,6 +125,10 @@ use anyhow::Context;
 use board::Board;
 pub use settings::{
     BoardSetup, BoardSimSettings, PowerUp, BETWEEN_TESTS_S, FRAME_PERIOD_US, HOVER_THROTTLE,
+};
+pub use steady::{
+    fly_steady_flights, SteadyCondition, SteadyFlights, GNSS_RATE_HZ, GNSS_VELOCITY_NOISE_M_S,
+    HOLD_S, SETTLE_S,
 };
 
 /// The board application on emulated devices. See the [module documentation](self).

@@ -333,6 +333,6 @@ pub(super) const NOT_IN_THE_LIST: &str =
 
 /// The seed of the emulated devices (the IMU's imperfections, the gimbal hover's
 /// simulator) of a board whose flight's noise seed is `test_seed`.
-fn devices_seed(test_seed: u32) -> u64 {
+pub(super) fn devices_seed(test_seed: u32) -> u64 {
     0xB0A2_D51A_u64 ^ u64::from(test_seed).rotate_left(23)
 }

@@ -19,9 +19,13 @@ over the sweep tests, φ0 = {:.2}°, θ0 = {:.2}°",
         ),
         None => "the structure is written about its file's trim".to_string(),
     };
-    let trim_points = match &s.trim_points {
-        Some(file) => format!("trim points from {file}"),
-        None => "no trim points".to_string(),
+    let trim_points = match (&s.trim_points, s.trim_points_source.as_str()) {
+        (Some(file), "flight") => format!(
+            "trim points from the flight: {} steady segments, written to {file}",
+            s.steady_segments.len()
+        ),
+        (Some(file), _) => format!("trim points from {file}"),
+        (None, _) => "no trim points".to_string(),
     };
     let mut content = note(&format!(
         "Aircraft {}, fit seed {}; {trim}; {trim_points}. Green: the bar is met; red: it \
@@ -35,6 +39,11 @@ redraws it).",
             escape(&error.stage),
             escape(&error.message)
         );
+    }
+    if s.hover_derivatives_unanchored {
+        content += "<p class=\"note\"><strong>Hover derivatives not anchored: no velocity \
+source (no trim points, no GNSS), so the speed derivatives are fitted from the frequency \
+responses alone, which barely inform them; the hover modes are not to be trusted.</strong></p>\n";
     }
     for text in &s.notes {
         content += &note(&format!("Note: {text}."));

@@ -47,7 +47,8 @@ pub struct TrimPoints {
 
 impl TrimPoints {
     /// Parse the CSV form: a header naming the columns (`label` optional, then every one
-    /// of [`STATE_COLUMNS`] and [`CONTROL_COLUMNS`], in any order), one point per line;
+    /// of [`STATE_COLUMNS`] and [`CONTROL_COLUMNS`], in any order, and optionally the
+    /// annotations `identify --gnss` writes, which are not read), one point per line;
     /// blank lines and lines starting with `#` are skipped. Every number must be finite.
     pub fn parse_csv(text: &str) -> Result<TrimPoints, TrimError> {
         let mut lines = text
@@ -64,7 +65,10 @@ impl TrimPoints {
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
         let column = |name: &str| names.iter().position(|n| *n == name);
         for name in &names {
-            if *name != "label" && !STATE_COLUMNS.contains(name) && !CONTROL_COLUMNS.contains(name)
+            if *name != "label"
+                && !STATE_COLUMNS.contains(name)
+                && !CONTROL_COLUMNS.contains(name)
+                && !is_annotation(name)
             {
                 return Err(TrimError::Csv {
                     line: header_line,
@@ -172,6 +176,17 @@ impl TrimPoints {
         }
         out
     }
+}
+
+/// Columns a trim-point file may carry beside the point (`identify --gnss` writes them,
+/// the fit reads past them): a column's standard error (`u_se` … `col_se`) and the ticks
+/// of the log's stretch the point was averaged over (`first_tick`, `last_tick`).
+fn is_annotation(name: &str) -> bool {
+    name == "first_tick"
+        || name == "last_tick"
+        || name.strip_suffix("_se").is_some_and(|column| {
+            STATE_COLUMNS.contains(&column) || CONTROL_COLUMNS.contains(&column)
+        })
 }
 
 /// Refuse a point outside [`PLAUSIBLE_RANGES`], naming the column, its value and the range.
