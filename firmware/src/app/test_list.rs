@@ -214,6 +214,24 @@ impl TestList {
         }
     }
 
+    /// The loop tests of `vehicle`'s preset ([`InputKind::LoopSweep`]): the roll (lat),
+    /// pitch (lon) and yaw/heading (ped) loops broken at their actuator input, in
+    /// entries 1, 2, 3, each a 90 s sweep at 5 % of stick travel on the campaign's first
+    /// band (it holds the rate loops' crossovers and phase crossovers). Three slices.
+    pub const fn loop_tests(vehicle: VehicleId) -> TestList {
+        let (bands, pulse_width_s) = match vehicle {
+            VehicleId::Bo105 => (BO105_BANDS, 1.0),
+            VehicleId::Trex700l => (TREX700L_BANDS, 0.3),
+        };
+        let [first, _] = bands;
+        let w = pulse_width_s;
+        let mut entries = [TestEntry::EMPTY; TEST_LIST_LEN];
+        entries[0] = entry(Axis::Lat, InputKind::LoopSweep, first, w);
+        entries[1] = entry(Axis::Lon, InputKind::LoopSweep, first, w);
+        entries[2] = entry(Axis::Ped, InputKind::LoopSweep, first, w);
+        TestList { entries, slices: 3 }
+    }
+
     /// The entry (1 … `slices`) the selector at position `position` ∈ [−1, 1] selects;
     /// a non-finite position selects nothing.
     pub fn entry_at(&self, position: f32) -> Option<u8> {

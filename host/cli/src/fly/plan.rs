@@ -68,7 +68,7 @@ pub fn plan_records(
     for &axis in axes {
         let bands: &[(f64, f64)] = match input {
             InputKind::Sweep | InputKind::AdaptiveSweep => bands,
-            InputKind::Doublet | InputKind::ThreeTwoOneOne => &bands[..1],
+            InputKind::Doublet | InputKind::ThreeTwoOneOne | InputKind::LoopSweep => &bands[..1],
         };
         for (n, &(omega_min, omega_max)) in bands.iter().enumerate() {
             let index = n as u32 + 1;
