@@ -7,7 +7,11 @@
 //! From each Sample of the test's excitation (plus the trim either side that every
 //! excitation record keeps): the total command u = `command` of the swept axis (what the
 //! servos' pulses express), the injection d = its `sweep`, and the loops' own output
-//! c = u − d. The coherence threshold for a valid point is the frequency responses' 0.6.
+//! c = u − d. A valid point has the frequency responses' coherence threshold 0.6 and lies
+//! where the windows resolve it without bias (five times the lowest frequency the longest
+//! window resolves, `sysid::frf::broken_loop::RESOLVED_PERIODS`): a gain-reduction margin
+//! at the band's bottom (a conditionally stable loop's low-frequency −180° crossing) is
+//! not measured.
 //!
 //! The board-sim pilot flies the mode switch in the middle (Level) with the pedal
 //! centred (heading hold), so a loop test measures the loops `sweephold margins`
@@ -53,8 +57,12 @@ pub struct MeasuredLoop {
     pub broken_at: &'static str,
     /// The sweep band [rad/s].
     pub band_rad_s: [f64; 2],
-    /// Points with coherence ≥ [`COHERENCE_THRESHOLD`], of all.
+    /// Points with coherence ≥ [`COHERENCE_THRESHOLD`] at or above `resolved_from_rad_s`,
+    /// of all.
     pub valid_points: usize,
+    /// The lowest frequency used: five times the lowest the longest window resolves
+    /// (`sysid::frf::broken_loop::RESOLVED_PERIODS`) [rad/s].
+    pub resolved_from_rad_s: f64,
     /// Grid points.
     pub points: usize,
     /// Gain crossover of the phase margin reported [rad/s].
@@ -82,7 +90,8 @@ pub struct MeasuredResponse {
     pub coherence: Vec<f64>,
 }
 
-/// The margins of `measured` on its points of coherence ≥ `threshold`.
+/// The margins of `measured` on its points of coherence ≥ `threshold` at or above the
+/// frequency its windows resolve without bias (`resolved_from_rad_s`).
 pub fn valid_margins(measured: &BrokenLoop, threshold: f64) -> (Margins, usize) {
     let mut valid = Sampled {
         omega: Vec::new(),
@@ -94,7 +103,11 @@ pub fn valid_margins(measured: &BrokenLoop, threshold: f64) -> (Margins, usize) 
         .zip(&measured.values)
         .zip(&measured.coherence)
     {
-        if *g >= threshold && l.re.is_finite() && l.im.is_finite() {
+        if *g >= threshold
+            && *w >= measured.resolved_from_rad_s
+            && l.re.is_finite()
+            && l.im.is_finite()
+        {
             valid.omega.push(*w);
             valid.values.push(*l);
         }
@@ -157,6 +170,7 @@ pub fn measure(path: &Path) -> anyhow::Result<MeasuredLoop> {
         broken_at: axis.name(),
         band_rad_s: band,
         valid_points,
+        resolved_from_rad_s: measured.resolved_from_rad_s,
         points: measured.omega.len(),
         crossover_rad_s: figures.crossover_rad_s,
         phase_margin_deg: figures.phase_margin_deg,
@@ -352,12 +366,10 @@ mod tests {
             .zip(&measured.values)
             .zip(&measured.coherence)
         {
-            // The band's ends are left out. At the bottom the longest window (half the
-            // record) holds a few periods only and its Hann main lobe (±4π/T) spans a
-            // large part of the frequency, which biases the ratio of two fast-changing
-            // spectra (measured: −2.3 dB, −18° at 0.5 rad/s; within 0.2 dB, 2° from
-            // 1.5 rad/s); at the top the sweep fades out (7.6° at 58.6 of 60 rad/s).
-            if *g < 0.9 || !(1.5..=50.0).contains(w) {
+            // Below `resolved_from_rad_s` the windows' resolution biases the estimate
+            // (−2.3 dB, −18° at 0.5 rad/s here); at the top the sweep fades out (7.6° at
+            // 58.6 of 60 rad/s).
+            if *g < 0.9 || *w < measured.resolved_from_rad_s || *w > 50.0 {
                 continue;
             }
             compared += 1;
@@ -370,6 +382,11 @@ mod tests {
             );
         }
         assert!(compared > 100, "{compared} points of coherence ≥ 0.9");
+        assert!(
+            measured.resolved_from_rad_s < 1.5,
+            "{}",
+            measured.resolved_from_rad_s
+        );
         let grid = control::loops::log_grid(band[0], band[1], 2400);
         let truth = exact_margins(&Sampled {
             values: grid.iter().map(|w| exact(*w)).collect(),

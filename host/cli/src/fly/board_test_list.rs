@@ -53,11 +53,11 @@ pub fn campaign_list(vehicle: &Vehicle, t_rec_s: f64) -> TestList {
 }
 
 /// The test list of a loop-test flight (`fly --input loop`) of `vehicle` with records of
-/// `t_rec_s`: entries 1, 2, 3 the loop tests of lat, lon and ped on the file's first
-/// band, the rest empty, three slices (the firmware's `TestList::loop_tests` with the
-/// file's band and the flight's record length).
+/// `t_rec_s`: entries 1, 2, 3 the loop tests of lat, lon and ped on the loop-test band of
+/// the file's first band ([`super::plan::loop_test_band`]), the rest empty, three slices
+/// (the firmware's `TestList::loop_tests` with that band and the flight's record length).
 pub fn loop_list(vehicle: &Vehicle, t_rec_s: f64) -> TestList {
-    let [(omega_min, omega_max), _] = vehicle.sweep_bands();
+    let (omega_min, omega_max) = super::plan::loop_test_band(&vehicle.sweep_bands());
     let mut list = TestList::loop_tests(vehicle.preset());
     for entry in list.entries.iter_mut().filter(|entry| !entry.is_empty()) {
         entry.omega_min = omega_min as f32;
