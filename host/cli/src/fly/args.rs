@@ -54,9 +54,9 @@ pub enum InputArg {
     /// A 3-2-1-1 multistep (one record per axis).
     #[value(name = "3211")]
     ThreeTwoOneOne,
-    /// A loop test (one record per axis, on the first band; `--fc board-sim` only, axes
-    /// lat, lon, ped): the sweep added at the pilot-mode loop's output with the board's
-    /// loops closed, for `sweephold loop` (docs/board-application.md, "Loop tests").
+    /// A loop test (one record per axis, from the first band's lower end to at least
+    /// 62.8 rad/s; the board-sim link only, axes lat, lon, ped): the sweep added at the
+    /// pilot-mode loop's output with the board's loops closed, for `margins --measured`.
     Loop,
 }
 
