@@ -145,6 +145,9 @@ pub enum ConfigError {
     SlewInvalid,
     /// An excitation scale outside (0, 1] (see `ExcitationScale::is_valid`).
     ExcitationScaleInvalid,
+    /// A loop test ([`InputKind::LoopSweep`]) on the collective, which has no pilot-mode
+    /// loop to break.
+    LoopOnCollective,
 }
 
 impl ConfigError {
@@ -172,6 +175,7 @@ impl ConfigError {
             ConfigError::AdaptiveAmplitudeInvalid => "adaptive amplitude settings invalid",
             ConfigError::SlewInvalid => "command slew limits must be positive",
             ConfigError::ExcitationScaleInvalid => "excitation scales must lie in (0, 1]",
+            ConfigError::LoopOnCollective => "no loop test on col",
         }
     }
 }
@@ -381,6 +385,9 @@ impl Config {
         }
         if !self.excitation_scale.is_valid() {
             return Err(ConfigError::ExcitationScaleInvalid);
+        }
+        if test.input.is_loop() && test.primary == Axis::Col {
+            return Err(ConfigError::LoopOnCollective);
         }
         // Record-length rule T_rec ≥ 4·T_max, T_max = 2π/ω_min: shorter is flown, flagged.
         let longest_period = core::f32::consts::TAU / sweep.omega_min;

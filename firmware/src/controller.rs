@@ -233,6 +233,9 @@ pub struct FlightController {
     switch_was_on: bool,
     /// Last finite stick values, for pass-through of a non-finite stick.
     last_finite_pilot: [f32; 4],
+    /// This tick's pilot-mode loop command in a loop test (see
+    /// [`FlightController::set_loop_command`]); taken by the tick's step.
+    loop_command: Option<[f32; 4]>,
 }
 
 impl FlightController {
@@ -294,6 +297,7 @@ impl FlightController {
             axes: [HeldAxis::RELEASED; 3],
             switch_was_on: false,
             last_finite_pilot: [0.0; 4],
+            loop_command: None,
             config,
         })
     }
@@ -363,6 +367,7 @@ impl FlightController {
         let tick = self.tick;
         let unchanged_seq_ticks = self.stale.observe(input.seq);
         let pilot = self.sanitize_pilot(&input.pilot.sticks);
+        let pilot = self.loop_or_pilot(pilot);
         let switch_on = input.pilot.test_switch;
         let switch_rising = switch_on && !self.switch_was_on;
         self.switch_was_on = switch_on;

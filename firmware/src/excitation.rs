@@ -21,14 +21,16 @@ impl Excitation {
     pub fn from_test(test: &TestConfig) -> Self {
         let fade_s = f64::from(test.sweep.fade_s);
         match test.input {
-            InputKind::Sweep | InputKind::AdaptiveSweep => Excitation::Sweep(SweepSignal::new(
-                test.sweep.amplitude,
-                f64::from(test.sweep.omega_min),
-                f64::from(test.sweep.omega_max),
-                f64::from(test.sweep.t_rec_s),
-                fade_s,
-                test.sweep.start_hold_cycles,
-            )),
+            InputKind::Sweep | InputKind::AdaptiveSweep | InputKind::LoopSweep => {
+                Excitation::Sweep(SweepSignal::new(
+                    test.sweep.amplitude,
+                    f64::from(test.sweep.omega_min),
+                    f64::from(test.sweep.omega_max),
+                    f64::from(test.sweep.t_rec_s),
+                    fade_s,
+                    test.sweep.start_hold_cycles,
+                ))
+            }
             InputKind::Doublet => Excitation::Pulse(PulseSignal::new(
                 PulsePattern::Doublet,
                 test.pulse.amplitude,

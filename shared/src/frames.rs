@@ -48,19 +48,22 @@ pub struct ProtocolVersion {
 /// abort reason [`AbortReason::Landed`] and the refusal [`RefusedCheck::NotAirborne`];
 /// 1.7 the Header's [`Header::selection`] (the test list entry and the engagement count),
 /// the refusal [`RefusedCheck::NoTestSelected`] and [`Frame::MeasurementFilter`]; 1.8 the
-/// bench servo test ([`Frame::ServoTest`], [`Frame::ServoTestReply`]).
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 8 };
+/// bench servo test ([`Frame::ServoTest`], [`Frame::ServoTestReply`]); 1.9 the loop test
+/// [`InputKind::LoopSweep`].
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 9 };
 
 impl ProtocolVersion {
     /// The version a [`Header`] of `test` announces: the oldest one whose decoders read
     /// everything the test streams. A test that uses nothing added since 1.2 announces
     /// 1.2, so its dumps are byte for byte those of a 1.2 flight controller and every
-    /// 1.2 host reads them whole; [`InputKind::AdaptiveSweep`] needs 1.3. A board
+    /// 1.2 host reads them whole; [`InputKind::AdaptiveSweep`] needs 1.3 and
+    /// [`InputKind::LoopSweep`] 1.9. A board
     /// application's stream also carries the 1.4 events: it announces
     /// [`ProtocolVersion::BOARD_APPLICATION`] whatever its test.
     pub const fn for_test(test: &TestConfig) -> ProtocolVersion {
         match test.input {
             InputKind::AdaptiveSweep => ProtocolVersion { major: 1, minor: 3 },
+            InputKind::LoopSweep => ProtocolVersion { major: 1, minor: 9 },
             InputKind::Sweep | InputKind::Doublet | InputKind::ThreeTwoOneOne => {
                 ProtocolVersion { major: 1, minor: 2 }
             }

@@ -109,12 +109,27 @@ pub enum InputKind {
     /// rate envelope of its last cycle, around A (the firmware's `amplitude` module).
     /// Since protocol 1.3.
     AdaptiveSweep,
+    /// A loop test: the same exponential sweep added to the board's pilot-mode loop of
+    /// the primary axis at its output (the loop's actuator command), the pilot-mode
+    /// loops closed on every axis; no off-axis noise, no attitude hold. `command` −
+    /// `sweep` of each Sample is then the loops' own output, and the broken-loop
+    /// response at the actuator is −(command − sweep)/command (docs/formats.md, "Loop
+    /// tests"). Since protocol 1.9; flown by the board application only.
+    LoopSweep,
 }
 
 impl InputKind {
-    /// Whether the input is a frequency sweep (fixed or adaptive amplitude).
+    /// Whether the input is a frequency sweep (fixed or adaptive amplitude, or a loop test).
     pub const fn is_sweep(self) -> bool {
-        matches!(self, InputKind::Sweep | InputKind::AdaptiveSweep)
+        matches!(
+            self,
+            InputKind::Sweep | InputKind::AdaptiveSweep | InputKind::LoopSweep
+        )
+    }
+
+    /// Whether the input is a loop test ([`InputKind::LoopSweep`]).
+    pub const fn is_loop(self) -> bool {
+        matches!(self, InputKind::LoopSweep)
     }
 }
 

@@ -99,6 +99,26 @@ fn adaptive_sweep_is_appended_and_announced_only_when_used() {
     assert!(test.input.is_sweep());
 }
 
+/// Protocol 1.9 appended the loop test's input kind (index 4): a Header of a loop test
+/// announces 1.9, every other test's announcement stays as it was.
+#[test]
+fn protocol_1_9_appends_the_loop_sweep() {
+    use sweephold_protocol::{InputKind, ProtocolVersion};
+    let encoded = |kind: InputKind| {
+        let mut buffer = [0u8; 4];
+        postcard::to_slice(&kind, &mut buffer).unwrap().to_vec()
+    };
+    assert_eq!(encoded(InputKind::LoopSweep), [4]);
+    let mut test = sweephold_protocol::synthetic::header().test;
+    test.input = InputKind::LoopSweep;
+    assert_eq!(
+        ProtocolVersion::for_test(&test),
+        ProtocolVersion { major: 1, minor: 9 }
+    );
+    assert!(test.input.is_sweep() && test.input.is_loop());
+    assert!(!InputKind::Sweep.is_loop());
+}
+
 /// Protocol 1.4 appended the board application's events after `Abort` (variant 4): the
 /// older events keep their encoding, the new ones take indices 5–8, and a board
 /// application announces 1.4 whatever its test.

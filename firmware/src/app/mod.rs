@@ -181,6 +181,9 @@ pub struct BoardApp {
     pulse_inverse: PulseInverse,
     /// The pilot cue shown and since when.
     cues: CueTracker,
+    /// The pilot-mode loops' own command of the last tick of a loop test (the applied
+    /// one holds the sweep too); `None` outside one.
+    loop_output: Option<Controls>,
 }
 
 /// Ticks in `seconds` at `dt_s`, at least one.
@@ -234,6 +237,7 @@ impl BoardApp {
             engagements: 0,
             pulse_inverse: PulseInverse::new(&config.flight.mixer),
             cues: CueTracker::default(),
+            loop_output: None,
             fc,
             config,
         })

@@ -15,14 +15,17 @@ impl BoardApp {
             rates: imu.rates,
             attitude: imu.attitude,
         };
+        // The loops' own command of the tick before, kept only from one loop-test tick
+        // to the next.
+        let loops_last = self.loop_output.take();
         match self.mode {
             Mode::Disarmed => (SAFE_COMMAND, None, false),
             Mode::Pilot => {
-                let (command, mode) = self.fly_loops(rc, &sensors, integrate);
+                let (command, mode) = self.fly_loops(rc, &sensors, integrate, self.last_command);
                 (command, Some(mode), false)
             }
             Mode::RcFailsafe => {
-                let (command, mode) = self.fly_loops(None, &sensors, integrate);
+                let (command, mode) = self.fly_loops(None, &sensors, integrate, self.last_command);
                 (command, Some(mode), false)
             }
             Mode::ImuFailsafe => {
@@ -42,7 +45,25 @@ impl BoardApp {
             Mode::Test => {
                 let phase = self.fc.phase();
                 let test_switch = rc.is_some_and(|frame| frame.test_switch);
-                if is_excitation(phase) {
+                // A loop test keeps the loops flying through its excitation; the
+                // sequencer adds the sweep to their command (`FlightController::
+                // set_loop_command`) and is fed the pilot's sticks for its override check.
+                let loop_test = self.fc.config().test.input.is_loop();
+                let excitation = is_excitation(phase);
+                // The tail's slew limit runs from the loops' own last command in a loop
+                // test, not from the applied one: the sweep added after the loop must not
+                // reach the loop's output other than through the aircraft.
+                let last = match loops_last {
+                    Some(own) if loop_test => own,
+                    _ => self.last_command,
+                };
+                let loops = (loop_test || !excitation)
+                    .then(|| self.fly_loops(rc, &sensors, integrate, last));
+                if let Some((command, _)) = loops.filter(|_| loop_test) {
+                    self.fc.set_loop_command(command);
+                    self.loop_output = Some(command);
+                }
+                if excitation {
                     let [t_lat, t_lon, t_ped, t_col] = self.fc.trim().sticks;
                     let trim = [t_lat, t_lon, t_ped, t_col];
                     let raw = rc.map_or(trim, |frame| frame.sticks.to_array());
@@ -53,14 +74,18 @@ impl BoardApp {
                     {
                         *feed = clamp_finite(trim + (raw - reference), 1.0);
                     }
-                    (Controls::from_array(feed), None, test_switch)
+                    (
+                        Controls::from_array(feed),
+                        loops.map(|(_, mode)| mode),
+                        test_switch,
+                    )
                 } else {
                     if matches!(phase, Phase::Armed | Phase::TrimCapture) {
                         if let Some(frame) = rc {
                             self.stick_reference.add(&frame.sticks);
                         }
                     }
-                    let (command, mode) = self.fly_loops(rc, &sensors, integrate);
+                    let (command, mode) = loops.unwrap_or((self.last_command, StickMode::Rate));
                     (command, Some(mode), test_switch)
                 }
             }
@@ -69,12 +94,14 @@ impl BoardApp {
 
     /// One step of the pilot-mode loops: on the pilot's sticks (`rc`), or, without
     /// them, the receiver failsafe's demand (trim attitude, heading held, held
-    /// collective).
+    /// collective). `last` is the command the tail's slew limit and a preload start
+    /// from.
     fn fly_loops(
         &mut self,
         rc: Option<&RcInput>,
         sensors: &LoopSensors,
         integrate: bool,
+        last: Controls,
     ) -> (Controls, StickMode) {
         let gains = &self.config.pilot;
         let (demand, mode) = match rc {
@@ -123,7 +150,7 @@ impl BoardApp {
             &self.factors,
             &demand,
             sensors,
-            &self.last_command,
+            &last,
             integrate,
             self.preload,
         );

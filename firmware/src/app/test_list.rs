@@ -163,6 +163,11 @@ pub struct TestList {
 const BO105_BANDS: [(f32, f32); 2] = [(0.2, 31.4), (0.01, 18.85)];
 const TREX700L_BANDS: [(f32, f32); 2] = [(0.2, 62.8), (0.01, 18.85)];
 
+/// Top of a loop test's band \[rad/s\]: above the phase crossovers of the presets' loops
+/// (predicted 18–45 rad/s on the identified models; the Bo-105's heading loop at 42 rad/s,
+/// past its campaign band's 31.4, where a loop test on that band measured no gain margin).
+pub const LOOP_TEST_OMEGA_MAX: f32 = 62.8;
+
 /// A campaign entry: 90 s at 5 % of stick travel.
 const fn entry(
     axis: Axis,
@@ -212,6 +217,25 @@ impl TestList {
             entries,
             slices: TEST_LIST_LEN as u8,
         }
+    }
+
+    /// The loop tests of `vehicle`'s preset ([`InputKind::LoopSweep`]): the roll (lat),
+    /// pitch (lon) and yaw/heading (ped) loops broken at their actuator input, in
+    /// entries 1, 2, 3, each a 90 s sweep at 5 % of stick travel from the campaign's
+    /// first band's ω_min to [`LOOP_TEST_OMEGA_MAX`]. Three slices.
+    pub const fn loop_tests(vehicle: VehicleId) -> TestList {
+        let (bands, pulse_width_s) = match vehicle {
+            VehicleId::Bo105 => (BO105_BANDS, 1.0),
+            VehicleId::Trex700l => (TREX700L_BANDS, 0.3),
+        };
+        let [(omega_min, _), _] = bands;
+        let first = (omega_min, LOOP_TEST_OMEGA_MAX);
+        let w = pulse_width_s;
+        let mut entries = [TestEntry::EMPTY; TEST_LIST_LEN];
+        entries[0] = entry(Axis::Lat, InputKind::LoopSweep, first, w);
+        entries[1] = entry(Axis::Lon, InputKind::LoopSweep, first, w);
+        entries[2] = entry(Axis::Ped, InputKind::LoopSweep, first, w);
+        TestList { entries, slices: 3 }
     }
 
     /// The entry (1 … `slices`) the selector at position `position` ∈ [−1, 1] selects;

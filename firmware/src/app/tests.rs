@@ -15,6 +15,7 @@ use sweephold_protocol::{AbortReason, Decoder, Event, Frame, HoldState};
 
 mod airborne;
 mod cues;
+mod loop_test;
 mod test_list;
 
 const DEG: f32 = core::f32::consts::PI / 180.0;

@@ -1,10 +1,72 @@
 //! The excitation phases' tick (fade-in, sweep, fade-out): the sweep or pulse on the
 //! primary axis, the off-axis noise, and on each held axis the conditional attitude
-//! hold's logic and controller.
+//! hold's logic and controller; in a loop test ([`InputKind::LoopSweep`]) the sweep
+//! added to the pilot-mode loops' command instead.
+//!
+//! # Loop test
+//!
+//! The board application closes its pilot-mode loops through the whole test and hands
+//! their command c to [`FlightController::set_loop_command`] before each step. In the
+//! excitation phases the command is then u = c + d on the primary axis (d the sweep,
+//! scaled as every excitation is) and c on the others: no trim, no hold, no noise, the
+//! configured command slew limit as in every test. The safety checks are the same as in
+//! every test; the pilot-override check compares the sticks the board application
+//! feeds (the captured trim plus the pilot's displacement from the capture's mean) with
+//! the trim, so it still sees the pilot's hands, not the loops' moving command. When a
+//! test ends (Done, an abort) the tick's command is c, the loops' command. Without a
+//! loop command (a flight controller without the board application) the pilot's sticks
+//! stand for it.
 
 use super::*;
 
 impl FlightController {
+    /// The pilot-mode loops' command of the coming tick, in a loop test: the command the
+    /// step passes through and, in the excitation phases, adds the sweep to. Used by the
+    /// next [`step`](Self::step) only (a step without one uses the pilot's sticks);
+    /// ignored in other tests. Non-finite values count as the last finite pilot stick.
+    pub fn set_loop_command(&mut self, command: Controls) {
+        self.loop_command = Some(command.to_array());
+    }
+
+    /// The command the tick starts from: the loops' command in a loop test if one was
+    /// set for this tick (each non-finite value replaced by the pilot's), else `pilot`.
+    pub(super) fn loop_or_pilot(&mut self, pilot: [f32; 4]) -> [f32; 4] {
+        let command = self.loop_command.take();
+        match command.filter(|_| self.config.test.input.is_loop()) {
+            Some(mut command) => {
+                for (value, stick) in command.iter_mut().zip(pilot) {
+                    if !value.is_finite() {
+                        *value = stick;
+                    }
+                }
+                command
+            }
+            None => pilot,
+        }
+    }
+
+    /// One excitation tick of a loop test: the sweep `sweep` (already scaled) added to
+    /// the loops' command `loops` on the primary axis (see the module documentation).
+    fn loop_parts(&self, sweep: f32, omega: f32, loops: [f32; 4]) -> TickParts {
+        let primary = self.config.test.primary.index();
+        let sweeps: [f32; 4] = core::array::from_fn(|k| if k == primary { sweep } else { 0.0 });
+        let mut command = [0.0; 4];
+        for (((command, &c), (&d, last)), step) in command
+            .iter_mut()
+            .zip(&loops)
+            .zip(sweeps.iter().zip(self.last_command))
+            .zip(self.slew_steps)
+        {
+            *command = clamp_unit(slew::limit(last, clamp_unit(c + d), step));
+        }
+        TickParts {
+            command,
+            sweep: sweeps,
+            noise: [0.0; 4],
+            sweep_omega: omega,
+        }
+    }
+
     /// One tick of the excitation phases.
     pub(super) fn excite(
         &mut self,
@@ -28,6 +90,9 @@ impl FlightController {
         // adaptive shaping so that its stick-travel and servo-rate bounds see what is flown.
         let scale = self.config.excitation_scale;
         sample.value *= scale.of(self.config.test.primary);
+        if self.config.test.input.is_loop() {
+            return self.loop_parts(sample.value, sample.omega, pilot);
+        }
         let trim = self.trim;
         let [_, _, _, pilot_col] = pilot;
         let [noise_lat, noise_lon, noise_ped] = self.noise.next_sample();

@@ -138,7 +138,7 @@ fn entry_fields_out_of_range_are_refused() {
     for entry in [1, 7, 12] {
         for (field, below, above) in [
             ("AXIS", -1.0, 5.0),
-            ("INPUT", -1.0, 4.0),
+            ("INPUT", -1.0, 5.0),
             ("WMIN", 0.0, 101.0),
             ("WMAX", 0.0, 401.0),
             ("WIDTH", 0.0, 61.0),

@@ -415,11 +415,12 @@ impl Params {
 }
 
 /// [`InputKind`] by its `TEST_INPUT` number.
-const INPUTS: [InputKind; 4] = [
+const INPUTS: [InputKind; 5] = [
     InputKind::Sweep,
     InputKind::Doublet,
     InputKind::ThreeTwoOneOne,
     InputKind::AdaptiveSweep,
+    InputKind::LoopSweep,
 ];
 /// [`ExcitationMode`] by its `TEST_MODE` number.
 const MODES: [ExcitationMode; 3] = [

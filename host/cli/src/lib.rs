@@ -32,6 +32,7 @@ pub mod identify;
 pub mod interrupt;
 pub mod logs;
 pub mod margins;
+pub mod measured_loop;
 pub mod mode_text;
 pub mod output;
 pub mod plot;

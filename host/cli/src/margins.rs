@@ -20,6 +20,7 @@ use sysid::fit::model::Actuator;
 use sysid::fit::{ModelDocument, ModelStructure};
 use sysid::models;
 
+use crate::measured_loop;
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use crate::structures;
 use crate::vehicle::Vehicle;
@@ -76,6 +77,11 @@ pub struct MarginsArgs {
     /// omega, re, im per loop) to this file, for an outside check.
     #[arg(long, value_name = "FILE")]
     pub export_loops: Option<PathBuf>,
+    /// Loop-test dumps (`fly --input loop`): each one's broken loop measured at its
+    /// axis' actuator input, with its margins, beside the predicted ones of the loop it
+    /// breaks (lat: roll_attitude, lon: pitch_attitude, ped: heading); repeatable.
+    #[arg(long, value_name = "DUMP")]
+    pub measured: Vec<PathBuf>,
 }
 
 /// `--servo-frame-hz`: a finite frequency > 0.
@@ -169,25 +175,41 @@ pub fn run(args: &MarginsArgs) -> anyhow::Result<()> {
             .filter_map(|(name, path)| path.as_deref().map(|p| (name, p)))
             .collect();
     check_input_file("model", &args.model)?;
-    refuse_inputs_as_outputs(&[args.model.as_path()], &outputs)?;
+    let inputs: Vec<&std::path::Path> = std::iter::once(args.model.as_path())
+        .chain(args.measured.iter().map(PathBuf::as_path))
+        .collect();
+    refuse_inputs_as_outputs(&inputs, &outputs)?;
+    let measured = measured_loop::measure_all(&args.measured)?;
     let analysis = analyse(args)?;
     if let Some(path) = &args.export_loops {
         write_json(path, &analysis.sampled(None)?)?;
     }
+    let document = WithMeasured {
+        predicted: &analysis.result,
+        measured: measured_loop::compared(&analysis.result, measured),
+    };
     if let Some(path) = &args.out {
-        write_json(path, &analysis.result)?;
+        write_json(path, &document)?;
     }
     if args.json {
-        let mut text = serde_json::to_string_pretty(&analysis.result)?;
+        let mut text = serde_json::to_string_pretty(&document)?;
         text.push('\n');
         crate::output::print(&text)
     } else {
-        crate::output::print(&table(
-            &analysis.result,
-            analysis.vehicle.name(),
-            &args.model,
-        ))
+        let mut text = table(&analysis.result, analysis.vehicle.name(), &args.model);
+        text.push_str(&measured_loop::table(&document.measured));
+        crate::output::print(&text)
     }
+}
+
+/// `margins.json`: the predicted figures and, with `--measured`, the measured loops
+/// beside them (no `measured` key without).
+#[derive(Serialize)]
+struct WithMeasured<'a> {
+    #[serde(flatten)]
+    predicted: &'a MarginsDocument,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    measured: Vec<measured_loop::Compared>,
 }
 
 /// The firmware preset's pilot-mode law of `vehicle` on the board.

@@ -90,7 +90,8 @@ pub fn test_config() -> impl Strategy<Value = TestConfig> {
         Just(InputKind::Sweep),
         Just(InputKind::Doublet),
         Just(InputKind::ThreeTwoOneOne),
-        Just(InputKind::AdaptiveSweep)
+        Just(InputKind::AdaptiveSweep),
+        Just(InputKind::LoopSweep)
     ];
     let sweep = (real(), real(), real(), real(), real(), any::<u8>()).prop_map(
         |(t_rec_s, amplitude, omega_min, omega_max, fade_s, start_hold_cycles)| SweepSettings {

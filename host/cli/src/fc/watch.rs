@@ -155,6 +155,7 @@ fn input_name(input: InputKind) -> &'static str {
         InputKind::Doublet => "doublet",
         InputKind::ThreeTwoOneOne => "3-2-1-1",
         InputKind::AdaptiveSweep => "adaptive sweep",
+        InputKind::LoopSweep => "loop sweep",
     }
 }
 

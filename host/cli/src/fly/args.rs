@@ -54,6 +54,10 @@ pub enum InputArg {
     /// A 3-2-1-1 multistep (one record per axis).
     #[value(name = "3211")]
     ThreeTwoOneOne,
+    /// A loop test (one record per axis, from the first band's lower end to at least
+    /// 62.8 rad/s; the board-sim link only, axes lat, lon, ped): the sweep added at the
+    /// pilot-mode loop's output with the board's loops closed, for `margins --measured`.
+    Loop,
 }
 
 impl InputArg {
@@ -62,6 +66,7 @@ impl InputArg {
             InputArg::Sweep => InputKind::Sweep,
             InputArg::Doublet => InputKind::Doublet,
             InputArg::ThreeTwoOneOne => InputKind::ThreeTwoOneOne,
+            InputArg::Loop => InputKind::LoopSweep,
         }
     }
 }
@@ -382,6 +387,14 @@ impl FlyArgs {
         }
         if self.amplitude == AmplitudeArg::Adaptive && self.input != InputArg::Sweep {
             bail!("--amplitude adaptive shapes a sweep: drop it or use --input sweep");
+        }
+        if self.input == InputArg::Loop {
+            if !matches!(self.fc, FcArg::BoardSim(_)) {
+                bail!("--input loop breaks the board's pilot-mode loops: it needs --fc board-sim");
+            }
+            if self.axes.contains(&Axis::Col) {
+                bail!("--input loop: the collective has no loop to break (use --axes lat,lon,ped)");
+            }
         }
         for (i, axis) in self.axes.iter().enumerate() {
             if self.axes[..i].contains(axis) {

@@ -52,6 +52,22 @@ pub fn campaign_list(vehicle: &Vehicle, t_rec_s: f64) -> TestList {
     list
 }
 
+/// The test list of a loop-test flight (`fly --input loop`) of `vehicle` with records of
+/// `t_rec_s`: entries 1, 2, 3 the loop tests of lat, lon and ped on the loop-test band of
+/// the file's first band ([`super::plan::loop_test_band`]), the rest empty, three slices
+/// (the firmware's `TestList::loop_tests` with that band and the flight's record length).
+pub fn loop_list(vehicle: &Vehicle, t_rec_s: f64) -> TestList {
+    let (omega_min, omega_max) = super::plan::loop_test_band(&vehicle.sweep_bands());
+    let mut list = TestList::loop_tests(vehicle.preset());
+    for entry in list.entries.iter_mut().filter(|entry| !entry.is_empty()) {
+        entry.omega_min = omega_min as f32;
+        entry.omega_max = omega_max as f32;
+        entry.t_rec_s = t_rec_s as f32;
+        entry.amplitude = PAPER_AMPLITUDE as f32;
+    }
+    list
+}
+
 /// The board's single test when the selector chooses `record`'s test: `record` with the
 /// per-test fields of the preset's own test `preset` (its global settings kept).
 pub fn single_test(preset: &TestConfig, record: &TestConfig) -> TestConfig {

@@ -274,7 +274,11 @@ pub fn board_sim_settings(args: &FlyArgs) -> anyhow::Result<link_board_sim::Boar
         imu_fault: args.imu_fault,
         swash: args.vehicle.aircraft().swash,
         rotor_rpm: servo_plant::board_rotor_rpm(args.vehicle.aircraft()),
-        test_list: board_test_list::campaign_list(&args.vehicle, args.t_rec_s),
+        test_list: if args.input == InputArg::Loop {
+            board_test_list::loop_list(&args.vehicle, args.t_rec_s)
+        } else {
+            board_test_list::campaign_list(&args.vehicle, args.t_rec_s)
+        },
         setup: match &args.fc {
             FcArg::BoardSim(Some(flash)) => link_board_sim::BoardSetup::Stored(Box::new(
                 board_flash::load_params(flash, args.vehicle.preset())?,

@@ -65,10 +65,12 @@ pub fn plan_records(
     seed: u64,
 ) -> Vec<RecordPlan> {
     let mut plans = Vec::new();
+    let loop_band = [loop_test_band(bands)];
     for &axis in axes {
         let bands: &[(f64, f64)] = match input {
             InputKind::Sweep | InputKind::AdaptiveSweep => bands,
             InputKind::Doublet | InputKind::ThreeTwoOneOne => &bands[..1],
+            InputKind::LoopSweep => &loop_band,
         };
         for (n, &(omega_min, omega_max)) in bands.iter().enumerate() {
             let index = n as u32 + 1;
@@ -86,6 +88,14 @@ pub fn plan_records(
         }
     }
     plans
+}
+
+/// The band of a loop test: the first band, reaching at least the firmware's
+/// `LOOP_TEST_OMEGA_MAX` (62.8 rad/s), so that it holds the loops' phase crossovers.
+pub fn loop_test_band(bands: &[(f64, f64); 2]) -> (f64, f64) {
+    let [(omega_min, omega_max), _] = *bands;
+    let top = f64::from(sweephold_firmware::app::test_list::LOOP_TEST_OMEGA_MAX);
+    (omega_min, omega_max.max(top))
 }
 
 /// A per-record seed: the first SplitMix64 output from the campaign seed plus the axis

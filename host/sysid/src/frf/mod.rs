@@ -21,6 +21,9 @@
 //! 6. [`analysis`] — the whole computation into an [`FrfDocument`], and the
 //!    cross-control coherence.
 //!
+//! [`broken_loop`](mod@broken_loop) measures a feedback loop's broken-loop response from a
+//! loop test's injection and total command with the same spectra.
+//!
 //! [`Record`], [`Channel`] and the dump reader [`load_dump_bytes`] are re-exported from
 //! [`crate::records`]: the record is this module's input, and the flight loop goes from
 //! a dump in memory straight to its cross-control coherence.
@@ -43,6 +46,7 @@
 //! [`FrfDocument`]: crate::document::FrfDocument
 
 pub mod analysis;
+pub mod broken_loop;
 pub mod chirp_z;
 pub mod coherence;
 pub mod composite;
