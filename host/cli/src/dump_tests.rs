@@ -2,7 +2,9 @@
 //! or records concatenated) holds one test per Header (split by
 //! [`sysid::records::load_dump_tests`]); every completed sweep is used, and every test is
 //! listed with how it ended and what became of it. `verify` and `identify` take every
-//! test with an excitation of any kind ([`excitation_records`]).
+//! test with an excitation of any kind ([`excitation_records`]). A loop test (the sweep
+//! added to the closed pilot-mode loops) is listed and left out by all three: its broken
+//! loop is `margins --measured`'s.
 
 use std::path::Path;
 
@@ -104,6 +106,16 @@ fn chosen_tests(
                     refusal.get_or_insert(error.to_string());
                 }
                 "left out: no excitation".to_string()
+            }
+            // A loop test's command is the closed loops' own answer plus the sweep: the
+            // airframe's response to it is not an open-loop record, and what it measures
+            // is the broken loop (`margins --measured`).
+            (_, _) if test.header.test.input.is_loop() => {
+                refusal.get_or_insert(format!(
+                    "{file}: test {}: a loop test: `sweephold margins --measured` reads it",
+                    test.number
+                ));
+                "left out: a loop test (`margins --measured` reads it)".to_string()
             }
             (_, Err(error)) if excitation == Excitation::Sweep && !is_sweep => {
                 refusal.get_or_insert(error.to_string());

@@ -151,6 +151,26 @@ fn a_board_sim_loop_test_is_measured_beside_the_prediction() {
     for (dump, bytes) in dumps.iter().zip(&before) {
         assert_eq!(&std::fs::read(dump).unwrap(), bytes);
     }
+    // Nor is a loop test an open-loop record: frf and identify list it and leave it out.
+    for verb in [
+        &["frf", dumps[0].to_str().unwrap()][..],
+        &[
+            "identify",
+            dumps[0].to_str().unwrap(),
+            "--vehicle",
+            "trex700l",
+            "--out",
+            dir.join("identified").to_str().unwrap(),
+        ][..],
+    ] {
+        let output = sweephold(verb);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{verb:?}: {stderr}");
+        assert!(
+            stderr.contains("a loop test: `sweephold margins --measured` reads it"),
+            "{verb:?}: {stderr}"
+        );
+    }
     let document: serde_json::Value = serde_json::from_slice(&std::fs::read(&a).unwrap()).unwrap();
     let measured = document["measured"].as_array().unwrap();
     let names: Vec<&str> = measured
