@@ -47,3 +47,4 @@ mod stdout;
 mod structures_ticks;
 mod test_list;
 mod trim_points;
+mod tune;
