@@ -7,7 +7,7 @@ use serde::Serialize;
 use sysid::fit::{Model, ModelDocument, ModelStructure};
 use sysid::random::SplitMix64;
 
-use super::{TuneOptions, LOOPS};
+use super::options::{TuneOptions, LOOPS};
 use crate::law::BoardLaw;
 use crate::loops::{self, Configuration, Sampled};
 use crate::margins::{self, bode};
