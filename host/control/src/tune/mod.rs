@@ -34,6 +34,8 @@
 //!    the highest of log-spaced candidates from 0.3 /s up to `outer_fraction` (1/3) of
 //!    the inner crossover (the lower of roll's and pitch's for `K_lvl`) that meet the
 //!    constraints on the loops they close (roll_attitude and pitch_attitude; heading).
+//!    Where none does, the inner crossovers they close (unless stated) step down by 15 %
+//!    and the outer design is tried again.
 //! 4. **Constraints**, on each loop broken at its actuator with the others closed: phase
 //!    margin at the loop's crossover (its highest-frequency gain crossover) ≥ 45° and
 //!    the gain margin above it (the least over the phase crossovers above the crossover:
@@ -291,6 +293,9 @@ fn design_outer(
     Err(last)
 }
 
+/// How far an inner crossover steps down when its outer loop finds no gain.
+const INNER_BACK_OFF: f64 = 0.85;
+
 /// The pilot-mode gains of `law` designed on `models`.
 pub fn tune(models: &Models, law: &BoardLaw, options: &TuneOptions) -> Result<Tuned, Refusal> {
     let mut law = law.clone();
@@ -305,14 +310,36 @@ pub fn tune(models: &Models, law: &BoardLaw, options: &TuneOptions) -> Result<Tu
                 design_rate_axis(models, &mut law, axis, options, options.crossovers[axis])
             })?;
     }
-    design_outer(
-        models,
-        &mut law,
-        true,
-        crossovers[0].min(crossovers[1]),
-        options,
-    )?;
-    design_outer(models, &mut law, false, crossovers[2], options)?;
+    // The outer loops; where none of their gains meets the constraints, the inner loops
+    // they close (unless stated) step down by 15 % and the outer design is tried again.
+    for (level, axes) in [(true, &[0usize, 1][..]), (false, &[2usize][..])] {
+        loop {
+            let inner = axes
+                .iter()
+                .map(|&a| crossovers[a])
+                .fold(f64::INFINITY, f64::min);
+            let refusal = match design_outer(models, &mut law, level, inner, options) {
+                Ok(()) => break,
+                Err(refusal) => refusal,
+            };
+            if axes.iter().any(|&a| options.crossovers[a].is_some()) {
+                return Err(refusal);
+            }
+            for &axis in axes {
+                // Down until a crossover meets the rate loop's own constraints again.
+                loop {
+                    let wc = crossovers[axis] * INNER_BACK_OFF;
+                    if wc < options.lowest_crossover_rad_s {
+                        return Err(refusal);
+                    }
+                    crossovers[axis] = wc;
+                    if design_rate_axis(models, &mut law, axis, options, Some(wc)).is_ok() {
+                        break;
+                    }
+                }
+            }
+        }
+    }
     // Every loop with every gain in place.
     for (index, &(name, _, _)) in LOOPS.iter().enumerate() {
         if let Some(why) = check_loop(models, &law, index, options).violation {
