@@ -187,6 +187,20 @@ pub fn design_rate_axis(
     options: &TuneOptions,
     stated: Option<f64>,
 ) -> Result<f64, Refusal> {
+    let bound = servo_rate_bound(models, law, axis, options);
+    design_rate_axis_within(models, law, axis, options, stated, bound)
+}
+
+/// [`design_rate_axis`] with the servo rate bounded by `bound` (that of the gains the
+/// whole design started from: a bound taken from gains already changed would creep).
+fn design_rate_axis_within(
+    models: &Models,
+    law: &mut BoardLaw,
+    axis: usize,
+    options: &TuneOptions,
+    stated: Option<f64>,
+    bound: Option<f64>,
+) -> Result<f64, Refusal> {
     let name = LOOPS[axis].0;
     let candidates = match stated {
         Some(wc) => vec![wc],
@@ -197,7 +211,6 @@ pub fn design_rate_axis(
         ),
     };
     let mut last_why = String::from("no candidate crossover");
-    let bound = servo_rate_bound(models, law, axis, options);
     for &wc in &candidates {
         // Of the PI zeros that meet the constraints at this crossover, the one with the
         // most room on its tighter margin (phase margin excess, gain margin excess
@@ -296,19 +309,54 @@ fn design_outer(
 /// How far an inner crossover steps down when its outer loop finds no gain.
 const INNER_BACK_OFF: f64 = 0.85;
 
-/// The pilot-mode gains of `law` designed on `models`.
+/// The pilot-mode gains of `law` designed on `models`. A loop that fails once every gain
+/// is in place (the loops designed later change the earlier ones a little) has its rate
+/// axis's cap lowered to 85 % of the crossover it had, and the design runs again.
 pub fn tune(models: &Models, law: &BoardLaw, options: &TuneOptions) -> Result<Tuned, Refusal> {
+    let mut options = options.clone();
+    loop {
+        match design_all(models, law, &options) {
+            Ok(tuned) => return Ok(tuned),
+            Err((refusal, None)) => return Err(refusal),
+            Err((refusal, Some((axis, crossover)))) => {
+                let cap = crossover * INNER_BACK_OFF;
+                if options.crossovers[axis].is_some() || cap < options.lowest_crossover_rad_s {
+                    return Err(refusal);
+                }
+                options.crossover_caps[axis] = cap;
+            }
+        }
+    }
+}
+
+/// The rate axis a loop of [`LOOPS`] closes around.
+fn inner_axis(index: usize) -> usize {
+    LOOPS[index].2
+}
+
+/// One pass of the design; a failure of the final check names the rate axis to lower
+/// and its crossover.
+#[allow(clippy::type_complexity)]
+fn design_all(
+    models: &Models,
+    law: &BoardLaw,
+    options: &TuneOptions,
+) -> Result<Tuned, (Refusal, Option<(usize, f64)>)> {
+    let bounds: [Option<f64>; 3] =
+        std::array::from_fn(|axis| servo_rate_bound(models, law, axis, options));
+    let design = |law: &mut BoardLaw, axis: usize, stated: Option<f64>| {
+        design_rate_axis_within(models, law, axis, options, stated, bounds[axis])
+    };
     let mut law = law.clone();
     let mut crossovers = [0.0; 3];
     for (axis, crossover) in crossovers.iter_mut().enumerate() {
-        *crossover = design_rate_axis(models, &mut law, axis, options, options.crossovers[axis])?;
+        *crossover = design(&mut law, axis, options.crossovers[axis]).map_err(|r| (r, None))?;
     }
     // Once more with the other axes' new gains, each at the crossover found.
     for (axis, crossover) in crossovers.iter_mut().enumerate() {
-        *crossover =
-            design_rate_axis(models, &mut law, axis, options, Some(*crossover)).or_else(|_| {
-                design_rate_axis(models, &mut law, axis, options, options.crossovers[axis])
-            })?;
+        *crossover = design(&mut law, axis, Some(*crossover))
+            .or_else(|_| design(&mut law, axis, options.crossovers[axis]))
+            .map_err(|r| (r, None))?;
     }
     // The outer loops; where none of their gains meets the constraints, the inner loops
     // they close (unless stated) step down by 15 % and the outer design is tried again.
@@ -323,30 +371,41 @@ pub fn tune(models: &Models, law: &BoardLaw, options: &TuneOptions) -> Result<Tu
                 Err(refusal) => refusal,
             };
             if axes.iter().any(|&a| options.crossovers[a].is_some()) {
-                return Err(refusal);
+                return Err((refusal, None));
             }
             for &axis in axes {
                 // Down until a crossover meets the rate loop's own constraints again.
                 loop {
                     let wc = crossovers[axis] * INNER_BACK_OFF;
                     if wc < options.lowest_crossover_rad_s {
-                        return Err(refusal);
+                        return Err((refusal, None));
                     }
                     crossovers[axis] = wc;
-                    if design_rate_axis(models, &mut law, axis, options, Some(wc)).is_ok() {
+                    if design(&mut law, axis, Some(wc)).is_ok() {
                         break;
                     }
                 }
             }
         }
     }
-    // Every loop with every gain in place.
+    // Every loop and servo rate with every gain in place.
+    for (axis, bound) in bounds.iter().enumerate() {
+        if let Some(why) = servo_rate_violation(models, &law, axis, options, *bound) {
+            let refusal = Refusal {
+                name: LOOPS[axis].0,
+                why: format!("{why} with all gains in place"),
+            };
+            return Err((refusal, Some((axis, crossovers[axis]))));
+        }
+    }
     for (index, &(name, _, _)) in LOOPS.iter().enumerate() {
         if let Some(why) = check_loop(models, &law, index, options).violation {
-            return Err(Refusal {
+            let refusal = Refusal {
                 name,
                 why: format!("{why} with all gains in place"),
-            });
+            };
+            let axis = inner_axis(index);
+            return Err((refusal, Some((axis, crossovers[axis]))));
         }
     }
     Ok(Tuned {
