@@ -197,6 +197,10 @@ pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
     let mut notes: Vec<String> = models.note.iter().cloned().collect();
     if let Err(why) = &structure {
         notes.push(format!("no robust check: {why}"));
+    } else if models.draws() == 0 {
+        notes.push(
+            "no draws (--samples 0): the constraints held on the identified model only".to_string(),
+        );
     }
     let tuned = tune::tune(&models, &law, &options).map_err(|refusal| anyhow!("{refusal}"))?;
     let mut tuned_law = law.clone();
