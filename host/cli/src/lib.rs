@@ -41,6 +41,7 @@ pub mod run_lock;
 pub mod sim;
 pub mod structures;
 pub mod table;
+pub mod tune;
 pub mod vehicle;
 pub mod verify;
 
@@ -86,6 +87,8 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Trim and linearize a simulated helicopter (a shipped aircraft or an aircraft file).
     Sim(sim::SimArgs),
+    /// Pilot-mode gains designed on an identified model for crossovers with margins.
+    Tune(tune::TuneArgs),
     /// Simulate an identified model on recorded inputs and score it (Theil's inequality coefficient).
     Verify(verify::VerifyArgs),
 }
@@ -120,6 +123,7 @@ fn run_verb(cli: Cli) -> anyhow::Result<()> {
         Command::Margins(args) => margins::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Sim(args) => sim::run(&args),
+        Command::Tune(args) => tune::run(&args),
         Command::Verify(args) => verify::run(&args),
     }
 }

@@ -85,7 +85,7 @@ pub struct MarginsArgs {
 }
 
 /// `--servo-frame-hz`: a finite frequency > 0.
-fn positive_hz(text: &str) -> Result<f64, String> {
+pub(crate) fn positive_hz(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(hz) if hz.is_finite() && hz > 0.0 => Ok(hz),
         _ => Err("expected a frequency in Hz > 0".to_string()),
@@ -120,14 +120,13 @@ pub fn analyse(args: &MarginsArgs) -> anyhow::Result<MarginsAnalysis> {
         None if document.structure.starts_with("trex700l") => Vehicle::shipped("trex700l"),
         None => Vehicle::shipped("bo105"),
     };
-    let law = board_law(&vehicle, args);
-    let servos = vehicle.servos();
-    let vehicle_servo = (servos.natural_frequency_rad_s.is_finite()
-        && servos.natural_frequency_rad_s > 0.0)
-        .then_some(Actuator {
-            natural_frequency_rad_s: servos.natural_frequency_rad_s,
-            damping: servos.damping,
-        });
+    let law = preset_law(
+        &vehicle,
+        args.no_filters,
+        args.compute_delay,
+        args.servo_frame_hz,
+    );
+    let vehicle_servo = vehicle_servo(&vehicle);
     let structure = structure_of(&document, &vehicle);
     let options = AnalysisOptions {
         samples: args.samples,
@@ -212,23 +211,42 @@ struct WithMeasured<'a> {
     measured: Vec<measured_loop::Compared>,
 }
 
-/// The firmware preset's pilot-mode law of `vehicle` on the board.
-fn board_law(vehicle: &Vehicle, args: &MarginsArgs) -> BoardLaw {
+/// The firmware preset's pilot-mode law of `vehicle` on the board (also `tune`'s).
+pub(crate) fn preset_law(
+    vehicle: &Vehicle,
+    no_filters: bool,
+    compute_delay_s: f64,
+    servo_frame_hz: Option<f64>,
+) -> BoardLaw {
     let app = AppConfig::preset(vehicle.preset(), Axis::Lat);
     let stack = StackConfig::with_app(app);
     BoardLaw {
         gains: app.pilot,
         tick_s: f64::from(app.flight.dt_s()),
-        filters: (!args.no_filters).then_some(stack.filters),
-        compute_delay_s: args.compute_delay,
-        servo_frame_hz: args.servo_frame_hz,
+        filters: (!no_filters).then_some(stack.filters),
+        compute_delay_s,
+        servo_frame_hz,
         servos: [None; 3],
     }
 }
 
+/// The vehicle's servo as an actuator (`None`: an instant one).
+pub(crate) fn vehicle_servo(vehicle: &Vehicle) -> Option<Actuator> {
+    let servos = vehicle.servos();
+    (servos.natural_frequency_rad_s.is_finite() && servos.natural_frequency_rad_s > 0.0).then_some(
+        Actuator {
+            natural_frequency_rad_s: servos.natural_frequency_rad_s,
+            damping: servos.damping,
+        },
+    )
+}
+
 /// The structure `document` was fitted with, for the spread: the 6-DOF, the vehicle's
 /// own hybrid (its numbers), or a shipped structure of that name.
-fn structure_of(document: &ModelDocument, vehicle: &Vehicle) -> Result<ModelStructure, String> {
+pub(crate) fn structure_of(
+    document: &ModelDocument,
+    vehicle: &Vehicle,
+) -> Result<ModelStructure, String> {
     let structure = if document.structure == models::BO105_6DOF.name {
         structures::six_dof().map_err(anyhow::Error::from)
     } else if document.structure == vehicle.structure() {

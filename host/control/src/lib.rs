@@ -24,7 +24,8 @@
 //! control law as it runs), [`loops`] (loop matrix, broken loops, stick responses),
 //! [`margins`] (crossover, margins, DRB of a sampled loop), [`handling`] (ADS-33
 //! bandwidth, phase delay, level), [`uncertainty`] (Monte-Carlo over the parameter
-//! covariance), [`analysis`] (everything for one model, the JSON document).
+//! covariance), [`analysis`] (everything for one model, the JSON document), [`tune`]
+//! (pilot-mode gains designed on the model).
 
 pub mod analysis;
 pub mod handling;
@@ -32,6 +33,7 @@ pub mod law;
 pub mod loops;
 pub mod margins;
 pub mod plant;
+pub mod tune;
 pub mod uncertainty;
 
 pub use analysis::{analyse, AnalysisOptions, MarginsDocument};

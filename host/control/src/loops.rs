@@ -58,8 +58,12 @@ pub fn log_grid(low: f64, high: f64, count: usize) -> Vec<f64> {
         .collect()
 }
 
-fn frame(plant: &Plant, law: &BoardLaw, config: Configuration, omega: f64) -> Option<Frame> {
-    let response = plant.response(omega)?;
+fn frame(
+    response: &DMatrix<Complex64>,
+    law: &BoardLaw,
+    config: Configuration,
+    omega: f64,
+) -> Option<Frame> {
     let path = law.output_path(omega);
     let filter = law.measurement(omega);
     let commanded = DMatrix::from_fn(6, 3, |i, k| response[(i, k)] * path * law.servo(k, omega));
@@ -123,7 +127,7 @@ pub fn responses(
     let mut sensitivity = [empty(), empty(), empty()];
     let mut stick_attitude = [empty(), empty(), empty()];
     for &omega in grid {
-        let frame = frame(plant, law, config, omega)?;
+        let frame = frame(&plant.response(omega)?, law, config, omega)?;
         for k in 0..3 {
             let s = frame.sensitivity[(k, k)];
             sensitivity[k].values.push(s);
@@ -141,4 +145,42 @@ pub fn responses(
         sensitivity,
         stick_attitude,
     })
+}
+
+/// The broken loops of `config` on `grid` from the plant's responses already computed
+/// there (`Plant::response` at each frequency of `grid`): a design that tries many
+/// gains on one model computes the model's responses once.
+pub fn broken_loops_from(
+    responses: &[DMatrix<Complex64>],
+    law: &BoardLaw,
+    config: Configuration,
+    grid: &[f64],
+) -> Option<[Sampled; 3]> {
+    let mut broken: [Sampled; 3] = std::array::from_fn(|_| Sampled {
+        omega: grid.to_vec(),
+        values: Vec::with_capacity(grid.len()),
+    });
+    for (response, &omega) in responses.iter().zip(grid) {
+        let frame = frame(response, law, config, omega)?;
+        for (k, loop_k) in broken.iter_mut().enumerate() {
+            loop_k
+                .values
+                .push(Complex64::new(1.0, 0.0) / frame.sensitivity[(k, k)] - 1.0);
+        }
+    }
+    Some(broken)
+}
+
+/// The command `u_k` the board computes per unit of axis k's rate target ω_t, with the
+/// loops of `config` closed, at ω: `[(I + L)⁻¹]_kk·F_ω`.
+pub fn command_per_target(
+    response: &DMatrix<Complex64>,
+    law: &BoardLaw,
+    config: Configuration,
+    axis: usize,
+    omega: f64,
+) -> Option<Complex64> {
+    let frame = frame(response, law, config, omega)?;
+    let terms = law.axis_terms(law.axes()[axis], omega);
+    Some(frame.sensitivity[(axis, axis)] * terms.target)
 }

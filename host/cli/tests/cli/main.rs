@@ -48,3 +48,4 @@ mod steady_flights;
 mod structures_ticks;
 mod test_list;
 mod trim_points;
+mod tune;
