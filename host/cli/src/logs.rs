@@ -191,11 +191,11 @@ fn topic_rows(topic: &Topic, jsonl: bool, out: &mut String) {
 /// `frf` options that only flight logs read.
 #[derive(Args, Debug, Clone, Default)]
 pub struct LogFrfArgs {
-    /// Flight logs: keep only T0..T1 \[s\] on the log's clock (default: the SystemID sweep
+    /// Flight logs: keep only T0..T1, seconds on the log's clock (default: the SystemID sweep
     /// of an ArduPilot log that has SIDS/SIDD messages, else all the chosen channels share).
     #[arg(long, value_name = "T0,T1", value_parser = parse_window, allow_hyphen_values = true)]
     pub log_window: Option<Window>,
-    /// Flight logs: resample at this rate \[Hz\] (default: the median message rate of the
+    /// Flight logs: resample at this rate in Hz (default: the median message rate of the
     /// first output's topic).
     #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
     pub log_rate: Option<f64>,

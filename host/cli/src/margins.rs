@@ -64,15 +64,9 @@ pub struct MarginsArgs {
     /// Seed of the draws.
     #[arg(long, default_value_t = 1, value_parser = crate::arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
-    /// Leave the board's IMU filter bank out (raw sensors).
-    #[arg(long)]
-    pub no_filters: bool,
-    /// Computation delay from the sensor sample to the command \[s\].
-    #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::arg_values::non_negative, allow_hyphen_values = true)]
-    pub compute_delay: f64,
-    /// Servo pulse frame rate \[Hz\] (held for a frame); none by default, as the simulator.
-    #[arg(long, value_name = "HZ", value_parser = positive_hz, allow_hyphen_values = true)]
-    pub servo_frame_hz: Option<f64>,
+    /// What the board adds around the model.
+    #[command(flatten)]
+    pub law: LawArgs,
     /// Write the broken loops and sensitivities sampled on the analysis grid (JSON:
     /// omega, re, im per loop) to this file, for an outside check.
     #[arg(long, value_name = "FILE")]
@@ -120,12 +114,7 @@ pub fn analyse(args: &MarginsArgs) -> anyhow::Result<MarginsAnalysis> {
         None if document.structure.starts_with("trex700l") => Vehicle::shipped("trex700l"),
         None => Vehicle::shipped("bo105"),
     };
-    let law = preset_law(
-        &vehicle,
-        args.no_filters,
-        args.compute_delay,
-        args.servo_frame_hz,
-    );
+    let law = args.law.preset_law(&vehicle);
     let vehicle_servo = vehicle_servo(&vehicle);
     let structure = structure_of(&document, &vehicle);
     let options = AnalysisOptions {
@@ -211,22 +200,36 @@ struct WithMeasured<'a> {
     measured: Vec<measured_loop::Compared>,
 }
 
-/// The firmware preset's pilot-mode law of `vehicle` on the board (also `tune`'s).
-pub(crate) fn preset_law(
-    vehicle: &Vehicle,
-    no_filters: bool,
-    compute_delay_s: f64,
-    servo_frame_hz: Option<f64>,
-) -> BoardLaw {
-    let app = AppConfig::preset(vehicle.preset(), Axis::Lat);
-    let stack = StackConfig::with_app(app);
-    BoardLaw {
-        gains: app.pilot,
-        tick_s: f64::from(app.flight.dt_s()),
-        filters: (!no_filters).then_some(stack.filters),
-        compute_delay_s,
-        servo_frame_hz,
-        servos: [None; 3],
+/// What the board adds between the sensors and the servos around an identified model
+/// (`margins` and `tune`).
+#[derive(Args, Clone, Debug)]
+pub struct LawArgs {
+    /// Leave the board's IMU filter bank out (raw sensors).
+    #[arg(long)]
+    pub no_filters: bool,
+    /// Computation delay from the sensor sample to the command, in seconds.
+    #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::arg_values::non_negative, allow_hyphen_values = true)]
+    pub compute_delay: f64,
+    /// Servo pulse frame rate in Hz (each pulse held for a frame); none by default, as the
+    /// simulator.
+    #[arg(long, value_name = "HZ", value_parser = positive_hz, allow_hyphen_values = true)]
+    pub servo_frame_hz: Option<f64>,
+}
+
+impl LawArgs {
+    /// The firmware preset's pilot-mode law of `vehicle` on the board, with these
+    /// additions.
+    pub(crate) fn preset_law(&self, vehicle: &Vehicle) -> BoardLaw {
+        let app = AppConfig::preset(vehicle.preset(), Axis::Lat);
+        let stack = StackConfig::with_app(app);
+        BoardLaw {
+            gains: app.pilot,
+            tick_s: f64::from(app.flight.dt_s()),
+            filters: (!self.no_filters).then_some(stack.filters),
+            compute_delay_s: self.compute_delay,
+            servo_frame_hz: self.servo_frame_hz,
+            servos: [None; 3],
+        }
     }
 }
 

@@ -13,7 +13,7 @@ use serde::Serialize;
 use sweephold_firmware::app::pilot_mode::{PilotModeGains, RateAxisGains};
 use sysid::fit::ModelDocument;
 
-use crate::margins::{positive_hz, preset_law, structure_of, vehicle_servo};
+use crate::margins::{structure_of, vehicle_servo, LawArgs};
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use crate::vehicle::Vehicle;
 
@@ -60,15 +60,9 @@ pub struct TuneArgs {
     /// Seed of the draws.
     #[arg(long, default_value_t = 1, value_parser = crate::arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
-    /// Leave the board's IMU filter bank out (raw sensors).
-    #[arg(long)]
-    pub no_filters: bool,
-    /// Computation delay from the sensor sample to the command \[s\].
-    #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = crate::arg_values::non_negative, allow_hyphen_values = true)]
-    pub compute_delay: f64,
-    /// Servo pulse frame rate \[Hz\] (held for a frame); none by default, as the simulator.
-    #[arg(long, value_name = "HZ", value_parser = positive_hz, allow_hyphen_values = true)]
-    pub servo_frame_hz: Option<f64>,
+    /// What the board adds around the model.
+    #[command(flatten)]
+    pub law: LawArgs,
 }
 
 /// `--crossover AXIS=RAD_S`.
@@ -176,12 +170,7 @@ pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
     let model = document
         .model()
         .ok_or_else(|| anyhow!("{}: a matrix has the wrong size", args.model.display()))?;
-    let mut law: BoardLaw = preset_law(
-        &vehicle,
-        args.no_filters,
-        args.compute_delay,
-        args.servo_frame_hz,
-    );
+    let mut law: BoardLaw = args.law.preset_law(&vehicle);
     law.servos = control::analysis::added_servos(&model, vehicle_servo(&vehicle));
     let rate_limit = vehicle.servos().rate_limit_per_s;
     let options = TuneOptions {

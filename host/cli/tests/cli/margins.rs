@@ -1,13 +1,7 @@
 //! `sweephold margins`: the table and margins.json of an identified model, byte-identical
 //! on a second run, the model untouched; bad inputs end in one `error:` line.
 
-use std::path::PathBuf;
-
-use crate::support::{sweephold, Scratch};
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../control/tests/fixtures/{name}"))
-}
+use crate::support::{control_fixture as fixture, sweephold, Scratch};
 
 #[test]
 fn margins_writes_the_table_and_the_same_json_twice() {

@@ -2,13 +2,7 @@
 //! untouched; a crossover no gains can meet refused in one line naming the loop and the
 //! constraint; bad arguments end in one `error:` line.
 
-use std::path::PathBuf;
-
-use crate::support::{sweephold, Scratch};
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../control/tests/fixtures/{name}"))
-}
+use crate::support::{control_fixture as fixture, sweephold, Scratch};
 
 #[test]
 fn tune_writes_the_same_gains_twice_and_meets_the_margins() {

@@ -15,3 +15,9 @@ pub fn sweephold(args: &[&str]) -> Output {
         .output()
         .expect("the binary runs")
 }
+
+/// A fixture of the control crate's tests (identified models the loop verbs read).
+pub fn control_fixture(name: &str) -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../control/tests/fixtures/{name}"))
+}
