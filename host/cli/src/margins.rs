@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Context};
 use clap::Args;
@@ -102,18 +102,29 @@ pub struct MarginsAnalysis {
     pub result: MarginsDocument,
 }
 
-/// Read the model of `args` and analyse it (no output written).
-pub fn analyse(args: &MarginsArgs) -> anyhow::Result<MarginsAnalysis> {
-    check_input_file("model", &args.model)?;
-    let text = fs::read_to_string(&args.model)
-        .with_context(|| format!("cannot read {}", args.model.display()))?;
+/// The identified model at `path` (a `model.json`) and the aircraft whose preset flies
+/// it: `vehicle`, else the one its structure names (a TREX 700L structure, else the
+/// Bo-105). `margins` and `tune` read their model so.
+pub(crate) fn model_and_vehicle(
+    path: &Path,
+    vehicle: Option<&Vehicle>,
+) -> anyhow::Result<(ModelDocument, Vehicle)> {
+    check_input_file("model", path)?;
+    let text =
+        fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     let document: ModelDocument = serde_json::from_str(&text)
-        .map_err(|e| anyhow!("{}: not a model.json: {e}", args.model.display()))?;
-    let vehicle = match &args.vehicle {
+        .map_err(|e| anyhow!("{}: not a model.json: {e}", path.display()))?;
+    let vehicle = match vehicle {
         Some(vehicle) => vehicle.clone(),
         None if document.structure.starts_with("trex700l") => Vehicle::shipped("trex700l"),
         None => Vehicle::shipped("bo105"),
     };
+    Ok((document, vehicle))
+}
+
+/// Read the model of `args` and analyse it (no output written).
+pub fn analyse(args: &MarginsArgs) -> anyhow::Result<MarginsAnalysis> {
+    let (document, vehicle) = model_and_vehicle(&args.model, args.vehicle.as_ref())?;
     let law = args.law.preset_law(&vehicle);
     let vehicle_servo = vehicle_servo(&vehicle);
     let structure = structure_of(&document, &vehicle);

@@ -2,18 +2,16 @@
 //! the method in its module documentation and docs/method.md, "Pilot-mode gains").
 
 use std::fmt::Write as _;
-use std::fs;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context};
+use anyhow::{anyhow, bail};
 use clap::Args;
 use control::law::BoardLaw;
 use control::tune::{self, LoopCheck, Models, TuneOptions};
 use serde::Serialize;
 use sweephold_firmware::app::pilot_mode::{PilotModeGains, RateAxisGains};
-use sysid::fit::ModelDocument;
 
-use crate::margins::{structure_of, vehicle_servo, LawArgs};
+use crate::margins::{model_and_vehicle, structure_of, vehicle_servo, LawArgs};
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use crate::vehicle::Vehicle;
 
@@ -158,15 +156,7 @@ pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
             );
         }
     }
-    let text = fs::read_to_string(&args.model)
-        .with_context(|| format!("cannot read {}", args.model.display()))?;
-    let document: ModelDocument = serde_json::from_str(&text)
-        .map_err(|e| anyhow!("{}: not a model.json: {e}", args.model.display()))?;
-    let vehicle = match &args.vehicle {
-        Some(vehicle) => vehicle.clone(),
-        None if document.structure.starts_with("trex700l") => Vehicle::shipped("trex700l"),
-        None => Vehicle::shipped("bo105"),
-    };
+    let (document, vehicle) = model_and_vehicle(&args.model, args.vehicle.as_ref())?;
     let model = document
         .model()
         .ok_or_else(|| anyhow!("{}: a matrix has the wrong size", args.model.display()))?;
