@@ -238,6 +238,24 @@ fn the_flights_steady_segments_give_the_simulators_trim_points() {
 
     // Bad GNSS files: one line naming the file and the line.
     let bad = dir.join("bad.csv");
+    let never = dir.join("never");
+    let identify_with_bad_gnss = || {
+        one_line_error(
+            &[
+                "identify",
+                s(&log),
+                "--vehicle",
+                "trex700l",
+                "--steady-flights",
+                s(&steady_log),
+                "--gnss",
+                s(&bad),
+                "--out",
+                s(&never),
+            ],
+            1,
+        )
+    };
     for (text, message) in [
         (
             "t,vn,ve,vd,heading\n1,0,0,0,0\n",
@@ -249,21 +267,7 @@ fn the_flights_steady_segments_give_the_simulators_trim_points() {
         ),
     ] {
         std::fs::write(&bad, text).unwrap();
-        let stderr = one_line_error(
-            &[
-                "identify",
-                s(&log),
-                "--vehicle",
-                "trex700l",
-                "--steady-flights",
-                s(&steady_log),
-                "--gnss",
-                s(&bad),
-                "--out",
-                s(&dir.join("never")),
-            ],
-            1,
-        );
+        let stderr = identify_with_bad_gnss();
         assert!(
             stderr.contains(&format!("{}: {message}", s(&bad))),
             "{stderr}"
@@ -271,21 +275,7 @@ fn the_flights_steady_segments_give_the_simulators_trim_points() {
     }
     // Fixes that miss the log's steady flights (one, at power-on) leave no segment.
     std::fs::write(&bad, "tick,vn,ve,vd,heading\n1,0,0,0,0\n").unwrap();
-    let stderr = one_line_error(
-        &[
-            "identify",
-            s(&log),
-            "--vehicle",
-            "trex700l",
-            "--steady-flights",
-            s(&steady_log),
-            "--gnss",
-            s(&bad),
-            "--out",
-            s(&dir.join("never")),
-        ],
-        1,
-    );
+    let stderr = identify_with_bad_gnss();
     assert!(
         stderr.contains("0 steady segment(s) of at least 5 s"),
         "{stderr}"
