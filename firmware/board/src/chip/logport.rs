@@ -3,7 +3,9 @@
 //! `sweephold decode` then reads as it reads a dump.
 //!
 //! The log never blocks the loop: a frame is copied into a 4 KiB ring (a short critical
-//! section: the copy, never the encoding) that the TXE interrupt drains at the line rate.
+//! section: the copy, never the encoding) that the TXE interrupt drains at the line rate
+//! (under QEMU, which never raises it, the loop's [`drain`] after each timer tick does,
+//! as for the link: see [`crate::chip::usart`]).
 //! When the logger falls behind, the oldest frames make room for the newest
 //! ([`ByteRing::push_frame_dropping_oldest`]); the drops are counted ([`dropped`]) and
 //! the file then lacks those frames (a frame that was being sent leaves one cut frame,
@@ -69,7 +71,7 @@ pub fn log_frame(bytes: &[u8]) {
             .borrow(cs)
             .borrow_mut()
             .push_frame_dropping_oldest(bytes);
-        pump(cs);
+        start(cs);
         dropped
     });
     if dropped > 0 {
@@ -99,6 +101,20 @@ fn pump(cs: &CriticalSection) {
     }
     let waiting = !ring.is_empty();
     usart3.cr1().modify(|_, w| w.txeie().bit(waiting));
+}
+
+/// Turn the TXE interrupt on (bytes are waiting): on silicon it fires once the critical
+/// section ends and `pump` sends them.
+fn start(cs: &CriticalSection) {
+    if let Some(usart3) = USART3.get(cs) {
+        usart3.cr1().modify(|_, w| w.txeie().set_bit());
+    }
+}
+
+/// Send what the ring holds while TXE is set, from thread mode, outside the control
+/// tick: what sends the log under QEMU (no TXE interrupt there); on silicon a check.
+pub fn drain() {
+    interrupt::free(pump);
 }
 
 /// USART3 interrupt: room in the transmitter.

@@ -5,11 +5,14 @@
 //! all-or-nothing [`UsartTx::queue_frame`] for whole frames; the receiver side is an
 //! [`embedded_io::Read`] + [`embedded_io::ReadReady`] ([`UsartRx`]).
 //!
-//! Transmit path: bytes go into a ring; the data register is fed whenever TXE is set,
-//! both right after queuing (from thread mode) and from the TXE interrupt. Feeding from
-//! thread mode matters in QEMU: its USART model writes each byte out at once, always
-//! reads TXE as set and never raises the TXE interrupt, so there the ring drains while
-//! it is being filled; on silicon the TXE interrupt drains it at the line rate.
+//! Transmit path: queuing a frame copies it into a ring and turns the TXE interrupt on;
+//! the interrupt feeds the data register at the line rate, between and during ticks,
+//! so no byte is sent from the tick itself. QEMU's USART model (7.2) writes each byte
+//! out at once, always reads TXE as set and never raises the TXE interrupt: there the
+//! loop empties the ring from thread mode after each timer tick ([`drain`]), outside
+//! the control tick, as the interrupt does on silicon. (A full ring is the one case
+//! where thread mode feeds the register inside a call: the blocking
+//! [`embedded_io::Write`] waits for room that way.)
 
 use core::cell::RefCell;
 use core::convert::Infallible;
@@ -116,6 +119,26 @@ fn pump(cs: &CriticalSection) {
     usart1.cr1().modify(|_, w| w.txeie().bit(waiting));
 }
 
+/// Turn the TXE interrupt on when bytes are waiting: on silicon it fires as soon as the
+/// critical section ends (TXE is set while the transmitter idles) and `pump` takes
+/// over. One register read-modify-write instead of a byte loop in the caller.
+fn start(cs: &CriticalSection) {
+    if CAPTURED.load(Ordering::Relaxed) || TX.borrow(cs).borrow().is_empty() {
+        return;
+    }
+    if let Some(usart1) = USART1.get(cs) {
+        usart1.cr1().modify(|_, w| w.txeie().set_bit());
+    }
+}
+
+/// Send what the ring holds while TXE is set, from thread mode. Called by the loop
+/// after each timer tick, outside the control tick: under QEMU, which never raises the
+/// TXE interrupt, this is what sends the frames; on silicon the interrupt has sent them
+/// already (or TXE reads clear) and this returns after a check.
+pub fn drain() {
+    interrupt::free(pump);
+}
+
 /// Set when the frames leave through semihosting instead of the pin (QEMU only, see
 /// `crate::image::semihosting`): the transmit ring then keeps what is queued until
 /// [`take_captured`] empties it.
@@ -179,7 +202,7 @@ impl UsartTx {
                 }
                 fits
             };
-            pump(cs);
+            start(cs);
             fits
         });
         if !queued {
@@ -226,7 +249,12 @@ impl embedded_io::Write for UsartTx {
         loop {
             let written = interrupt::free(|cs| {
                 let written = { TX.borrow(cs).borrow_mut().push_slice(buf) };
-                pump(cs);
+                if written == 0 {
+                    // Full: on silicon the interrupt makes room; QEMU needs the push.
+                    pump(cs);
+                } else {
+                    start(cs);
+                }
                 written
             });
             if written > 0 {
