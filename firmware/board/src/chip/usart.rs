@@ -119,11 +119,13 @@ fn pump(cs: &CriticalSection) {
     usart1.cr1().modify(|_, w| w.txeie().bit(waiting));
 }
 
-/// Turn the TXE interrupt on when bytes are waiting: on silicon it fires as soon as the
-/// critical section ends (TXE is set while the transmitter idles) and `pump` takes
-/// over. One register read-modify-write instead of a byte loop in the caller.
+/// Turn the TXE interrupt on (the caller has queued bytes): on silicon it fires as soon
+/// as the critical section ends (TXE is set while the transmitter idles) and `pump`
+/// takes over. One register read-modify-write instead of a byte loop in the caller.
+/// Not inlined: its callers share one copy (flash).
+#[inline(never)]
 fn start(cs: &CriticalSection) {
-    if CAPTURED.load(Ordering::Relaxed) || TX.borrow(cs).borrow().is_empty() {
+    if CAPTURED.load(Ordering::Relaxed) {
         return;
     }
     if let Some(usart1) = USART1.get(cs) {
@@ -202,7 +204,9 @@ impl UsartTx {
                 }
                 fits
             };
-            start(cs);
+            if fits {
+                start(cs);
+            }
             fits
         });
         if !queued {

@@ -44,16 +44,11 @@ impl FrameSink for Telemetry<'_> {
     }
 }
 
-/// Encode `frame` (in `scratch`) and queue it; `false` when it was dropped (ring full)
-/// or could not be encoded (impossible for the protocol's own types with a
-/// `MAX_FRAME_LEN` buffer).
+/// Encode `frame` (in `scratch`) and queue it ([`UsartTx::queue_encoded`]); `false`
+/// when it was dropped (ring full) or could not be encoded (impossible for the
+/// protocol's own types with a `MAX_FRAME_LEN` buffer); either is counted as dropped.
 pub fn send(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) -> bool {
-    match encode(frame, scratch) {
-        Ok(len) => scratch
-            .get(..len)
-            .is_some_and(|bytes| tx.queue_frame(bytes)),
-        Err(_) => false,
-    }
+    tx.queue_encoded(frame, scratch)
 }
 
 /// Encode `frame` (in `scratch`) and queue it through the blocking
