@@ -71,7 +71,7 @@ pub fn log_frame(bytes: &[u8]) {
             .borrow(cs)
             .borrow_mut()
             .push_frame_dropping_oldest(bytes);
-        start(cs);
+        pump(cs, false);
         dropped
     });
     if dropped > 0 {
@@ -84,14 +84,17 @@ pub fn dropped() -> u32 {
     DROPPED.load(Ordering::Relaxed)
 }
 
-/// Feed the data register while it has room; the TXE interrupt stays on exactly while
-/// bytes are waiting.
-fn pump(cs: &CriticalSection) {
+/// With `feed`, write bytes from the ring while the data register has room (TXE);
+/// either way, keep the TXE interrupt on exactly while bytes are waiting (on silicon
+/// it fires once the critical section ends and sends them). One function for
+/// [`log_frame`] and [`drain`] (flash).
+#[inline(never)]
+fn pump(cs: &CriticalSection, feed: bool) {
     let Some(usart3) = USART3.get(cs) else {
         return;
     };
     let mut ring = RING.borrow(cs).borrow_mut();
-    while usart3.sr().read().txe().bit_is_set() {
+    while feed && usart3.sr().read().txe().bit_is_set() {
         match ring.pop() {
             Some(byte) => {
                 usart3.dr().write(|w| w.dr().set(u16::from(byte)));
@@ -103,20 +106,12 @@ fn pump(cs: &CriticalSection) {
     usart3.cr1().modify(|_, w| w.txeie().bit(waiting));
 }
 
-/// Turn the TXE interrupt on (bytes are waiting): on silicon it fires once the critical
-/// section ends and `pump` sends them.
-fn start(cs: &CriticalSection) {
-    if let Some(usart3) = USART3.get(cs) {
-        usart3.cr1().modify(|_, w| w.txeie().set_bit());
-    }
-}
-
 /// Send what the ring holds while TXE is set, from thread mode, outside the control
 /// tick: what sends the log under QEMU (no TXE interrupt there); on silicon a check.
 /// The same work as the interrupt's.
 #[inline(never)]
 pub fn drain() {
-    interrupt::free(pump);
+    interrupt::free(|cs| pump(cs, true));
 }
 
 /// USART3 interrupt: room in the transmitter.

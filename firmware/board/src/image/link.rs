@@ -4,7 +4,6 @@ use sweephold_firmware::FrameSink;
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{encode, Decoder, Frame, FrameError, MAX_FRAME_LEN};
 
-use crate::chip::logport;
 use crate::chip::usart::{UsartRx, UsartTx};
 
 /// Bytes taken from the receive ring per decoder pass.
@@ -51,17 +50,13 @@ pub fn send(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) -> bool
     tx.queue_encoded(frame, scratch)
 }
 
-/// Encode `frame` (in `scratch`) and queue it through the blocking
-/// [`embedded_io::Write`] of [`UsartTx`]: waits for room in the ring (at most the time
-/// the line needs to drain it, ~22 ms for 1 KiB at 460 800 Bd) instead of dropping the
-/// frame.
+/// Encode `frame` (in `scratch`) and queue it whole, waiting for room in the ring
+/// ([`UsartTx::queue_frame_waiting`]) instead of dropping the frame.
 pub fn send_waiting(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) {
     // Encoded with interrupts enabled; only the copy into the ring masks them.
     if let Ok(len) = encode(frame, scratch) {
         if let Some(bytes) = scratch.get(..len) {
-            logport::log_frame(bytes);
-            // Infallible, and `write` never returns Ok(0) for a non-empty buffer.
-            let _ = embedded_io::Write::write_all(tx, bytes);
+            tx.queue_frame_waiting(bytes);
         }
     }
 }
