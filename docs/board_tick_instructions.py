@@ -34,8 +34,9 @@ The UARTs' byte pumps are outside the calls by construction, as on the board: a 
 only copies its frames into the link and log rings and turns the TXE interrupts on; the
 interrupts send the bytes on the board, and under QEMU (whose USART never raises TXE)
 the image's loop sends them from thread mode after the timer tick, outside both calls
-(`firmware/board/src/chip/usart.rs`). The script checks this: a call that executed a
-pump instruction is listed (only a full transmit ring makes the blocking write pump).
+(`firmware/board/src/chip/usart.rs`). The script checks this: it counts the calls that
+stored a byte into a USART's data register (only a full transmit ring makes a waiting
+writer do so).
 
 `TICK_SYMBOLS=N` in the environment also lists the N symbols the pilot-mode control
 tick's instructions run in, per tick (inlined code counts in its caller; the memory
@@ -114,15 +115,31 @@ NOT_THE_BOARDS = re.compile(
     r"floatsidf|floatdidf|^(TIM5|USART1|USART2|USART3)$|on_interrupt|ByteRing\$LT\$_\$GT\$4push$")
 
 
-# The UART byte pumps: never inside a call unless a full transmit ring makes the
-# blocking write wait (see the module's doc).
+# The UARTs' pumps: inside a call they only turn the TXE interrupt on; a byte sent
+# inside one is a store to a data register (USART_DR, offset 4) in them, which happens
+# only when a full transmit ring makes a waiting writer feed it (see the module's doc).
 PUMPS = re.compile(r"usart4pump|logport4pump")
+
+
+def data_register_stores(image):
+    """Addresses of the pumps' stores to a USART's data register."""
+    listing = subprocess.run(["llvm-objdump", "-d", "--no-show-raw-insn", image],
+                             capture_output=True, text=True, check=True).stdout
+    stores, inside = set(), False
+    for line in listing.splitlines():
+        if line.endswith(">:"):
+            inside = bool(PUMPS.search(line))
+        elif inside and re.search(r"\bstrh(\.w)?\s+\w+, \[\w+, #4\]", line):
+            stores.add(int(line.split(":")[0], 16))
+    if len(stores) != 2:
+        sys.exit(f"expected one data-register store in each pump, found {len(stores)}")
+    return stores
 
 
 MEMORY_BUILTINS = re.compile(r"memcpy|memclr|memset|memmove")
 
 
-def count(log, functions, phase, result, by_symbol):
+def count(log, functions, phase, result, by_symbol, stores):
     """Per call of each function: (phase at entry, instructions, instructions that are
     not the board's, see NOT_THE_BOARDS). The functions do not nest. `by_symbol`, when
     not None, adds up the board's instructions of the pilot-mode control ticks by the
@@ -150,7 +167,7 @@ def count(log, functions, phase, result, by_symbol):
         if is_foreign:
             emulated += 1
         else:
-            if PUMPS.search(symbol):
+            if PUMPS.search(symbol) and pc_of(line) in stores:
                 pumped += 1
             if by_symbol is not None and started == "pilot" and active[0] == "control_tick":
                 # The memory builtins by their caller: which copy or clear it is.
@@ -198,7 +215,8 @@ def main():
              "-singlestep", "-d", "exec,nochain", "-D", fifo],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         log = open(fifo, errors="replace")
-        reader = threading.Thread(target=count, args=(log, functions, phase, result, by_symbol))
+        reader = threading.Thread(target=count, args=(log, functions, phase, result, by_symbol,
+                                                         data_register_stores(image)))
         reader.start()
         link, _ = servers[0].accept()
         sbus, _ = servers[1].accept()
@@ -233,12 +251,12 @@ def main():
                 print(f"{name} ({mode}): no calls traced")
                 continue
             totals = sorted(n - e for n, e, _ in calls)
-            pumped = [u for _, _, u in calls if u > 0]
+            sent = [u for _, _, u in calls if u > 0]
             emulated = statistics.median(e for _, e, _ in calls)
             print(f"{name} ({mode}): {len(calls)} calls, the board's instructions min {totals[0]} "
                   f"median {statistics.median(totals):.0f} max {totals[-1]} (emulator and "
-                  f"interrupts besides: median {emulated:.0f}); calls with UART byte pumps: "
-                  f"{len(pumped)}" + (f" ({sum(pumped)} instructions)" if pumped else ""))
+                  f"interrupts besides: median {emulated:.0f}); calls that sent UART bytes: "
+                  f"{len(sent)}" + (f" ({sum(sent)} bytes)" if sent else ""))
     if by_symbol is not None:
         # TICK_SYMBOLS=N: where the pilot-mode control tick's instructions go, per tick.
         ticks = sum(1 for f, p, *_ in result if f == "control_tick" and p == "pilot") or 1

@@ -13,7 +13,7 @@
 //! Sample cost ~550 instructions per ring, measured with `docs/board_tick_instructions.py`
 //! `TICK_SYMBOLS`); the Cortex-M4 loads and stores words at any address (LDR/STR,
 //! unaligned access is not trapped by default), which the loop does: a pilot-mode control
-//! tick's copies (its Sample into both rings, the SBUS bytes out of theirs) took 385
+//! tick's copies (its Sample into both rings, the SBUS bytes out of theirs) took 373
 //! instructions against the library's 1 177. (No crate for it: the alternative is that `memcpy`,
 //! from `compiler_builtins`, which cannot assume unaligned access on every ARM target;
 //! `bbqueue`-style grants, encoding straight into the ring, would save one of the two
