@@ -161,7 +161,7 @@ fn bad_configuration_is_refused_up_front() {
 }
 
 /// The paper's comparison on shortened (20 s) lateral records over three seeds: conditional
-/// attitude hold flies without an abort inside 10°, and decorrelates the controls far
+/// attitude hold flies without an abort within 10° of trim, and decorrelates the controls far
 /// better than the standard feedback loop.
 ///
 /// Measured (seeds 1–3, mean of the six lateral records, four-period coherence windows):
@@ -185,17 +185,15 @@ fn conditional_hold_decorrelates_the_controls() {
                     run.file, run.abort_reason
                 );
                 if mode == "cah" {
+                    // Within 10° of the trim the record captured (the presets measure the
+                    // hold's thresholds from it).
+                    let from_trim = run.max_from_trim_deg.as_ref().expect("a captured trim");
                     assert!(
-                        run.max_abs_deg.phi <= 10.0,
-                        "{}: |phi| {}",
+                        from_trim.phi <= 10.0 && from_trim.theta <= 10.0,
+                        "{}: |phi|, |theta| from trim {}, {}",
                         run.file,
-                        run.max_abs_deg.phi
-                    );
-                    assert!(
-                        run.max_abs_deg.theta <= 10.0,
-                        "{}: |theta| {}",
-                        run.file,
-                        run.max_abs_deg.theta
+                        from_trim.phi,
+                        from_trim.theta
                     );
                 }
                 values.push(run.cross_coherence["lon"]);

@@ -93,10 +93,12 @@ fn the_six_dof_from_an_equation_error_start_with_trim_points_is_recovered_or_ref
         ])
     };
 
-    // Seed 1: the search lands outside (X_ped, Z_ped, X_col of 10⁶–10¹¹); held at their
-    // starts, the fit gives a model inside every range, the held ones reported.
+    // Seed 5: the search lands outside (X_ped, M_ped, M_lat, L_col of 10⁵–10⁶ among 14);
+    // held at their starts, the fit gives a model inside every range, the held ones
+    // reported. (Of fit seeds 1–8 on this campaign, 5 and 8 are recovered so, the others
+    // refused as seed 3 below.)
     let model = dir.0.join("m6.json");
-    let run = fit("1", &model);
+    let run = fit("5", &model);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert_eq!(
         run.status.code(),

@@ -31,7 +31,11 @@ fn every_verb_that_prints_fails_in_one_line_when_stdout_is_full() {
     let dir = scratch("full");
     let campaign = sweephold(
         &dir,
-        &["campaign", "--quick", "--quiet", "--out", "c"],
+        // Seed 2: its responses fit the 6-DOF from the file's start (the quick campaign of
+        // seed 1 lands in a degenerate minimum, which is refused before anything prints).
+        &[
+            "campaign", "--quick", "--quiet", "--seed", "2", "--out", "c",
+        ],
         Stdio::piped(),
     );
     assert!(

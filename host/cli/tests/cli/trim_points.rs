@@ -154,12 +154,16 @@ fn fit(frf: &std::path::Path, model: &str, extra: &[&str]) -> (Option<i32>, Stri
     )
 }
 
-/// The quick campaign's responses and the simulator's trim points, in `dir`.
+/// The quick campaign's responses (seed 4) and the simulator's trim points, in `dir`.
+/// Seed 4: the 6-DOF with these points lands in a degenerate minimum that holding its
+/// parameters recovers (on seeds 1–3 the held runs land outside too and are refused).
 fn quick_campaign_and_trim_points(dir: &TempDir) -> (PathBuf, PathBuf) {
     let campaign = dir.0.join("c");
     let out = sweephold(&[
         "campaign",
         "--quick",
+        "--seed",
+        "4",
         "--vehicle",
         "bo105",
         "--out",
@@ -193,7 +197,7 @@ fn degenerate_fits_and_points_that_cannot_inform_are_never_a_success() {
     let (frf, points) = quick_campaign_and_trim_points(&dir);
 
     // The 6-DOF with the simulator's own points: its search lands in a degenerate minimum
-    // (X_ped, Z_ped of 10⁶–10⁹, and the balance then gives speed derivatives of 10¹⁴);
+    // (Z_ped, X_col, M_lat of 10⁵–10⁸ among ten);
     // the fit holds those parameters at their starts and runs again: a model whose
     // derived speed derivatives are of a helicopter's size, the held ones recorded.
     let model = dir.0.join("m6.json");
