@@ -30,12 +30,25 @@ What the board does not run is counted apart (`NOT_THE_BOARDS`): the emulated ch
 sampling, and its SPI transaction, which stands in for SPI1's 14-byte exchange) and the
 interrupt handlers that land inside a call.
 
+The UARTs' byte pumps are outside the calls by construction, as on the board: a call
+only copies its frames into the link and log rings and turns the TXE interrupts on; the
+interrupts send the bytes on the board, and under QEMU (whose USART never raises TXE)
+the image's loop sends them from thread mode after the timer tick, outside both calls
+(`firmware/board/src/chip/usart.rs`). The script checks this: it counts the calls that
+stored a byte into a USART's data register (only a full transmit ring makes a waiting
+writer do so).
+
+`TICK_SYMBOLS=N` in the environment also lists the N symbols the pilot-mode control
+tick's instructions run in, per tick (inlined code counts in its caller; the memory
+builtins by their caller), for profiling against `llvm-objdump -d`.
+
 Each is reported by board-application mode as the Samples show it: before arming
 (disarmed, calibrated) and in the stabilised pilot mode.
 
 Measured: see docs/performance.md.
 """
 
+import collections
 import os
 import re
 import socket
@@ -99,17 +112,38 @@ def bounds(image, name):
 # of them land than on the board).
 NOT_THE_BOARDS = re.compile(
     r"emulator|before_poll|df3|__aeabi_f2d|__aeabi_d2f|__aeabi_d|dcmp|[fF]ixdf|floatun.idf|"
-    r"floatsidf|floatdidf|^(TIM5|USART1|USART2|USART3)$|on_interrupt|ByteRing.*push")
+    r"floatsidf|floatdidf|^(TIM5|USART1|USART2|USART3)$|on_interrupt|ByteRing\$LT\$_\$GT\$4push$")
 
 
-# The UART byte pumps: QEMU's USART model always reads TXE set, so a whole frame leaves
-# from thread mode inside the call; on the board the TXE interrupts send it between ticks.
+# The UARTs' pumps: inside a call they only turn the TXE interrupt on; a byte sent
+# inside one is a store to a data register (USART_DR, offset 4) in them, which happens
+# only when a full transmit ring makes a waiting writer feed it (see the module's doc).
 PUMPS = re.compile(r"usart4pump|logport4pump")
 
 
-def count(log, functions, phase, result):
+def data_register_stores(image):
+    """Addresses of the pumps' stores to a USART's data register."""
+    listing = subprocess.run(["llvm-objdump", "-d", "--no-show-raw-insn", image],
+                             capture_output=True, text=True, check=True).stdout
+    stores, inside = set(), False
+    for line in listing.splitlines():
+        if line.endswith(">:"):
+            inside = bool(PUMPS.search(line))
+        elif inside and re.search(r"\bstrh(\.w)?\s+\w+, \[\w+, #4\]", line):
+            stores.add(int(line.split(":")[0], 16))
+    if len(stores) != 2:
+        sys.exit(f"expected one data-register store in each pump, found {len(stores)}")
+    return stores
+
+
+MEMORY_BUILTINS = re.compile(r"memcpy|memclr|memset|memmove")
+
+
+def count(log, functions, phase, result, by_symbol, stores):
     """Per call of each function: (phase at entry, instructions, instructions that are
-    not the board's, see NOT_THE_BOARDS). The functions do not nest."""
+    not the board's, see NOT_THE_BOARDS). The functions do not nest. `by_symbol`, when
+    not None, adds up the board's instructions of the pilot-mode control ticks by the
+    symbol they execute in (inlined code counts in its caller)."""
     entries = {f"/{entry:08x}/": (name, entry, exit_pc) for name, (entry, exit_pc) in functions.items()}
     active = None
     foreign = {}
@@ -120,6 +154,7 @@ def count(log, functions, phase, result):
             for field, spec in entries.items():
                 if field in line and pc_of(line) == spec[1]:
                     active, n, emulated, pumped, started = spec, 0, 0, 0, phase[0]
+                    caller = None
                     break
             else:
                 continue
@@ -131,8 +166,16 @@ def count(log, functions, phase, result):
             is_foreign = foreign[symbol] = bool(NOT_THE_BOARDS.search(symbol))
         if is_foreign:
             emulated += 1
-        elif PUMPS.search(symbol):
-            pumped += 1
+        else:
+            if PUMPS.search(symbol) and pc_of(line) in stores:
+                pumped += 1
+            if by_symbol is not None and started == "pilot" and active[0] == "control_tick":
+                # The memory builtins by their caller: which copy or clear it is.
+                if MEMORY_BUILTINS.search(symbol):
+                    by_symbol[f"{symbol} <- {caller}"] += 1
+                else:
+                    by_symbol[symbol] += 1
+                    caller = symbol
         if f"/{active[2]:08x}/" in line and pc_of(line) == active[2]:
             result.append((active[0], started, n, emulated, pumped))
             active = None
@@ -148,6 +191,7 @@ def main():
     }
     phase = ["calibrating"]
     result = []
+    by_symbol = collections.Counter() if os.environ.get("TICK_SYMBOLS") else None
     with tempfile.TemporaryDirectory() as folder:
         fifo = os.path.join(folder, "exec.log")
         os.mkfifo(fifo)
@@ -171,7 +215,8 @@ def main():
              "-singlestep", "-d", "exec,nochain", "-D", fifo],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         log = open(fifo, errors="replace")
-        reader = threading.Thread(target=count, args=(log, functions, phase, result))
+        reader = threading.Thread(target=count, args=(log, functions, phase, result, by_symbol,
+                                                         data_register_stores(image)))
         reader.start()
         link, _ = servers[0].accept()
         sbus, _ = servers[1].accept()
@@ -206,11 +251,18 @@ def main():
                 print(f"{name} ({mode}): no calls traced")
                 continue
             totals = sorted(n - e for n, e, _ in calls)
-            unpumped = statistics.median(n - e - u for n, e, u in calls)
+            sent = [u for _, _, u in calls if u > 0]
             emulated = statistics.median(e for _, e, _ in calls)
             print(f"{name} ({mode}): {len(calls)} calls, the board's instructions min {totals[0]} "
-                  f"median {statistics.median(totals):.0f} max {totals[-1]}; median without the "
-                  f"UART byte pumps {unpumped:.0f} (emulator and interrupts besides: median {emulated:.0f})")
+                  f"median {statistics.median(totals):.0f} max {totals[-1]} (emulator and "
+                  f"interrupts besides: median {emulated:.0f}); calls that sent UART bytes: "
+                  f"{len(sent)}" + (f" ({sum(sent)} bytes)" if sent else ""))
+    if by_symbol is not None:
+        # TICK_SYMBOLS=N: where the pilot-mode control tick's instructions go, per tick.
+        ticks = sum(1 for f, p, *_ in result if f == "control_tick" and p == "pilot") or 1
+        print(f"control_tick (pilot), instructions per tick by symbol ({ticks} ticks):")
+        for name, k in by_symbol.most_common(int(os.environ["TICK_SYMBOLS"])):
+            print(f"  {k / ticks:8.1f} {name}")
 
 
 if __name__ == "__main__":

@@ -19,11 +19,12 @@ interrupts included (over semihosting the image masks the loop timer's interrupt
 host is the clock). The run is pinned to one CPU so one QEMU flies every record.
 
 Output: ticks traced; min / median / max instructions per tick; the same without the
-framing symbols (encode, COBS, CRC, ring); the eight symbols with the most instructions
+framing symbols (encode, COBS, CRC, the queuing and the copies into the link and log
+rings); the eight symbols with the most instructions
 per tick. TICK_PCS=N in the environment also lists the N most executed instructions
 (address and symbol, per tick), for profiling against `llvm-objdump -d`.
 
-Measured (2026-11-21, lateral sweep campaign `--t-rec 10 --seed 5`, 6 022 ticks): min 3 123,
+Latest figures: docs/performance.md. First measured (2026-11-21, lateral sweep campaign `--t-rec 10 --seed 5`, 6 022 ticks): min 3 123,
 median 4 277, max 13 219 (the max is a tick with log lines and events); without framing
 median 1 928; lateral doublet (--input doublet --seed 6) median 4 178. Before the f32
 sweep phase and the one-pass framing: median 20 651.
@@ -38,7 +39,7 @@ import sys
 import tempfile
 import threading
 
-FRAMING = re.compile(r"codec|queue_frame|send_waiting|[Ss]erializ|cobs|crc|postcard|usart|board4link")
+FRAMING = re.compile(r"codec|queue_frame|queue_encoded|send_waiting|[Ss]erializ|cobs|crc|postcard|usart|logport|ring4copy|ByteRing|board4link")
 
 
 def step_bounds(image):

@@ -151,10 +151,15 @@ impl Gains {
     /// trex700l` flies every default record without an abort. Re-tune on the real
     /// aircraft before flight.
     ///
-    /// Release fade τ_r = 0.3 s on roll and pitch: the output a hold leaves behind at
-    /// release is mostly its restoring command, and on an airframe this quick a fade of
-    /// 1 s carried it through trim and out beyond the engage angle on the other side
-    /// (cah excursions 9.7–12.1° from trim over seeds 1–10; 8.7–9.5° with 0.3 s).
+    /// Release fade τ_r = 0.8 s on roll and pitch: the output a hold leaves behind at
+    /// release is mostly its restoring command. A short fade (0.3 s) hands the steps the
+    /// cross-control coherence measures back into both held axes (cah lat–lon 0.279 over
+    /// seeds 1–10); a long one alone carried the aircraft through trim and beyond the
+    /// engage angle on the other side (1 s: excursions to 10.6° from trim). With the
+    /// preset's narrower hysteresis (engage 4.5°, release 3°) and the holds' share slewed
+    /// at 3.6 /s ([`crate::config::TREX700L_HOLD_SLEW`]), 0.8 s gives 0.240 with every
+    /// excursion within 9.2°
+    /// (docs/decisions/2026-11-27-trex-cah-coherence-release.md).
     ///
     /// Heading: N_ped ≈ 80 rad/s² per stick, and the pedal slews at 4 /s. With Kp 1.5,
     /// Kd 0.3 and ±0.3 of authority the heading hold needed 0.15 s to reverse its
@@ -172,7 +177,7 @@ impl Gains {
                 integrator_limit: 0.3,
                 reversed: false,
                 bumpless_time_s: 0.05,
-                release_time_s: 0.3,
+                release_time_s: 0.8,
             },
             lon: AxisGains {
                 kp: 2.0,
@@ -182,7 +187,7 @@ impl Gains {
                 integrator_limit: 0.3,
                 reversed: false,
                 bumpless_time_s: 0.05,
-                release_time_s: 0.3,
+                release_time_s: 0.8,
             },
             ped: AxisGains {
                 kp: 0.6,

@@ -12,8 +12,13 @@ const PILOT: [f32; 4] = [0.05, -0.1, 0.02, 0.3];
 
 /// Bo-105 lateral sweep shortened for tests: 10 s record (flagged short), 0.5 s fades,
 /// 0.1 s trim capture.
+/// The Bo-105 preset with a short record and the paper's hold thresholds (6° / 4° from
+/// level), which the rule tests below are written in.
 fn short_config() -> Config {
     let mut config = Config::bo105_default(Axis::Lat);
+    config.test.hold_engage_rad = 6.0 * DEG;
+    config.test.hold_release_rad = 4.0 * DEG;
+    config.hold_reference = HoldReference::Level;
     config.test.sweep.t_rec_s = 10.0;
     config.test.sweep.fade_s = 0.5;
     config.trim_capture_s = 0.1;
@@ -416,7 +421,7 @@ fn hold_slew_limits_must_be_positive() {
     assert_eq!(Config::bo105_default(Axis::Lat).hold_slew, HoldSlew::NONE);
     assert_eq!(
         Config::trex700l_default(Axis::Lat).hold_slew,
-        HoldSlew::NONE
+        crate::config::TREX700L_HOLD_SLEW
     );
 }
 

@@ -1,11 +1,23 @@
 //! A fixed-size byte ring that moves slices, not bytes.
 //!
 //! The USART's transmit ring takes a whole frame (~130 bytes) per call and the semihosting
-//! link drains it in blocks: copying with at most two `copy_from_slice` per call (the
-//! part before the wrap and the part after) costs a memcpy instead of a bounds-checked
+//! link drains it in blocks: copying with at most two block copies per call (the
+//! part before the wrap and the part after) costs a word loop instead of a bounds-checked
 //! push per byte (heapless `Deque::push_back` in a loop: ~16 instructions a byte).
 //! Indices stay in [0, N) and the stored length in [0, N]; every access goes through
 //! `get`/`get_mut`, so nothing can panic.
+//!
+//! The copies themselves are [`copy`]'s word loop, not `copy_from_slice`: a frame lands
+//! at whatever offset the ring's tail has, so source and destination are rarely aligned
+//! alike, and the library `memcpy` then takes its misaligned path (shifts and merges, a
+//! Sample cost ~550 instructions per ring, measured with `docs/board_tick_instructions.py`
+//! `TICK_SYMBOLS`); the Cortex-M4 loads and stores words at any address (LDR/STR,
+//! unaligned access is not trapped by default), which the loop does: a pilot-mode control
+//! tick's copies (its Sample into both rings, the SBUS bytes out of theirs) took 373
+//! instructions against the library's 1 177. (No crate for it: the alternative is that `memcpy`,
+//! from `compiler_builtins`, which cannot assume unaligned access on every ARM target;
+//! `bbqueue`-style grants, encoding straight into the ring, would save one of the two
+//! copies but not the other, the log's, and are not done.)
 
 /// Ring of `N` bytes (`N` > 0).
 pub struct ByteRing<const N: usize> {
@@ -45,10 +57,10 @@ impl<const N: usize> ByteRing<N> {
         let (before_wrap, after_wrap) = data.split_at(first.min(data.len()));
         let after_wrap = after_wrap.get(..count - first).unwrap_or(&[]);
         if let Some(slot) = self.bytes.get_mut(tail..tail + first) {
-            slot.copy_from_slice(before_wrap);
+            copy(slot, before_wrap);
         }
         if let Some(slot) = self.bytes.get_mut(..after_wrap.len()) {
-            slot.copy_from_slice(after_wrap);
+            copy(slot, after_wrap);
         }
         self.len += count;
         count
@@ -60,11 +72,11 @@ impl<const N: usize> ByteRing<N> {
         let first = count.min(N - self.head);
         let (before_wrap, after_wrap) = out.split_at_mut(first.min(out.len()));
         if let Some(stored) = self.bytes.get(self.head..self.head + first) {
-            before_wrap.copy_from_slice(stored);
+            copy(before_wrap, stored);
         }
         let rest = count - first;
         if let (Some(slot), Some(stored)) = (after_wrap.get_mut(..rest), self.bytes.get(..rest)) {
-            slot.copy_from_slice(stored);
+            copy(slot, stored);
         }
         self.len -= count;
         // An empty ring starts over at 0, so its bytes stay in one piece as long as
@@ -95,9 +107,22 @@ impl<const N: usize> ByteRing<N> {
         byte
     }
 
-    /// Append one byte; `false` when full.
+    /// Append one byte; `false` when full. Direct, not through
+    /// [`push_slice`](Self::push_slice): the receive interrupts push one byte at a time
+    /// (and `docs/board_tick_instructions.py` tells their work from a tick's by symbol).
     pub fn push(&mut self, byte: u8) -> bool {
-        self.push_slice(&[byte]) == 1
+        if self.len >= N {
+            return false;
+        }
+        let tail = (self.head + self.len) % N;
+        match self.bytes.get_mut(tail) {
+            Some(slot) => {
+                *slot = byte;
+                self.len += 1;
+                true
+            }
+            None => false,
+        }
     }
 
     /// Append `frame`, one whole COBS frame ending in its `0x00` delimiter, dropping the
@@ -138,6 +163,38 @@ impl<const N: usize> ByteRing<N> {
             }
             self.len += 1;
         }
+    }
+}
+
+/// Copy `src` into `dst` (the shorter length of the two) a 32-bit word at a time,
+/// whatever the alignment of either, then the last bytes. It compiles to one LDR and
+/// one STR a word (`llvm-objdump -d`); were the optimiser ever to turn it back into a
+/// `memcpy` call, `docs/board_tick_instructions.py`'s `TICK_SYMBOLS` would show it.
+fn copy(dst: &mut [u8], src: &[u8]) {
+    let len = dst.len().min(src.len());
+    let (dst, src) = (
+        dst.get_mut(..len).unwrap_or(&mut []),
+        src.get(..len).unwrap_or(&[]),
+    );
+    let mut dst_words = dst.chunks_exact_mut(4);
+    let mut src_words = src.chunks_exact(4);
+    for (to, from) in (&mut dst_words).zip(&mut src_words) {
+        to.copy_from_slice(&word(from).to_ne_bytes());
+    }
+    for (to, from) in dst_words
+        .into_remainder()
+        .iter_mut()
+        .zip(src_words.remainder())
+    {
+        *to = *from;
+    }
+}
+
+/// The four bytes of `bytes` as one word (a single unaligned load on the Cortex-M4).
+fn word(bytes: &[u8]) -> u32 {
+    match bytes {
+        [a, b, c, d] => u32::from_ne_bytes([*a, *b, *c, *d]),
+        _ => 0,
     }
 }
 
@@ -244,6 +301,37 @@ mod tests {
         let mut out = [0u8; 8];
         let count = ring.pop_slice(&mut out);
         assert_eq!(&out[..count], &[0, 4, 5, 0, 6, 7, 8, 0]);
+    }
+
+    /// The word copy against `copy_from_slice` at every alignment of either side and
+    /// every length up to three pairs of words, and with unequal lengths.
+    #[test]
+    fn word_copy_copies_every_byte_at_any_alignment() {
+        let source: Vec<u8> = (0..64u8)
+            .map(|i| i.wrapping_mul(37).wrapping_add(1))
+            .collect();
+        for src_offset in 0..4 {
+            for dst_offset in 0..4 {
+                for len in 0..=26 {
+                    let mut got = vec![0xAAu8; 40];
+                    let mut expected = got.clone();
+                    let from = &source[src_offset..src_offset + len];
+                    super::copy(&mut got[dst_offset..dst_offset + len], from);
+                    expected[dst_offset..dst_offset + len].copy_from_slice(from);
+                    assert_eq!(
+                        got, expected,
+                        "src +{src_offset} dst +{dst_offset} len {len}"
+                    );
+                }
+            }
+        }
+        let mut short = [0u8; 5];
+        super::copy(&mut short, &source[..20]);
+        assert_eq!(short, source[..5]);
+        let mut long = [0u8; 20];
+        super::copy(&mut long, &source[..11]);
+        assert_eq!(long[..11], source[..11]);
+        assert_eq!(long[11..], [0; 9]);
     }
 
     #[test]

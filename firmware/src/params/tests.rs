@@ -60,7 +60,7 @@ fn the_defaults_are_the_presets_bit_for_bit() {
         ("CYC_RING", 1.5),
         ("HEAD_RPM", 2100.0),
         ("TAIL_RPM", 9600.0),
-        ("HOLD_ENGAGE", 6.0),
+        ("HOLD_ENGAGE", 4.5),
         ("ABORT_RATE_Y", 250.0),
         ("RC_MODE", 8.0),
         ("IMU_ROT", 0.0),

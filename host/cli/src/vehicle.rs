@@ -243,9 +243,9 @@ mod tests {
         assert_eq!(trex.trim_balance(), TrimBalance::Joint);
         assert_eq!(trex.range_source(), RangeSource::Estimate);
         assert_eq!(trex.servos(), rotorsim::SimOptions::default().actuator);
-        // The third flies the TREX's preset with the gains, cyclic excitation and slew
-        // limits its file states (the holds' share limited, the whole command not), and
-        // the preset's everything else.
+        // The third flies the TREX's preset with the gains, cyclic excitation, slew
+        // limits (the holds' share limited, the whole command not), hysteresis and
+        // release fades its file states, and the preset's everything else.
         let fbl = Vehicle::shipped("fbl700");
         assert_eq!(fbl.preset(), VehicleId::Trex700l);
         let own = fbl.firmware_config(Axis::Lat);
@@ -253,6 +253,10 @@ mod tests {
         expected.excitation_scale.per_axis = [0.7, 0.7, 0.2, 1.0];
         expected.slew = sweephold_firmware::slew::CommandSlew::NONE;
         expected.hold_slew.per_s = [3.6, 3.6, 4.0];
+        expected.test.hold_engage_rad = 6.0_f32.to_radians();
+        expected.test.hold_release_rad = 4.0_f32.to_radians();
+        expected.gains.lat.release_time_s = 0.3;
+        expected.gains.lon.release_time_s = 0.3;
         for (gains, [kp, ki, kd]) in [
             (&mut expected.gains.lat, [2.12, 0.07, 0.113]),
             (&mut expected.gains.lon, [2.94, 0.074, 0.22]),

@@ -3,7 +3,9 @@
 //! `sweephold decode` then reads as it reads a dump.
 //!
 //! The log never blocks the loop: a frame is copied into a 4 KiB ring (a short critical
-//! section: the copy, never the encoding) that the TXE interrupt drains at the line rate.
+//! section: the copy, never the encoding) that the TXE interrupt drains at the line rate
+//! (under QEMU, which never raises it, the loop's [`drain`] after each timer tick does,
+//! as for the link: see [`crate::chip::usart`]).
 //! When the logger falls behind, the oldest frames make room for the newest
 //! ([`ByteRing::push_frame_dropping_oldest`]); the drops are counted ([`dropped`]) and
 //! the file then lacks those frames (a frame that was being sent leaves one cut frame,
@@ -69,7 +71,7 @@ pub fn log_frame(bytes: &[u8]) {
             .borrow(cs)
             .borrow_mut()
             .push_frame_dropping_oldest(bytes);
-        pump(cs);
+        pump(cs, false);
         dropped
     });
     if dropped > 0 {
@@ -82,14 +84,17 @@ pub fn dropped() -> u32 {
     DROPPED.load(Ordering::Relaxed)
 }
 
-/// Feed the data register while it has room; the TXE interrupt stays on exactly while
-/// bytes are waiting.
-fn pump(cs: &CriticalSection) {
+/// With `feed`, write bytes from the ring while the data register has room (TXE);
+/// either way, keep the TXE interrupt on exactly while bytes are waiting (on silicon
+/// it fires once the critical section ends and sends them). One function for
+/// [`log_frame`] and [`drain`] (flash).
+#[inline(never)]
+fn pump(cs: &CriticalSection, feed: bool) {
     let Some(usart3) = USART3.get(cs) else {
         return;
     };
     let mut ring = RING.borrow(cs).borrow_mut();
-    while usart3.sr().read().txe().bit_is_set() {
+    while feed && usart3.sr().read().txe().bit_is_set() {
         match ring.pop() {
             Some(byte) => {
                 usart3.dr().write(|w| w.dr().set(u16::from(byte)));
@@ -101,9 +106,17 @@ fn pump(cs: &CriticalSection) {
     usart3.cr1().modify(|_, w| w.txeie().bit(waiting));
 }
 
+/// Send what the ring holds while TXE is set, from thread mode, outside the control
+/// tick: what sends the log under QEMU (no TXE interrupt there); on silicon a check.
+/// The same work as the interrupt's.
+#[inline(never)]
+pub fn drain() {
+    interrupt::free(|cs| pump(cs, true));
+}
+
 /// USART3 interrupt: room in the transmitter.
 pub fn on_interrupt() {
-    interrupt::free(pump);
+    drain();
 }
 
 /// Stop the log's interrupt (panic path).

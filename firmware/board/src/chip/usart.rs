@@ -1,15 +1,19 @@
 //! USART1: the telemetry and in-the-loop link, interrupt-driven, with byte rings.
 //!
 //! Pins: the board map's `link_tx` / `link_rx` (alternate function 7); 8N1 at [`BAUD`], no flow control.
-//! The transmitter side is an [`embedded_io::Write`] ([`UsartTx`]) plus an
-//! all-or-nothing [`UsartTx::queue_frame`] for whole frames; the receiver side is an
+//! The transmitter side is an [`embedded_io::Write`] ([`UsartTx`]) plus whole-frame
+//! queuing: [`UsartTx::queue_frame`] (all or nothing) and
+//! [`UsartTx::queue_frame_waiting`] (waits for room); the receiver side is an
 //! [`embedded_io::Read`] + [`embedded_io::ReadReady`] ([`UsartRx`]).
 //!
-//! Transmit path: bytes go into a ring; the data register is fed whenever TXE is set,
-//! both right after queuing (from thread mode) and from the TXE interrupt. Feeding from
-//! thread mode matters in QEMU: its USART model writes each byte out at once, always
-//! reads TXE as set and never raises the TXE interrupt, so there the ring drains while
-//! it is being filled; on silicon the TXE interrupt drains it at the line rate.
+//! Transmit path: queuing a frame copies it into a ring and turns the TXE interrupt on;
+//! the interrupt feeds the data register at the line rate, between and during ticks,
+//! so no byte is sent from the tick itself. QEMU's USART model (7.2) writes each byte
+//! out at once, always reads TXE as set and never raises the TXE interrupt: there the
+//! loop empties the ring from thread mode after each timer tick ([`drain`]), outside
+//! the control tick, as the interrupt does on silicon. (A full ring is the one case
+//! where thread mode feeds the register inside a call: the waiting writers,
+//! [`UsartTx::queue_frame_waiting`] and [`embedded_io::Write`], wait for room that way.)
 
 use core::cell::RefCell;
 use core::convert::Infallible;
@@ -44,6 +48,9 @@ pub const BAUD: u32 = 460_800;
 /// Transmit ring [bytes]: several ticks' worth of frames (a tick queues a Sample, an
 /// ActuatorOut and now and then a few Events, each at most `MAX_FRAME_LEN`).
 pub const TX_CAPACITY: usize = 1024;
+
+// Every frame fits the ring whole, so `queue_frame_waiting` always ends.
+const _: () = assert!(MAX_FRAME_LEN <= TX_CAPACITY);
 
 /// Receive ring [bytes]: in the loop the host sends one SensorIn (~80 bytes on the wire)
 /// and waits for the answer, so a few frames' worth is plenty.
@@ -94,9 +101,13 @@ pub fn init(
     ))
 }
 
-/// Feed the data register from the ring while it has room, and keep the TXE interrupt
-/// on exactly while bytes are waiting.
-fn pump(cs: &CriticalSection) {
+/// With `feed`, write bytes from the ring while the data register has room (TXE);
+/// either way, keep the TXE interrupt on exactly while bytes are waiting. Thread mode
+/// queues without `feed` (on silicon the interrupt, enabled here, sends the bytes as
+/// soon as the critical section ends); the interrupt and [`drain`] feed. One function
+/// for both (flash).
+#[inline(never)]
+fn pump(cs: &CriticalSection, feed: bool) {
     if CAPTURED.load(Ordering::Relaxed) {
         return;
     }
@@ -104,7 +115,7 @@ fn pump(cs: &CriticalSection) {
         return;
     };
     let mut ring = TX.borrow(cs).borrow_mut();
-    while usart1.sr().read().txe().bit_is_set() {
+    while feed && usart1.sr().read().txe().bit_is_set() {
         match ring.pop() {
             Some(byte) => {
                 usart1.dr().write(|w| w.dr().set(u16::from(byte)));
@@ -114,6 +125,14 @@ fn pump(cs: &CriticalSection) {
     }
     let waiting = !ring.is_empty();
     usart1.cr1().modify(|_, w| w.txeie().bit(waiting));
+}
+
+/// Send what the ring holds while TXE is set, from thread mode. Called by the loop
+/// after each timer tick, outside the control tick: under QEMU, which never raises the
+/// TXE interrupt, this is what sends the frames; on silicon the interrupt has sent them
+/// already (or TXE reads clear) and this returns after a check.
+pub fn drain() {
+    interrupt::free(|cs| pump(cs, true));
 }
 
 /// Set when the frames leave through semihosting instead of the pin (QEMU only, see
@@ -148,7 +167,7 @@ pub fn on_interrupt() {
                 RX_LOST.fetch_add(1, Ordering::Relaxed);
             }
         }
-        pump(cs);
+        pump(cs, true);
     });
 }
 
@@ -167,25 +186,44 @@ impl UsartTx {
     /// Queue `frame` whole, or drop it whole when the ring lacks room (a partial frame
     /// would only cost the host a corrupt frame too). Returns `false` when dropped.
     pub fn queue_frame(&mut self, frame: &[u8]) -> bool {
+        self.queue(frame, false)
+    }
+
+    /// Queue `frame` whole, waiting for room (at most the time the line needs to drain
+    /// the ring, ~22 ms for 1 KiB at 460 800 Bd) instead of dropping it.
+    pub fn queue_frame_waiting(&mut self, frame: &[u8]) {
+        self.queue(frame, true);
+    }
+
+    /// Queue `frame` whole; with `wait`, feed the transmitter from thread mode until
+    /// the ring has room (on silicon the interrupt makes it; QEMU needs the feed). A
+    /// frame longer than the ring is dropped either way. `false` when dropped.
+    fn queue(&mut self, frame: &[u8], wait: bool) -> bool {
         // Every frame the link carries also goes to the onboard log, whether or not the
         // link has room for it.
         logport::log_frame(frame);
-        let queued = interrupt::free(|cs| {
-            let fits = {
-                let mut ring = TX.borrow(cs).borrow_mut();
-                let fits = ring.room() >= frame.len();
-                if fits {
-                    ring.push_slice(frame);
-                }
+        let wait = wait && frame.len() <= TX_CAPACITY;
+        loop {
+            let queued = interrupt::free(|cs| {
+                let fits = {
+                    let mut ring = TX.borrow(cs).borrow_mut();
+                    let fits = ring.room() >= frame.len();
+                    if fits {
+                        ring.push_slice(frame);
+                    }
+                    fits
+                };
+                pump(cs, wait && !fits);
                 fits
-            };
-            pump(cs);
-            fits
-        });
-        if !queued {
-            self.dropped_frames = self.dropped_frames.wrapping_add(1);
+            });
+            if queued {
+                return true;
+            }
+            if !wait {
+                self.dropped_frames = self.dropped_frames.wrapping_add(1);
+                return false;
+            }
         }
-        queued
     }
 
     /// Queue `frame` without waiting: encoded in `scratch` with interrupts enabled,
@@ -226,7 +264,8 @@ impl embedded_io::Write for UsartTx {
         loop {
             let written = interrupt::free(|cs| {
                 let written = { TX.borrow(cs).borrow_mut().push_slice(buf) };
-                pump(cs);
+                // Full: on silicon the interrupt makes room; QEMU needs the feed.
+                pump(cs, written == 0);
                 written
             });
             if written > 0 {
@@ -239,7 +278,7 @@ impl embedded_io::Write for UsartTx {
     fn flush(&mut self) -> Result<(), Infallible> {
         loop {
             let done = interrupt::free(|cs| {
-                pump(cs);
+                pump(cs, true);
                 TX.borrow(cs).borrow().is_empty()
                     && USART1
                         .get(cs)

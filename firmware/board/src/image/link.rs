@@ -4,7 +4,6 @@ use sweephold_firmware::FrameSink;
 use sweephold_protocol::codec::EncodeError;
 use sweephold_protocol::{encode, Decoder, Frame, FrameError, MAX_FRAME_LEN};
 
-use crate::chip::logport;
 use crate::chip::usart::{UsartRx, UsartTx};
 
 /// Bytes taken from the receive ring per decoder pass.
@@ -44,29 +43,20 @@ impl FrameSink for Telemetry<'_> {
     }
 }
 
-/// Encode `frame` (in `scratch`) and queue it; `false` when it was dropped (ring full)
-/// or could not be encoded (impossible for the protocol's own types with a
-/// `MAX_FRAME_LEN` buffer).
+/// Encode `frame` (in `scratch`) and queue it ([`UsartTx::queue_encoded`]); `false`
+/// when it was dropped (ring full) or could not be encoded (impossible for the
+/// protocol's own types with a `MAX_FRAME_LEN` buffer); either is counted as dropped.
 pub fn send(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) -> bool {
-    match encode(frame, scratch) {
-        Ok(len) => scratch
-            .get(..len)
-            .is_some_and(|bytes| tx.queue_frame(bytes)),
-        Err(_) => false,
-    }
+    tx.queue_encoded(frame, scratch)
 }
 
-/// Encode `frame` (in `scratch`) and queue it through the blocking
-/// [`embedded_io::Write`] of [`UsartTx`]: waits for room in the ring (at most the time
-/// the line needs to drain it, ~22 ms for 1 KiB at 460 800 Bd) instead of dropping the
-/// frame.
+/// Encode `frame` (in `scratch`) and queue it whole, waiting for room in the ring
+/// ([`UsartTx::queue_frame_waiting`]) instead of dropping the frame.
 pub fn send_waiting(tx: &mut UsartTx, scratch: &mut FrameScratch, frame: &Frame) {
     // Encoded with interrupts enabled; only the copy into the ring masks them.
     if let Ok(len) = encode(frame, scratch) {
         if let Some(bytes) = scratch.get(..len) {
-            logport::log_frame(bytes);
-            // Infallible, and `write` never returns Ok(0) for a non-empty buffer.
-            let _ = embedded_io::Write::write_all(tx, bytes);
+            tx.queue_frame_waiting(bytes);
         }
     }
 }

@@ -147,6 +147,9 @@ pub struct Runner {
     /// The board application on the IMU and the receiver.
     stack: Stack,
     sbus: SbusRx,
+    /// The SBUS bytes a control tick takes from the receive ring: kept here, so that a
+    /// tick does not clear a fresh 256-byte stack buffer (~130 instructions).
+    sbus_bytes: [u8; sbus_uart::RX_CAPACITY],
     /// The in-the-loop flight logic.
     fc: FlightController,
     servos: Servos<ServoChannel>,
@@ -222,13 +225,12 @@ impl Runner {
     #[inline(never)]
     fn control_tick(&mut self) {
         self.apply_params();
-        let mut received = [0u8; sbus_uart::RX_CAPACITY];
-        let count = self.sbus.take(&mut received);
+        let count = self.sbus.take(&mut self.sbus_bytes);
         let tick = self.stack.app().flight_controller().tick();
         log::set_tick(tick);
         let out = self.stack.control_tick(
             self.now_us,
-            received.get(..count).unwrap_or(&[]),
+            self.sbus_bytes.get(..count).unwrap_or(&[]),
             &mut Telemetry::new(&mut self.tx, &mut self.scratch),
         );
         // A bench servo test replaces one pulse while disarmed, never armed.
@@ -467,6 +469,7 @@ pub fn run() -> ! {
     let mut runner = Runner {
         stack,
         sbus,
+        sbus_bytes: [0; sbus_uart::RX_CAPACITY],
         fc,
         servos,
         esc,
@@ -516,6 +519,10 @@ pub fn run() -> ! {
         if due > 0 {
             runner.on_timer(due);
         }
+        // What QEMU's USARTs need from thread mode (no TXE interrupt there); on silicon
+        // the interrupts have sent the bytes already.
+        usart::drain();
+        logport::drain();
         // Sleep until the next interrupt, with interrupts masked around the check so
         // one that fires in between still wakes the WFI.
         cortex_m::interrupt::free(|_| {
@@ -569,6 +576,8 @@ fn run_semihosting(mut runner: Runner) -> ! {
 /// Hand everything queued in the transmit ring to the host; ask QEMU to exit if the
 /// host is gone.
 fn send_captured(output: usize) {
+    // The onboard log's UART too, outside the tick (see `crate::chip::usart`).
+    logport::drain();
     let mut outgoing = [0u8; 512];
     loop {
         let count = usart::take_captured(&mut outgoing);
