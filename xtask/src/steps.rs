@@ -120,8 +120,11 @@ pub fn print_report(name: &str, report: std::io::Result<Report>) -> StepResult {
 
 /// The flash and RAM budgets of an image: the boards' STM32F405 has 1 MiB flash and
 /// 192 KiB SRAM; the image keeps to a quarter of the flash and half of the RAM. It fits
-/// far tighter limits today (144 KiB text, 16 KiB static RAM): those are checked too, so
-/// growth shows before it matters.
+/// far tighter limits today (148 KiB text, 16 KiB static RAM): those are checked too, so
+/// growth shows before it matters. The tight flash limit was 144 KiB until table version 7:
+/// the pilot mode's eight gain parameters and their typed view took the SpeedyBee image
+/// from 147 428 B (28 B under it) to 148 236 B, and the gains belong in the table (tuned
+/// per aircraft and pushed, not compiled in); 148 KiB keeps some 3 KiB of warning room.
 pub fn check_budgets(ws: &Workspace, elf: &Path) -> StepResult {
     let output = ws
         .command("size", &[])
@@ -139,7 +142,7 @@ pub fn check_budgets(ws: &Workspace, elf: &Path) -> StepResult {
     print!("{table}");
     let (flash, ram) = flash_and_ram(&table)?;
     println!(
-        "flash text+data {flash} B (limit 262144, tight 147456), static RAM data+bss {ram} B (limit 98304, tight 16384)"
+        "flash text+data {flash} B (limit 262144, tight 151552), static RAM data+bss {ram} B (limit 98304, tight 16384)"
     );
     match over_budget(flash, ram) {
         Some(why) => Err(format!("{}: {why}", elf.display())),
@@ -171,7 +174,7 @@ fn over_budget(flash: u64, ram: u64) -> Option<&'static str> {
     let budgets = [
         (flash, 262_144, "image flash over 256 KiB"),
         (ram, 98_304, "static RAM over 96 KiB"),
-        (flash, 147_456, "image flash over the tight 144 KiB"),
+        (flash, 151_552, "image flash over the tight 148 KiB"),
         (ram, 16_384, "static RAM over the tight 16 KiB"),
     ];
     budgets
@@ -195,8 +198,8 @@ mod tests {
     fn budgets_name_the_first_one_broken() {
         assert_eq!(over_budget(140_880, 7_624), None);
         assert_eq!(
-            over_budget(147_457, 7_624),
-            Some("image flash over the tight 144 KiB")
+            over_budget(151_553, 7_624),
+            Some("image flash over the tight 148 KiB")
         );
         assert_eq!(
             over_budget(140_880, 16_385),

@@ -1,6 +1,6 @@
 //! The board's parameters: one typed table of everything an aircraft owner sets up
 //! (swash type and servos, receiver map, IMU mounting, head speed, hold gains and
-//! thresholds, abort limits, the test), its defaults from the aircraft preset, and the
+//! thresholds, abort limits, the test, the pilot mode's loop gains), its defaults from the aircraft preset, and the
 //! typed view the control code reads.
 //!
 //! * [`table`] — the definitions: name (≤ 16 characters, ArduPilot / Rotorflight
@@ -27,6 +27,8 @@ pub mod link;
 #[cfg(test)]
 pub(crate) mod mock_flash;
 pub mod no_flash;
+#[cfg(test)]
+mod pilot_gains_tests;
 #[cfg(any(test, feature = "std"))]
 pub mod ram_flash;
 pub mod store;

@@ -40,7 +40,8 @@ pub const MAX_NAME_LEN: usize = 16;
 /// source and the airborne rule, version 5 the test list (`TEST_SEL_CH`, `TEST_SEL_N`,
 /// `TEST1_*` … `TEST12_*`), version 6 the holds' slew limits (`HSLEW_*`): a record of
 /// an older version holds no base preset or none of those and boots the defaults.
-pub const TABLE_VERSION: u16 = 6;
+/// Version 7 appended the pilot mode's rate-loop gains and outer-loop gains (`PM_*`).
+pub const TABLE_VERSION: u16 = 7;
 
 /// Swash type codes: H1, 120°, 135°, 140°.
 const SWASH_TYPES: &[f32] = &[0.0, 120.0, 135.0, 140.0];
@@ -57,6 +58,17 @@ const ROTATIONS: &[f32] = &[
 /// included.
 const PULSE_MIN: f32 = 500.0;
 const PULSE_MAX: f32 = 2500.0;
+/// Largest pilot-mode rate-loop Kp \[stick per rad/s\]: full stick at 1 rad/s of rate
+/// error is already several times the presets' (0.024–0.8) and `tune`'s designs; above
+/// it the loop's crossover lies beyond every servo's and the 200 Hz tick's reach.
+const PM_KP_MAX: f32 = 2.0;
+/// Largest pilot-mode rate-loop Ki \[stick per rad\]: ten times the presets' (0.3–0.6).
+const PM_KI_MAX: f32 = 10.0;
+/// Pilot-mode outer-loop gains (K_lvl, K_ψ) \[1/s\]: at least 0.1 /s (a Level stick or
+/// heading hold that returns slower than in 10 s holds nothing), at most 20 /s, the
+/// rate loops' highest crossover `tune` designs for (an outer loop sits below its inner).
+const PM_OUTER_MIN: f32 = 0.1;
+const PM_OUTER_MAX: f32 = 20.0;
 
 /// A parameter's doc line: the text on the host; empty in the flight-controller image
 /// (`target_os = "none"`), which never shows it and would spend about 9 KiB of its
@@ -301,6 +313,14 @@ params! {
     HoldSlewLat = "HSLEW_LAT", "1/s", 0.0, 1000.0, Real, "Excitation phases: slew limit of the roll hold's share of lat (stick per s); 0: none.";
     HoldSlewLon = "HSLEW_LON", "1/s", 0.0, 1000.0, Real, "Excitation phases: slew limit of the pitch hold's share of lon (stick per s); 0: none.";
     HoldSlewPed = "HSLEW_PED", "1/s", 0.0, 1000.0, Real, "Excitation phases: slew limit of the heading hold's share of ped (stick per s); 0: none.";
+    PilotRollKp = "PM_ROLL_KP", "s/rad", 0.0, PM_KP_MAX, Real, "Pilot mode, roll-rate loop: stick per rad/s of rate error (Kp).";
+    PilotRollKi = "PM_ROLL_KI", "1/rad", 0.0, PM_KI_MAX, Real, "Pilot mode, roll-rate loop: stick per rad of integrated rate error (Ki).";
+    PilotPitchKp = "PM_PITCH_KP", "s/rad", 0.0, PM_KP_MAX, Real, "Pilot mode, pitch-rate loop: stick per rad/s of rate error (Kp).";
+    PilotPitchKi = "PM_PITCH_KI", "1/rad", 0.0, PM_KI_MAX, Real, "Pilot mode, pitch-rate loop: stick per rad of integrated rate error (Ki).";
+    PilotYawKp = "PM_YAW_KP", "s/rad", 0.0, PM_KP_MAX, Real, "Pilot mode, yaw-rate loop: pedal per rad/s of rate error (Kp).";
+    PilotYawKi = "PM_YAW_KI", "1/rad", 0.0, PM_KI_MAX, Real, "Pilot mode, yaw-rate loop: pedal per rad of integrated rate error (Ki).";
+    PilotLevelGain = "PM_LEVEL_K", "1/s", PM_OUTER_MIN, PM_OUTER_MAX, Real, "Pilot mode, Level stick: desired rate per rad of attitude error (K_lvl).";
+    PilotHeadingGain = "PM_HEADING_K", "1/s", PM_OUTER_MIN, PM_OUTER_MAX, Real, "Pilot mode, heading hold: desired yaw rate per rad of heading error (K_ψ).";
 }
 
 /// The vehicle whose preset a `FRAME` value names (ArduPilot's `FRAME_CLASS` idea: one

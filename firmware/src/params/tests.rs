@@ -305,18 +305,32 @@ fn frame_names_the_preset_under_the_table() {
         ParamId::ALL[ParamId::HoldPedRev.index() + 1..ParamId::AirTime.index() + 1],
         [ParamId::TestColSrc, ParamId::AirColMin, ParamId::AirTime]
     );
-    // Version 5 appended the test list after them, version 6 the holds' slew limits.
-    assert_eq!(TABLE_VERSION, 6);
+    // Version 5 appended the test list after them, version 6 the holds' slew limits,
+    // version 7 the pilot mode's gains.
+    assert_eq!(TABLE_VERSION, 7);
     assert_eq!(
         ParamId::ALL[ParamId::AirTime.index() + 1],
         ParamId::TestSelCh
     );
     assert_eq!(
-        ParamId::ALL[ParamId::Test12Amp.index() + 1..],
+        ParamId::ALL[ParamId::Test12Amp.index() + 1..ParamId::HoldSlewPed.index() + 1],
         [
             ParamId::HoldSlewLat,
             ParamId::HoldSlewLon,
             ParamId::HoldSlewPed
+        ]
+    );
+    assert_eq!(
+        ParamId::ALL[ParamId::HoldSlewPed.index() + 1..],
+        [
+            ParamId::PilotRollKp,
+            ParamId::PilotRollKi,
+            ParamId::PilotPitchKp,
+            ParamId::PilotPitchKi,
+            ParamId::PilotYawKp,
+            ParamId::PilotYawKi,
+            ParamId::PilotLevelGain,
+            ParamId::PilotHeadingGain
         ]
     );
     for vehicle in VEHICLES {

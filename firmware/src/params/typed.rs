@@ -103,6 +103,13 @@ const HOLD_SLEW_IDS: [ParamId; 3] = [
     ParamId::HoldSlewPed,
 ];
 
+/// The pilot mode's rate loops (roll, pitch, yaw): Kp, Ki.
+const PILOT_RATE_IDS: [[ParamId; 2]; 3] = [
+    [ParamId::PilotRollKp, ParamId::PilotRollKi],
+    [ParamId::PilotPitchKp, ParamId::PilotPitchKi],
+    [ParamId::PilotYawKp, ParamId::PilotYawKi],
+];
+
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
 /// Parameters per test list entry: `TESTn_AXIS`, `_INPUT`, `_WMIN`, `_WMAX`, `_WIDTH`,
@@ -407,6 +414,16 @@ impl Params {
             let values = core::array::from_fn(|f| v(entry_param(k, f)));
             *entry = entry_from(values).ok_or(ParamsError::Value(entry_param(k, 1)))?;
         }
+        let pilot = &mut stack.app.pilot;
+        for (axis, [kp, ki]) in [&mut pilot.roll, &mut pilot.pitch, &mut pilot.yaw]
+            .into_iter()
+            .zip(PILOT_RATE_IDS)
+        {
+            axis.kp = v(kp);
+            axis.ki = v(ki);
+        }
+        pilot.level_gain = v(ParamId::PilotLevelGain);
+        pilot.heading_gain = v(ParamId::PilotHeadingGain);
         let flight = &mut stack.app.flight;
         flight.test.warnings = flight.validate().map_err(ParamsError::Flight)?;
         stack.app.validate().map_err(ParamsError::App)?;

@@ -10,9 +10,13 @@ use control::law::BoardLaw;
 use control::tune::{self, LoopCheck, Models, TuneOptions};
 use serde::Serialize;
 use sweephold_firmware::app::pilot_mode::{PilotModeGains, RateAxisGains};
+use sweephold_firmware::params::ParamId;
+
+use crate::fc::client::BoardValue;
+use crate::fc::params_file;
 
 use crate::margins::{model_and_vehicle, structure_of, vehicle_servo, LawArgs};
-use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
+use crate::output::{check_input_file, refuse_inputs_as_outputs, write_atomic, write_json};
 use crate::vehicle::Vehicle;
 
 /// Arguments of `sweephold tune`.
@@ -30,7 +34,9 @@ the identified model and on the 5th percentile of --samples models drawn from th
 Cramer-Rao bounds; the servo rate for a full Rate-stick step within the aircraft file's \
 servo rate limit (or within the preset gains' rate where these already exceed it). Prints \
 the predicted figures of the preset's gains and the tuned ones side by side; --out writes \
-the tuned gains and the figures as JSON. When no gains meet the constraints: one line naming \
+the tuned gains and the figures as JSON; --params writes the eight tuned gains as a params \
+file (PM_ROLL_KP, PM_ROLL_KI, PM_PITCH_KP, PM_PITCH_KI, PM_YAW_KP, PM_YAW_KI, PM_LEVEL_K, \
+PM_HEADING_K) for `sweephold fc params push FILE --save --fc …`. When no gains meet the constraints: one line naming \
 the loop and the constraint, exit status 1."
 )]
 pub struct TuneArgs {
@@ -49,6 +55,10 @@ pub struct TuneArgs {
     /// Write the tuned gains and the figures (JSON) to this file.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Write the tuned gains as a params file (`PM_*` parameters only) that `sweephold
+    /// fc params push` loads.
+    #[arg(long, value_name = "FILE")]
+    pub params: Option<PathBuf>,
     /// Print the JSON document instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -144,8 +154,17 @@ pub struct TuneDocument {
 /// Run `sweephold tune`.
 pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
     check_input_file("model", &args.model)?;
+    let mut outputs = Vec::new();
     if let Some(out) = &args.out {
-        refuse_inputs_as_outputs(&[args.model.as_path()], &[("--out", out.as_path())])?;
+        outputs.push(("--out", out.as_path()));
+    }
+    if let Some(params) = &args.params {
+        outputs.push(("--params", params.as_path()));
+    }
+    refuse_inputs_as_outputs(&[args.model.as_path()], &outputs)?;
+    if let (Some(out), Some(params)) = (&args.out, &args.params) {
+        // The same path twice: one file would silently replace the other.
+        refuse_inputs_as_outputs(&[out.as_path()], &[("--params", params.as_path())])?;
     }
     let mut crossovers = [None; 3];
     for &(axis, w) in &args.crossover {
@@ -210,8 +229,20 @@ pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
         }),
         notes,
     };
+    // Checked before anything is written: a gain the board's table refuses is an error.
+    let params_text = match &args.params {
+        Some(_) => Some(params_file::write_tuned(
+            &args.model.display().to_string(),
+            &result.vehicle,
+            &tuned_params(&result.tuned)?,
+        )),
+        None => None,
+    };
     if let Some(out) = &args.out {
         write_json(out, &result)?;
+    }
+    if let (Some(path), Some(text)) = (&args.params, &params_text) {
+        write_atomic(path, text.as_bytes())?;
     }
     if args.json {
         let mut text = serde_json::to_string_pretty(&result)?;
@@ -220,6 +251,40 @@ pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
     } else {
         crate::output::print(&table(&result))
     }
+}
+
+/// The tuned gains as the board's `PM_*` parameters, in the table's order; a value the
+/// table refuses (outside its range) is an error naming it.
+fn tuned_params(gains: &GainSet) -> anyhow::Result<Vec<BoardValue>> {
+    let values = [
+        (ParamId::PilotRollKp, gains.roll[0]),
+        (ParamId::PilotRollKi, gains.roll[1]),
+        (ParamId::PilotPitchKp, gains.pitch[0]),
+        (ParamId::PilotPitchKi, gains.pitch[1]),
+        (ParamId::PilotYawKp, gains.yaw[0]),
+        (ParamId::PilotYawKi, gains.yaw[1]),
+        (ParamId::PilotLevelGain, gains.level_gain),
+        (ParamId::PilotHeadingGain, gains.heading_gain),
+    ];
+    values
+        .into_iter()
+        .map(|(id, value)| {
+            let def = id.def();
+            def.check(value).map_err(|why| {
+                anyhow!(
+                    "--params: tuned {} = {value} is refused by the board's table ({}: {} … {})",
+                    def.name,
+                    why.message(),
+                    def.min,
+                    def.max
+                )
+            })?;
+            Ok(BoardValue {
+                name: def.name.to_string(),
+                value,
+            })
+        })
+        .collect()
 }
 
 fn cell(spread: &tune::Spread, decimals: usize) -> String {

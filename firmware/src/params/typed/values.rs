@@ -185,6 +185,16 @@ pub fn values_of(params: &Params) -> [f32; COUNT] {
             put(entry_param(k, f), value);
         }
     }
+    let pilot = &stack.app.pilot;
+    for (axis, [kp, ki]) in [pilot.roll, pilot.pitch, pilot.yaw]
+        .into_iter()
+        .zip(PILOT_RATE_IDS)
+    {
+        put(kp, axis.kp);
+        put(ki, axis.ki);
+    }
+    put(ParamId::PilotLevelGain, pilot.level_gain);
+    put(ParamId::PilotHeadingGain, pilot.heading_gain);
     values
 }
 

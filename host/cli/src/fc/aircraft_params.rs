@@ -8,7 +8,9 @@
 //! every servo's direction, centre, limits and throw, the frame rates, the mixer's
 //! scales and ring, the hold's gains, limits, time constants, directions, reference and
 //! thresholds, the abort limits, the pulse width, the excitation scale, the command
-//! slew, the holds' slew and the test's collective source (`TEST_COL_SRC`: the board's table defaults to
+//! slew, the holds' slew, the pilot mode's gains (`PM_*`: the preset's; an aircraft file
+//! states none, `sweephold tune --params` writes tuned ones to push after it) and the
+//! test's collective source (`TEST_COL_SRC`: the board's table defaults to
 //! `pilot`, an aircraft file that states no `collective` has its preset's `trim`, so
 //! that a board set up from a file flies as `--fc board-sim` flies that file) — each the
 //! file's value or, where the file states none, its preset's — and the head and tail

@@ -40,6 +40,24 @@ pub fn write(source: &Source, values: &[BoardValue]) -> String {
     text
 }
 
+/// The text of a params file holding `values` designed by `sweephold tune` on `model`
+/// for `vehicle`: the same `[params]` as a pulled file, its `[source]` naming the model.
+pub fn write_tuned(model: &str, vehicle: &str, values: &[BoardValue]) -> String {
+    let mut text = String::from("# sweephold flight-controller parameters (sweephold tune)\n");
+    text.push_str("[source]\n");
+    text.push_str(&format!("tune = {}\n", quoted(model)));
+    text.push_str(&format!("vehicle = {}\n", quoted(vehicle)));
+    text.push_str(&format!(
+        "protocol = \"{}.{}\"\n",
+        PROTOCOL_VERSION.major, PROTOCOL_VERSION.minor
+    ));
+    text.push_str(&format!("count = {}\n\n[params]\n", values.len()));
+    for value in values {
+        text.push_str(&format!("{} = {}\n", value.name, number(value.value)));
+    }
+    text
+}
+
 /// A TOML basic string.
 fn quoted(text: &str) -> String {
     toml::Value::String(text.to_string()).to_string()
@@ -124,6 +142,18 @@ mod tests {
             assert_eq!(a.value.to_bits(), b.value.to_bits(), "{}", a.name);
         }
         assert!(text.contains("protocol = \"1."), "{text}");
+    }
+
+    #[test]
+    fn a_tuned_file_reads_back_to_the_same_f32_values() {
+        let values = vec![value("PM_ROLL_KP", 0.0416), value("PM_LEVEL_K", 1.0 / 3.0)];
+        let text = write_tuned("out/\"x\"/model9.json", "trex700l", &values);
+        let back = parse(&text, "test").unwrap();
+        assert_eq!(back.len(), 2);
+        assert_eq!(back[0].name, "PM_LEVEL_K");
+        assert_eq!(back[0].value.to_bits(), (1.0f32 / 3.0).to_bits());
+        assert_eq!(back[1].value.to_bits(), 0.0416f32.to_bits());
+        assert!(text.contains("count = 2"), "{text}");
     }
 
     #[test]

@@ -223,6 +223,13 @@ pub struct FlyArgs {
     /// the pilot's hands at trim (seconds, 0–600).
     #[arg(long = "fly-on", value_name = "SECONDS", value_parser = parse_fly_on, allow_hyphen_values = true)]
     pub fly_on_s: Option<f64>,
+    /// `--fc board-sim`, with --fly-on: a discrete gust AT_S seconds after the test ended,
+    /// the pilot's hands at trim: body-axis air velocity rising from zero to (U, V, W)
+    /// m/s and falling back as 1 - cos over 1 s (each component within ±20 m/s; the
+    /// flight must go on at least 1 s beyond AT_S). summary.json's `after.gust_pulse`
+    /// holds the peak |phi|, |theta| excursion from the attitude at its onset.
+    #[arg(long = "gust-pulse", value_name = "AT_S:U,V,W", value_parser = super::gust_pulse::GustPulse::parse, allow_hyphen_values = true)]
+    pub gust_pulse: Option<super::gust_pulse::GustPulse>,
     /// `--fc board-sim`: `per-record` powers the board up for every record (its settings
     /// the record's); `once` flies every record on one power-up, one after the other, each
     /// test chosen from the board's test list by the transmitter's selector with 10 s of
@@ -438,6 +445,7 @@ impl FlyArgs {
                 ("--rc-loss", self.rc_loss_at_s.is_some()),
                 ("--imu-fault", self.imu_fault.is_some()),
                 ("--fly-on", self.fly_on_s.is_some()),
+                ("--gust-pulse", self.gust_pulse.is_some()),
                 ("--power-up", self.power_up.is_some()),
                 ("--steady-flights", self.steady_flights),
             ];
@@ -473,6 +481,19 @@ impl FlyArgs {
         if let Some(t) = self.fly_on_s {
             if !(0.0..=MAX_FLY_ON_S).contains(&t) {
                 bail!("--fly-on {t}: expected seconds from 0 to {MAX_FLY_ON_S}");
+            }
+        }
+        if let Some(gust) = self.gust_pulse {
+            let end = gust.at_s + super::gust_pulse::GUST_LENGTH_S;
+            if self.fly_on_s.is_none_or(|t| t < end) {
+                bail!(
+                    "--gust-pulse {}: the gust blows after the test, while flying on: it needs \
+                     --fly-on {end} or longer",
+                    gust.at_s
+                );
+            }
+            if self.linearized_plant {
+                bail!("--linearized-plant flies in still air only: drop --gust-pulse");
             }
         }
         if let Some(at) = self.pilot_override_at_s {

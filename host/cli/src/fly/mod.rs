@@ -6,6 +6,7 @@ pub mod board_flash;
 pub mod board_test_list;
 pub mod defmt_log;
 pub mod frame_channel;
+pub mod gust_pulse;
 pub mod imu_fault;
 pub mod link;
 pub mod link_board_sim;
@@ -145,6 +146,13 @@ pub fn run(args: &FlyArgs) -> anyhow::Result<()> {
                     "{:>9}  after the test: {:.1} s in {}, max |phi| {:4.1} deg, |theta| {:4.1} deg",
                     "", after.duration_s, after.mode, after.max_abs_deg.phi, after.max_abs_deg.theta
                 );
+                if let Some(gust) = &after.gust_pulse {
+                    let [u, v, w] = gust.body_wind_m_s;
+                    crate::note!(
+                        "{:>9}  gust ({u}, {v}, {w}) m/s at {} s: peak excursion phi {:.2} deg, theta {:.2} deg",
+                        "", gust.at_s, gust.peak_excursion_deg.phi, gust.peak_excursion_deg.theta
+                    );
+                }
             }
         }
         crate::note!(
@@ -358,6 +366,7 @@ pub fn fly_with_workers(
         pilot_stick_noise: args.pilot_noise,
         collective_step: args.collective_step,
         fly_on_s: args.fly_on_s.unwrap_or(0.0),
+        gust_pulse: args.gust_pulse,
     };
 
     let bars = MultiProgress::with_draw_target(if args.quiet {

@@ -8,6 +8,7 @@ use sweephold_protocol::{
 };
 use sysid::random::SplitMix64;
 
+use super::gust_pulse::{GustPulse, GustResponse};
 use super::link::FlightControllerLink;
 use super::pilot_collective::{CollectiveStep, HeightHold};
 use super::summary::{AfterTest, AttitudeDeg, FromTrimDeg, HoldFraction, MaxAbsDeg};
@@ -30,6 +31,8 @@ pub struct Disturbances {
     /// Seconds flown on after the test ended (Done or Aborted), the pilot's hands at trim
     /// (0: the record ends with the test).
     pub fly_on_s: f64,
+    /// A discrete gust while flying on (`--gust-pulse`).
+    pub gust_pulse: Option<GustPulse>,
 }
 
 /// What one record produced.
@@ -281,6 +284,7 @@ pub fn fly_record(
     // The tick count and final phase when the test ended, and the flight after it.
     let mut ended: Option<(u64, Phase)> = None;
     let mut after = AttitudeDeg::default();
+    let mut gust = disturbances.gust_pulse.map(GustResponse::new);
     let mut ticks = 0;
     let ticks_per_second = u64::from(config.rate_hz).max(1);
     while ticks < max_ticks + fly_on_ticks {
@@ -330,6 +334,10 @@ pub fn fly_record(
                 errors.add(sample, truth);
             }
         }
+        if let (Some(gust), Some((end, _))) = (gust.as_mut(), ended) {
+            let since_end = (ticks - end) as f64 * dt;
+            sim.set_wind(gust.step(since_end, truth));
+        }
         reading = sim.step(dt, link.controls_flown(&out));
         truth = sim.state().attitude();
         ticks += 1;
@@ -374,6 +382,7 @@ pub fn fly_record(
         mode: link.board_mode().unwrap_or("unknown").to_string(),
         duration_s: ticks.saturating_sub(test_ticks) as f64 * dt,
         max_abs_deg: after,
+        gust_pulse: gust.and_then(|g| g.summary()),
     });
     Ok(FlownRecord {
         frames: monitor.decoder.stats().good_frames,

@@ -66,6 +66,23 @@ pub struct AfterTest {
     pub duration_s: f64,
     /// Peak |φ|, |θ| of the simulated aircraft over that time \[deg\].
     pub max_abs_deg: AttitudeDeg,
+    /// The discrete gust flown after the test (`--gust-pulse`), if it began.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust_pulse: Option<GustPulseSummary>,
+}
+
+/// A discrete gust flown after the test (`fly --gust-pulse`) and the aircraft's response.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct GustPulseSummary {
+    /// Onset, seconds after the test ended.
+    pub at_s: f64,
+    /// Duration of its 1 − cos rise and fall \[s\].
+    pub length_s: f64,
+    /// Peak body-axis air velocity (u, v, w) \[m/s\].
+    pub body_wind_m_s: [f64; 3],
+    /// Peak |φ − φ_onset|, |θ − θ_onset| of the simulated aircraft from the onset to the
+    /// end of the flight \[deg\].
+    pub peak_excursion_deg: AttitudeDeg,
 }
 
 /// One flown record.

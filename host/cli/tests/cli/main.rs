@@ -29,6 +29,7 @@ mod fly_signals;
 mod frf_csv;
 mod frf_dump_origin;
 mod frf_inputs;
+mod gust_pulse;
 mod identify;
 mod inputs;
 #[cfg(unix)]
