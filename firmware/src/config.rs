@@ -14,6 +14,12 @@ use crate::mixer::MixerConfig;
 use crate::safety::SafetyLimits;
 use crate::slew::{CommandSlew, HoldSlew};
 
+mod presets;
+pub use presets::{
+    BO105_HOLD_ENGAGE_RAD, BO105_HOLD_RELEASE_RAD, TREX700L_HOLD_ENGAGE_RAD,
+    TREX700L_HOLD_RELEASE_RAD, TREX700L_HOLD_SLEW, TREX700L_SLEW,
+};
+
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
 /// Lowest accepted tick rate \[Hz\].
@@ -189,43 +195,6 @@ impl core::fmt::Display for ConfigError {
 #[cfg(any(test, feature = "std"))]
 impl std::error::Error for ConfigError {}
 
-/// The TREX 700L preset's command slew limit: the pedal at 4 /s, the simulated tail
-/// servo's rate ([`CommandSlew::pedal`]), so that the recorded pedal command is one the
-/// servo achieves; the heading hold otherwise outruns it on 7 % of the ticks. Over seeds
-/// 1–10 it takes r/ped's J against the truth from 199–2764 to 31–63 and every seed's truth
-/// J_ave down (docs/decisions/2026-11-24-trex700l-pedal-slew.md).
-pub const TREX700L_SLEW: CommandSlew = CommandSlew::pedal(4.0);
-
-/// The TREX 700L preset's slew limit of the roll and pitch holds' share of the commands:
-/// 3.6 /s, inside the simulated servos' 4 /s, so that the restoring command a hold leaves
-/// behind at release (faded over [`Gains::trex700l`]'s 0.8 s) moves no faster than the
-/// servos follow. Together with the fade and the narrower hysteresis of
-/// [`TREX700L_HOLD_ENGAGE_RAD`]/[`TREX700L_HOLD_RELEASE_RAD`] it takes the cah lat–lon
-/// cross-control coherence from 0.279 to 0.240 (seeds 1–10) with every excursion within
-/// 9.2° of trim (docs/decisions/2026-11-27-trex-cah-coherence-release.md).
-pub const TREX700L_HOLD_SLEW: HoldSlew = HoldSlew {
-    per_s: [3.6, 3.6, f32::INFINITY],
-};
-
-/// The TREX 700L preset's hold engage angle from the captured trim: 4.5° (the paper's 6°
-/// let the quick airframe swing to 10° and beyond before a hold answered it once its
-/// release fade was lengthened).
-pub const TREX700L_HOLD_ENGAGE_RAD: f32 = 4.5 * DEG;
-
-/// The TREX 700L preset's hold release angle from the captured trim: 3° (the paper's 4°).
-pub const TREX700L_HOLD_RELEASE_RAD: f32 = 3.0 * DEG;
-
-/// The Bo-105 preset's hold engage angle, measured from the captured trim: 5°. The
-/// paper's 6° and 4° from level let the aircraft, which hovers at φ −2.6°, θ +2.2°, swing
-/// 9.9–11.0° from its trim (seeds 1–10); 5° and 3.5° from trim keep every cah excursion
-/// within 8.6° of trim, the lat–lon cross-control coherence at 0.239 (0.225 on seeds
-/// 11–20) and every identification bar
-/// (docs/decisions/2026-11-27-trex-cah-coherence-release.md).
-pub const BO105_HOLD_ENGAGE_RAD: f32 = 5.0 * DEG;
-
-/// The Bo-105 preset's hold release angle from the captured trim: 3.5°.
-pub const BO105_HOLD_RELEASE_RAD: f32 = 3.5 * DEG;
-
 /// The paper's test on `primary`: conditional attitude hold with off-axis noise, a 90 s
 /// sweep 0.3–31.4 rad/s at 5 % of stick travel, 2 s raised-cosine fades, no ω_min hold,
 /// 3 % RMS noise low-passed at ω_max, seed 1, hold engage 6° / release 4°.
@@ -265,10 +234,9 @@ impl Config {
         }
     }
 
-    /// Bo-105 (simulator) defaults at 200 Hz: [`paper_test`] with the holds engaged at 5°
-    /// and released at 3.5° from the captured trim ([`BO105_HOLD_ENGAGE_RAD`]), 1 s trim
-    /// capture, [`Gains::bo105`], [`SafetyLimits::bo105`], standard CCPM-120 mixer (unused
-    /// by the simulator, which takes the commands).
+    /// Bo-105 (simulator) defaults at 200 Hz: [`paper_test`] with the hysteresis of
+    /// [`BO105_HOLD_ENGAGE_RAD`], 1 s trim capture, [`Gains::bo105`], [`SafetyLimits::bo105`],
+    /// standard CCPM-120 mixer (unused by the simulator, which takes the commands).
     pub const fn bo105_default(primary: Axis) -> Self {
         let mut test = paper_test(primary);
         test.hold_engage_rad = BO105_HOLD_ENGAGE_RAD;
@@ -290,12 +258,9 @@ impl Config {
         }
     }
 
-    /// TREX 700L defaults at 200 Hz: [`paper_test`] with 0.3 s pulses (faster airframe)
-    /// and the holds engaged at 4.5° and released at 3° from trim
-    /// ([`TREX700L_HOLD_ENGAGE_RAD`]), 1 s trim capture, [`Gains::trex700l`],
-    /// [`SafetyLimits::trex700l`], CCPM-120 mixer, the pedal slewed at 4 /s
-    /// ([`TREX700L_SLEW`]) and excited at 1/5 ([`ExcitationScale::trex700l`]), the roll and
-    /// pitch holds' share slewed at 3.6 /s ([`TREX700L_HOLD_SLEW`]).
+    /// TREX 700L defaults at 200 Hz: [`paper_test`] with 0.3 s pulses and the holds of
+    /// [`TREX700L_HOLD_SLEW`], 1 s trim capture, [`Gains::trex700l`], [`SafetyLimits::trex700l`],
+    /// CCPM-120 mixer, the pedal slewed at 4 /s ([`TREX700L_SLEW`]) and excited at 1/5.
     pub const fn trex700l_default(primary: Axis) -> Self {
         let mut test = paper_test(primary);
         test.pulse.width_s = 0.3;
