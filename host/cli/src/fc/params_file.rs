@@ -29,14 +29,7 @@ pub fn write(source: &Source, values: &[BoardValue]) -> String {
     if let Some(image) = &source.image {
         text.push_str(&format!("image = {}\n", quoted(image)));
     }
-    text.push_str(&format!(
-        "protocol = \"{}.{}\"\n",
-        PROTOCOL_VERSION.major, PROTOCOL_VERSION.minor
-    ));
-    text.push_str(&format!("count = {}\n\n[params]\n", values.len()));
-    for value in values {
-        text.push_str(&format!("{} = {}\n", value.name, number(value.value)));
-    }
+    push_protocol_and_params(&mut text, values);
     text
 }
 
@@ -47,6 +40,12 @@ pub fn write_tuned(model: &str, vehicle: &str, values: &[BoardValue]) -> String 
     text.push_str("[source]\n");
     text.push_str(&format!("tune = {}\n", quoted(model)));
     text.push_str(&format!("vehicle = {}\n", quoted(vehicle)));
+    push_protocol_and_params(&mut text, values);
+    text
+}
+
+/// The end of every params file's `[source]` (the protocol, the count) and its `[params]`.
+fn push_protocol_and_params(text: &mut String, values: &[BoardValue]) {
     text.push_str(&format!(
         "protocol = \"{}.{}\"\n",
         PROTOCOL_VERSION.major, PROTOCOL_VERSION.minor
@@ -55,7 +54,6 @@ pub fn write_tuned(model: &str, vehicle: &str, values: &[BoardValue]) -> String 
     for value in values {
         text.push_str(&format!("{} = {}\n", value.name, number(value.value)));
     }
-    text
 }
 
 /// A TOML basic string.
