@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use crate::support::{sweephold, Scratch};
 
-/// The lateral doublet on board-sim (seed 2), then 6 s flown on with `gust`; the first
+/// The lateral doublet on board-sim (seed 2), then 8 s flown on with `gust`; the first
 /// run's `after` section.
 fn after_the_doublet(name: &str, gust: &str) -> Value {
     let dir = Scratch::unmade(&format!("gust-pulse-{name}"));
@@ -22,7 +22,7 @@ fn after_the_doublet(name: &str, gust: &str) -> Value {
         "--seed",
         "2",
         "--fly-on",
-        "6",
+        "8",
         "--gust-pulse",
         gust,
         "-q",
@@ -45,8 +45,8 @@ fn after_the_doublet(name: &str, gust: &str) -> Value {
 
 #[test]
 fn a_lateral_gust_rolls_the_hovering_aircraft_more_than_still_air() {
-    let still = after_the_doublet("still", "3:0,0,0");
-    let gust = after_the_doublet("lateral", "3:0,5,0");
+    let still = after_the_doublet("still", "5:0,0,0");
+    let gust = after_the_doublet("lateral", "5:0,10,0");
     let peak = |after: &Value| {
         let excursion = &after["gust_pulse"]["peak_excursion_deg"];
         excursion["phi"]
@@ -55,13 +55,15 @@ fn a_lateral_gust_rolls_the_hovering_aircraft_more_than_still_air() {
             .max(excursion["theta"].as_f64().unwrap())
     };
     let g = &gust["gust_pulse"];
-    assert_eq!(g["at_s"], 3.0);
+    assert_eq!(g["at_s"], 5.0);
     assert_eq!(g["length_s"], 1.0);
-    assert_eq!(g["body_wind_m_s"], serde_json::json!([0.0, 5.0, 0.0]));
+    assert_eq!(g["body_wind_m_s"], serde_json::json!([0.0, 10.0, 0.0]));
     // Still air: what the hover's own motion after the doublet and the sensors give in
-    // the last 3 s (measured 0.7°); the 5 m/s gust: 2.3° (seed 2, 2026-11-27).
+    // the last 3 s (measured 0.93°); the 10 m/s gust: 2.94° (seed 2, the Bo-105 preset of
+    // 2026-11-27, whose holds measure from trim; 5 s after the doublet its hover has
+    // settled, where 3 s after it the still air alone read 1.5–2.1°).
     let (calm, disturbed) = (peak(&still), peak(&gust));
-    assert!(disturbed > 1.5, "5 m/s lateral gust: {disturbed} deg");
+    assert!(disturbed > 1.5, "10 m/s lateral gust: {disturbed} deg");
     assert!(
         disturbed > 2.0 * calm,
         "gust {disturbed} deg against still air {calm} deg"
