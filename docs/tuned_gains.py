@@ -14,7 +14,10 @@ attitude excursion from trim.
 With `--gust AT_S:U,V,W`, also on each board the lateral doublet, then the pilot mode's hover
 (`--fly-on`, hands at trim) with `--gust-pulse AT_S:U,V,W` and its peak attitude excursion
 from the attitude at the gust's onset, and the same flight in still air (AT_S:0,0,0) on the
-shipped board as the floor. Prints one row per seed and loop. Needs a build of the CLI:
+same board: the same seed and board fly the same flight up to the onset, so the gust
+flight's excursion trace less the still-air one is the attitude response to the gust alone
+(its peak: "gust response"), and the still-air flight's own peak is the floor the raw
+excursion stands on. Prints one row per seed and loop. Needs a build of the CLI:
 
     cargo build --release -p sweephold
     python3 docs/tuned_gains.py --vehicle trex700l --seeds 1-3 --out out/tuned
@@ -131,23 +134,28 @@ def main():
                 flown_sweeps.append(aborts(folder))
             flights.append((seed, *flown_sweeps))
         if args.gust:
-            peaks = []
-            # The still-air flight (the gust's components zero) is the floor: the hover's
-            # own motion and the sensors over the same time.
             still = args.gust.split(":")[0] + ":0,0,0"
-            for label, flash, gust in (("still", shipped_flash, still),
-                                       ("shipped", shipped_flash, args.gust),
-                                       ("tuned", tuned_flash, args.gust)):
-                folder = f"{base}-gust-{label}"
-                if not (args.reuse and os.path.isfile(os.path.join(folder, "summary.json"))):
-                    run([args.binary, "fly", "--vehicle", args.vehicle, "--seed", str(seed),
-                         "--axes", "lat", "--input", "doublet", "--fly-on", str(args.fly_on),
-                         "--gust-pulse", gust, "--out", folder, "--quiet",
-                         "--fc", f"board-sim:{flash}"])
-                with open(os.path.join(folder, "summary.json")) as f:
-                    peak = json.load(f)["runs"][0]["after"]["gust_pulse"]["peak_excursion_deg"]
-                peaks.append((peak["phi"], peak["theta"]))
-            gusts.append((seed, *peaks))
+            gust = {}
+            for label, flash in (("shipped", shipped_flash), ("tuned", tuned_flash)):
+                for kind, pulse in (("still", still), ("gust", args.gust)):
+                    folder = f"{base}-{kind}-{label}"
+                    if not (args.reuse and os.path.isfile(os.path.join(folder, "summary.json"))):
+                        run([args.binary, "fly", "--vehicle", args.vehicle, "--seed", str(seed),
+                             "--axes", "lat", "--input", "doublet", "--fly-on", str(args.fly_on),
+                             "--gust-pulse", pulse, "--out", folder, "--quiet",
+                             "--fc", f"board-sim:{flash}"])
+                    with open(os.path.join(folder, "summary.json")) as f:
+                        gust[kind, label] = json.load(f)["runs"][0]["after"]["gust_pulse"]
+            figures = {}
+            for label in ("shipped", "tuned"):
+                flown, calm = gust["gust", label], gust["still", label]
+                raw = flown["peak_excursion_deg"]
+                floor = calm["peak_excursion_deg"]
+                response = [max((abs(a - b) for a, b in zip(flown["excursion_deg"][k],
+                                                            calm["excursion_deg"][k])), default=0.0)
+                            for k in ("phi", "theta")]
+                figures[label] = ((raw["phi"], raw["theta"]), (floor["phi"], floor["theta"]), response)
+            gusts.append((seed, figures))
         print(f"seed {seed}: tuned parameters on the board: {' '.join(changed)}", file=sys.stderr)
 
     def cell(value, digits):
@@ -169,10 +177,12 @@ def main():
         print(f"seed {seed}: the campaign's sweeps (fly, cah): aborted {shipped[0]} of {shipped[1]} "
               f"shipped, {flown[0]} of {flown[1]} tuned; max from trim |φ|, |θ| "
               f"{shipped[2]:.1f}, {shipped[3]:.1f} shipped, {flown[2]:.1f}, {flown[3]:.1f} tuned deg")
-    for seed, (np_, nt), (sp, st), (tp, tt) in gusts:
-        print(f"seed {seed}: gust {args.gust}: peak excursion |φ|, |θ| shipped {sp:.2f}, {st:.2f} → "
-              f"tuned {tp:.2f}, {tt:.2f} deg (still air {np_:.2f}, {nt:.2f})")
-
+    for seed, figures in gusts:
+        (sr, sf, sg), (tr, tf, tg) = figures["shipped"], figures["tuned"]
+        print(f"seed {seed}: gust {args.gust}: gust response (gust flight less still air) |φ|, |θ| "
+              f"shipped {sg[0]:.2f}, {sg[1]:.2f} → tuned {tg[0]:.2f}, {tg[1]:.2f} deg; raw peak "
+              f"excursion shipped {sr[0]:.2f}, {sr[1]:.2f} → tuned {tr[0]:.2f}, {tr[1]:.2f} deg "
+              f"(still air {sf[0]:.2f}, {sf[1]:.2f} → {tf[0]:.2f}, {tf[1]:.2f})")
 
 if __name__ == "__main__":
     main()

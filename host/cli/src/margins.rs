@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Context};
 use clap::Args;
-use control::analysis::{self, AnalysisOptions, Figure, MarginsDocument};
+use control::analysis::{self, AnalysisOptions, Figure, MarginsDocument, POOR_PAIR_COST};
 use control::law::BoardLaw;
 use control::Plant;
 use serde::{Deserialize, Serialize};
@@ -391,17 +391,45 @@ fn table(result: &MarginsDocument, vehicle: &str, model: &std::path::Path) -> St
         "DRB [rad/s]"
     );
     for l in &result.loops {
+        // `*`: read where the model is extrapolated (beyond its fitted pairs' band).
+        let mark = |what: &str, text: String| {
+            if l.extrapolated.contains(&what) {
+                text + "*"
+            } else {
+                text
+            }
+        };
         let _ = writeln!(
             text,
             "{:<15} {:<4} {:>15} {:>14} {:>14} {:>14} {:>15} {:>14}",
             l.name,
             l.broken_at,
-            cell(&l.crossover_rad_s, 2),
-            cell(&l.phase_margin_deg, 1),
+            mark("crossover", cell(&l.crossover_rad_s, 2)),
+            mark("crossover", cell(&l.phase_margin_deg, 1)),
             cell(&l.min_phase_margin_deg, 1),
-            cell(&l.gain_margin_db, 1),
-            cell(&l.phase_crossover_rad_s, 2),
+            mark("phase_crossover", cell(&l.gain_margin_db, 1)),
+            mark("phase_crossover", cell(&l.phase_crossover_rad_s, 2)),
             cell(&l.drb_rad_s, 2),
+        );
+    }
+    for l in &result.loops {
+        if let Some((pair, cost)) = l.worst_pair.as_ref().filter(|(_, j)| *j > POOR_PAIR_COST) {
+            let _ = writeln!(
+                text,
+                "! {}: the model fits {pair} at J {cost:.0} (> {POOR_PAIR_COST:.0}): the loop's \
+                 figures rest on a response the model does not follow",
+                l.name
+            );
+        }
+    }
+    for l in result.loops.iter().filter(|l| !l.extrapolated.is_empty()) {
+        let _ = writeln!(
+            text,
+            "* {}: read above {:.1} rad/s, the top of the model's fitted {} pairs: extrapolated \
+             by the model's structure, not identified",
+            l.name,
+            l.fitted_to_rad_s.unwrap_or(f64::NAN),
+            l.broken_at
         );
     }
     let _ = writeln!(

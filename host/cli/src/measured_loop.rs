@@ -7,11 +7,23 @@
 //! From each Sample of the test's excitation (plus the trim either side that every
 //! excitation record keeps): the total command u = `command` of the swept axis (what the
 //! servos' pulses express), the injection d = its `sweep`, and the loops' own output
-//! c = u − d. A valid point has the frequency responses' coherence threshold 0.6 and lies
-//! where the windows resolve it without bias (five times the lowest frequency the longest
-//! window resolves, `sysid::frf::broken_loop::RESOLVED_PERIODS`): a gain-reduction margin
-//! at the band's bottom (a conditionally stable loop's low-frequency −180° crossing) is
-//! not measured.
+//! c = u − d. A valid point has a normalized random error of at most
+//! [`MAX_RANDOM_ERROR`] (0.15, the bound of `frf`'s valid ranges) and lies where the
+//! windows resolve it without bias (five times the lowest frequency the longest window
+//! resolves, `sysid::frf::broken_loop::RESOLVED_PERIODS`): a gain-reduction margin at the
+//! band's bottom (a conditionally stable loop's low-frequency −180° crossing) is not
+//! measured.
+//!
+//! No coherence threshold: with the injection as instrument, the noise that enters the
+//! loop elsewhere (the gyro's, through the loop's gains) does not bias L = −G_dc/G_du, it
+//! only adds random error, and the random error is what bounds the estimate. The coherence
+//! of a sweep against that noise does not grow with the record (at the top of Tischler's
+//! sweep the time spent per e-fold of frequency is T/4 and the noise's is T) and sits
+//! below 0.6 near a heading loop's phase crossover, where |L| is −10 to −25 dB and the
+//! loop's output c is small against the gyro noise it carries; there the random error
+//! (about 90 independent one-second windows) is still 0.06–0.14. Measured against the same
+//! loop tests flown with perfect sensors (docs/decisions/2026-11-27-loop-test-validity.md)
+//! the error grows with the bound's estimate and stays within it.
 //!
 //! The board-sim pilot flies the mode switch in the middle (Level) with the pedal
 //! centred (heading hold), so a loop test measures the loops `sweephold margins`
@@ -33,8 +45,9 @@ use control::analysis::MarginsDocument;
 
 use crate::output::check_input_file;
 
-/// Coherence below which a point of the measured loop is not used.
-pub const COHERENCE_THRESHOLD: f64 = 0.6;
+/// Normalized random error above which a point of the measured loop is not used (the
+/// bound `frf` applies to its valid ranges, docs/decisions/2026-11-21-random-error-bound.md).
+pub const MAX_RANDOM_ERROR: f64 = 0.15;
 
 /// The loop of `margins` a loop test on `axis` measures (see the module documentation).
 pub fn predicted_counterpart(axis: Axis) -> Option<&'static str> {
@@ -57,7 +70,7 @@ pub struct MeasuredLoop {
     pub broken_at: &'static str,
     /// The sweep band [rad/s].
     pub band_rad_s: [f64; 2],
-    /// Points with coherence ≥ [`COHERENCE_THRESHOLD`] at or above `resolved_from_rad_s`,
+    /// Points with random error ≤ [`MAX_RANDOM_ERROR`] at or above `resolved_from_rad_s`,
     /// of all.
     pub valid_points: usize,
     /// The lowest frequency used: five times the lowest the longest window resolves
@@ -88,22 +101,24 @@ pub struct MeasuredResponse {
     pub im: Vec<Option<f64>>,
     /// Coherence.
     pub coherence: Vec<f64>,
+    /// Normalized random error (null where no window resolves the point).
+    pub random_error: Vec<Option<f64>>,
 }
 
-/// The margins of `measured` on its points of coherence ≥ `threshold` at or above the
-/// frequency its windows resolve without bias (`resolved_from_rad_s`).
-pub fn valid_margins(measured: &BrokenLoop, threshold: f64) -> (Margins, usize) {
+/// The margins of `measured` on its points of random error ≤ `max_random_error` at or
+/// above the frequency its windows resolve without bias (`resolved_from_rad_s`).
+pub fn valid_margins(measured: &BrokenLoop, max_random_error: f64) -> (Margins, usize) {
     let mut valid = Sampled {
         omega: Vec::new(),
         values: Vec::new(),
     };
-    for ((w, l), g) in measured
+    for ((w, l), e) in measured
         .omega
         .iter()
         .zip(&measured.values)
-        .zip(&measured.coherence)
+        .zip(&measured.random_error)
     {
-        if *g >= threshold
+        if *e <= max_random_error
             && *w >= measured.resolved_from_rad_s
             && l.re.is_finite()
             && l.im.is_finite()
@@ -162,7 +177,7 @@ pub fn measure(path: &Path) -> anyhow::Result<MeasuredLoop> {
         &BrokenLoopOptions::default(),
     )
     .map_err(|e| anyhow!("{source}: {e}"))?;
-    let (figures, valid_points) = valid_margins(&measured, COHERENCE_THRESHOLD);
+    let (figures, valid_points) = valid_margins(&measured, MAX_RANDOM_ERROR);
     let finite = |v: f64| v.is_finite().then_some(v);
     Ok(MeasuredLoop {
         source: file_name(path),
@@ -179,6 +194,7 @@ pub fn measure(path: &Path) -> anyhow::Result<MeasuredLoop> {
         response: MeasuredResponse {
             re: measured.values.iter().map(|v| finite(v.re)).collect(),
             im: measured.values.iter().map(|v| finite(v.im)).collect(),
+            random_error: measured.random_error.iter().map(|&e| finite(e)).collect(),
             omega: measured.omega,
             coherence: measured.coherence,
         },
@@ -309,56 +325,92 @@ mod tests {
         0.05 * theta.sin()
     }
 
-    /// A known discrete loop: plant P(z) = b·z^−D/(z − a) (a first-order lag and D ticks
-    /// of delay), controller K(z) = kp + ki·T/(z − 1) on the plant's output with noise on
-    /// the measurement; the sweep added at the controller's output. The measured broken
-    /// loop matches L = K·P on its valid points and its margins match the exact loop's.
+    /// The known loop of these tests (sampled at 200 Hz): plant P(z) = b·z^−D/(z − a) (a
+    /// first-order lag and D ticks of delay), controller K(z) = kp + ki·T/(z − 1) on the
+    /// plant's output with white noise of `noise` (rms) on the measurement; the sweep over
+    /// `band` added at the controller's output, 5 s at rest either side, fading in and out
+    /// over 2 s as the firmware flies it.
+    struct KnownLoop {
+        t: f64,
+        a: f64,
+        b: f64,
+        delay: i32,
+        kp: f64,
+        ki: f64,
+    }
+
+    impl KnownLoop {
+        fn new() -> Self {
+            let t = 1.0 / 200.0;
+            let a = (-t / 0.25f64).exp();
+            KnownLoop {
+                t,
+                a,
+                b: (1.0 - a) * 4.0,
+                delay: 6,
+                kp: 1.2,
+                ki: 2.0,
+            }
+        }
+
+        fn exact(&self, omega: f64) -> Complex<f64> {
+            let z = Complex::from_polar(1.0, omega * self.t);
+            let plant = self.b * z.powi(-self.delay) / (z - self.a);
+            let controller = self.kp + self.ki * self.t / (z - 1.0);
+            controller * plant
+        }
+
+        fn margins(&self, band: [f64; 2]) -> Margins {
+            let grid = control::loops::log_grid(band[0], band[1], 2400);
+            exact_margins(&Sampled {
+                values: grid.iter().map(|w| self.exact(*w)).collect(),
+                omega: grid,
+            })
+        }
+
+        /// The injection d and the total u of a 90 s loop test.
+        fn fly(&self, band: [f64; 2], noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
+            let (t, a, b, kp, ki) = (self.t, self.a, self.b, self.kp, self.ki);
+            let duration = 90.0;
+            let lead = 5.0;
+            let n = ((duration + 2.0 * lead) / t) as usize;
+            let fade = |time: f64| {
+                let edge = time.min(duration - time).clamp(0.0, 2.0) / 2.0;
+                0.5 - 0.5 * (std::f64::consts::PI * edge).cos()
+            };
+            let mut random = SplitMix64::new(seed);
+            let (mut x, mut integral) = (0.0, 0.0);
+            let mut history = vec![0.0f64; self.delay as usize + 1];
+            let (mut d, mut u) = (Vec::with_capacity(n), Vec::with_capacity(n));
+            for k in 0..n {
+                let y = history[0] + noise * random.normal_pair().0;
+                let c = -(kp * y + integral);
+                integral += ki * t * y;
+                let time = k as f64 * t - lead;
+                let injection = if (0.0..=duration).contains(&time) {
+                    fade(time) * sweep(time, duration, band)
+                } else {
+                    0.0
+                };
+                let total = c + injection;
+                d.push(injection);
+                u.push(total);
+                x = a * x + b * total;
+                history.rotate_left(1);
+                *history.last_mut().unwrap() = x;
+            }
+            (d, u)
+        }
+    }
+
+    /// The measured broken loop of the known loop matches L = K·P on its valid points and
+    /// its margins match the exact loop's.
     #[test]
     fn the_measured_broken_loop_of_a_known_loop_matches_it() {
-        let rate = 200.0;
-        let t = 1.0 / rate;
-        let a = (-t / 0.25f64).exp();
-        let b = (1.0 - a) * 4.0;
-        let delay: i32 = 6;
-        let (kp, ki) = (1.2, 2.0);
-        let exact = |omega: f64| -> Complex<f64> {
-            let z = Complex::from_polar(1.0, omega * t);
-            let plant = b * z.powi(-delay) / (z - a);
-            let controller = kp + ki * t / (z - 1.0);
-            controller * plant
-        };
+        let known = KnownLoop::new();
         let band = [0.5, 60.0];
-        let duration = 90.0;
-        // 5 s at rest either side of the sweep, which fades in and out over 2 s, as the
-        // firmware flies it.
-        let lead = 5.0;
-        let n = ((duration + 2.0 * lead) * rate) as usize;
-        let fade = |time: f64| {
-            let edge = time.min(duration - time).clamp(0.0, 2.0) / 2.0;
-            0.5 - 0.5 * (std::f64::consts::PI * edge).cos()
-        };
-        let mut random = SplitMix64::new(7);
-        let (mut x, mut integral) = (0.0, 0.0);
-        let mut history = vec![0.0f64; delay as usize + 1];
-        let (mut d, mut u) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for k in 0..n {
-            let y = history[0] + 0.002 * random.normal_pair().0;
-            let c = -(kp * y + integral);
-            integral += ki * t * y;
-            let time = k as f64 * t - lead;
-            let injection = if (0.0..=duration).contains(&time) {
-                fade(time) * sweep(time, duration, band)
-            } else {
-                0.0
-            };
-            let total = c + injection;
-            d.push(injection);
-            u.push(total);
-            x = a * x + b * total;
-            history.rotate_left(1);
-            *history.last_mut().unwrap() = x;
-        }
-        let measured = broken_loop(&d, &u, rate, band, &BrokenLoopOptions::default()).unwrap();
+        let (d, u) = known.fly(band, 0.002, 7);
+        let measured = broken_loop(&d, &u, 200.0, band, &BrokenLoopOptions::default()).unwrap();
         let mut compared = 0;
         for ((w, l), g) in measured
             .omega
@@ -373,7 +425,7 @@ mod tests {
                 continue;
             }
             compared += 1;
-            let truth = exact(*w);
+            let truth = known.exact(*w);
             let db = 20.0 * (l.norm() / truth.norm()).log10();
             let degrees = (l / truth).arg().to_degrees();
             assert!(
@@ -387,12 +439,8 @@ mod tests {
             "{}",
             measured.resolved_from_rad_s
         );
-        let grid = control::loops::log_grid(band[0], band[1], 2400);
-        let truth = exact_margins(&Sampled {
-            values: grid.iter().map(|w| exact(*w)).collect(),
-            omega: grid,
-        });
-        let (found, valid) = valid_margins(&measured, COHERENCE_THRESHOLD);
+        let truth = known.margins(band);
+        let (found, valid) = valid_margins(&measured, MAX_RANDOM_ERROR);
         assert!(valid > 150);
         let pair = |a: Option<f64>, b: Option<f64>| (a.unwrap(), b.unwrap());
         let (gm, gm_true) = pair(found.gain_margin_db, truth.gain_margin_db);
@@ -403,5 +451,46 @@ mod tests {
         assert!((gm - gm_true).abs() < 0.3, "GM {gm} vs {gm_true}");
         assert!((pm - pm_true).abs() < 1.5, "PM {pm} vs {pm_true}");
         assert!((wc / wc_true - 1.0).abs() < 0.02, "wc {wc} vs {wc_true}");
+    }
+
+    /// With measurement noise large enough that the coherence near the phase crossover
+    /// (50 rad/s) falls to 0.3–0.5 (the loop's output there small against the noise it
+    /// carries, as on a heading loop), the random error still bounds the estimate: over
+    /// ten noise seeds the valid points of coherence below 0.6 lie within their random
+    /// error of the truth (rms of |L̂/L − 1| against the rms εr), and the gain margin is
+    /// measured on every seed within 1 dB of the exact one (−0.05 to +0.8 dB here; the
+    /// band reaches 80 rad/s so that the crossover lies clear of the sweep's fade-out).
+    #[test]
+    fn points_of_low_coherence_are_valid_within_their_random_error() {
+        let known = KnownLoop::new();
+        let band = [0.5, 80.0];
+        let truth = known.margins(band).gain_margin_db.unwrap();
+        let (mut error2, mut bound2, mut low) = (0.0, 0.0, 0usize);
+        for seed in 1..=10 {
+            let (d, u) = known.fly(band, 0.025, seed);
+            let measured = broken_loop(&d, &u, 200.0, band, &BrokenLoopOptions::default()).unwrap();
+            let (found, _) = valid_margins(&measured, MAX_RANDOM_ERROR);
+            let gm = found.gain_margin_db.expect("a gain margin on every seed");
+            assert!((gm - truth).abs() < 1.0, "seed {seed}: GM {gm} vs {truth}");
+            for k in 0..measured.omega.len() {
+                let (w, e, g) = (
+                    measured.omega[k],
+                    measured.random_error[k],
+                    measured.coherence[k],
+                );
+                if e <= MAX_RANDOM_ERROR && g < 0.6 && w >= measured.resolved_from_rad_s && w < 50.0
+                {
+                    low += 1;
+                    error2 += (measured.values[k] / known.exact(w) - 1.0).norm_sqr();
+                    bound2 += e * e;
+                }
+            }
+        }
+        assert!(low > 100, "{low} valid points of coherence below 0.6");
+        let (rms_error, rms_bound) = ((error2 / low as f64).sqrt(), (bound2 / low as f64).sqrt());
+        assert!(
+            rms_error < 1.5 * rms_bound,
+            "rms error {rms_error} against rms random error {rms_bound}"
+        );
     }
 }

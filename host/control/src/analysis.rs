@@ -79,6 +79,60 @@ pub struct LoopFigures {
     /// Every gain crossover of the identified model's loop: [ω_c rad/s, PM deg]. More
     /// than one where the loop is conditionally stable around unstable hover modes.
     pub all_crossovers: Vec<[f64; 2]>,
+    /// The highest frequency of the model's fitted pairs driven by the loop's actuator
+    /// [rad/s] (null: the model document lists none).
+    pub fitted_to_rad_s: Option<f64>,
+    /// The figures read beyond `fitted_to_rad_s` on the identified model (`crossover`,
+    /// `phase_crossover`): there the model is extrapolated, not identified, and the
+    /// figure rests on its structure alone.
+    pub extrapolated: Vec<&'static str>,
+    /// The model's worst-fitted pair driven by the loop's actuator, `output/input`, and its
+    /// cost J (null: the model document lists none).
+    pub worst_pair: Option<(String, f64)>,
+}
+
+/// A fitted pair's cost above which the figures of a loop it drives are marked: Tischler's
+/// guideline lets a few pairs of an acceptable fit (J_ave ≤ 100) reach 150–200; above it
+/// the model does not follow that response, and neither need its loop.
+pub const POOR_PAIR_COST: f64 = 200.0;
+
+/// The costliest of `document`'s fitted pairs whose input is `control`.
+pub fn worst_pair(document: &ModelDocument, control: &str) -> Option<(String, f64)> {
+    document
+        .pairs
+        .iter()
+        .filter(|pair| pair.input == control && pair.cost.is_finite())
+        .max_by(|a, b| a.cost.total_cmp(&b.cost))
+        .map(|pair| (format!("{}/{}", pair.output, pair.input), pair.cost))
+}
+
+/// The highest frequency of `document`'s fitted pairs whose input is `control` [rad/s].
+pub fn fitted_to(document: &ModelDocument, control: &str) -> Option<f64> {
+    document
+        .pairs
+        .iter()
+        .filter(|pair| pair.input == control && pair.range[1].is_finite())
+        .map(|pair| pair.range[1])
+        .reduce(f64::max)
+}
+
+/// Which of `figures`' frequencies lie beyond `fitted_to` (1 % above, for the grid).
+fn beyond(
+    fitted_to: Option<f64>,
+    crossover: Option<f64>,
+    phase_crossover: Option<f64>,
+) -> Vec<&'static str> {
+    let Some(top) = fitted_to else {
+        return Vec::new();
+    };
+    [
+        ("crossover", crossover),
+        ("phase_crossover", phase_crossover),
+    ]
+    .into_iter()
+    .filter(|(_, w)| w.is_some_and(|w| w > 1.01 * top))
+    .map(|(name, _)| name)
+    .collect()
 }
 
 /// ADS-33 figures of one stick.
@@ -395,6 +449,7 @@ pub fn analyse(
         .enumerate()
         .map(|(i, &(name, broken_at, config, _))| {
             let f = |k: usize| figure(nominal.loops[i][k], &move |s: &Scalars| s.loops[i][k]);
+            let fitted_to_rad_s = fitted_to(document, broken_at);
             LoopFigures {
                 name,
                 broken_at,
@@ -407,6 +462,9 @@ pub fn analyse(
                 phase_crossover_rad_s: f(5),
                 drb_rad_s: f(6),
                 all_crossovers: nominal.crossovers[i].clone(),
+                fitted_to_rad_s,
+                extrapolated: beyond(fitted_to_rad_s, nominal.loops[i][0], nominal.loops[i][5]),
+                worst_pair: worst_pair(document, broken_at),
             }
         })
         .collect();
@@ -466,4 +524,25 @@ fn standard_deviation(values: &[f64]) -> Option<f64> {
     let mean = values.iter().sum::<f64>() / n;
     let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
     Some(variance.sqrt())
+}
+
+#[cfg(test)]
+mod fitted_band_tests {
+    use super::*;
+
+    #[test]
+    fn figures_above_the_fitted_band_are_named() {
+        assert_eq!(
+            beyond(Some(31.4), Some(4.5), Some(44.5)),
+            vec!["phase_crossover"]
+        );
+        assert_eq!(
+            beyond(Some(62.8), Some(4.5), Some(44.5)),
+            Vec::<&str>::new()
+        );
+        assert_eq!(beyond(None, Some(4.5), Some(44.5)), Vec::<&str>::new());
+        assert_eq!(beyond(Some(31.4), Some(40.0), None), vec!["crossover"]);
+        // On the grid's edge: 1 % above the top is still the fitted band.
+        assert_eq!(beyond(Some(31.4), Some(31.6), None), Vec::<&str>::new());
+    }
 }

@@ -92,3 +92,51 @@ fn without_a_finite_bound_there_is_no_spread_and_a_note() {
         result.notes
     );
 }
+
+/// The Bo-105 model is fitted to 31.4 rad/s on every control; its heading loop's phase
+/// crossover (about 45 rad/s) is read where the model is extrapolated, and says so; its
+/// attitude loops' figures lie inside the fitted band.
+#[test]
+fn figures_beyond_the_fitted_band_are_marked() {
+    let options = AnalysisOptions {
+        samples: 0,
+        ..AnalysisOptions::default()
+    };
+    let result = analyse(&document(|_| {}), None, &law(), None, &options).unwrap();
+    let find = |name: &str| result.loops.iter().find(|l| l.name == name).unwrap();
+    let heading = find("heading");
+    assert!((heading.fitted_to_rad_s.unwrap() - 31.4).abs() < 1e-3);
+    assert!(heading.phase_crossover_rad_s.value.unwrap() > 35.0);
+    assert_eq!(heading.extrapolated, vec!["phase_crossover"]);
+    let roll = find("roll_attitude");
+    assert!(roll.extrapolated.is_empty(), "{:?}", roll.extrapolated);
+}
+
+/// Each loop names the costliest fitted pair its actuator drives: a ped pair refitted at
+/// J 334 is the heading and yaw-rate loops' worst, above the bound that marks it.
+#[test]
+fn each_loop_names_its_worst_fitted_pair() {
+    let options = AnalysisOptions {
+        samples: 0,
+        ..AnalysisOptions::default()
+    };
+    let edited = document(|value| {
+        for pair in value["pairs"].as_array_mut().unwrap() {
+            if pair["input"] == "ped" && pair["output"] == "r" {
+                pair["cost"] = serde_json::json!(334.0);
+            }
+        }
+    });
+    let result = analyse(&edited, None, &law(), None, &options).unwrap();
+    let find = |name: &str| result.loops.iter().find(|l| l.name == name).unwrap();
+    for name in ["heading", "yaw_rate"] {
+        let (pair, cost) = find(name).worst_pair.clone().unwrap();
+        assert_eq!((pair.as_str(), cost), ("r/ped", 334.0));
+        assert!(cost > control::analysis::POOR_PAIR_COST);
+    }
+    let (pair, cost) = find("roll_attitude").worst_pair.clone().unwrap();
+    assert!(
+        pair.ends_with("/lat") && cost < control::analysis::POOR_PAIR_COST,
+        "{pair} {cost}"
+    );
+}

@@ -7,11 +7,15 @@
 //! back over [`GUST_LENGTH_S`], `w(t) = W/2·(1 − cos(2πt/T))`. A hovering helicopter has
 //! no airspeed to turn a gust length into a time: the length is stated in seconds. The
 //! excursion is measured on the simulated aircraft (not the board's estimate) from its
-//! attitude at the gust's onset to the end of the flight.
+//! attitude at the gust's onset to the end of the flight, and its trace is kept
+//! ([`TRACE_STEP_S`]): the same flight in still air (the gust's components zero; the same
+//! seed and board fly the same flight up to the onset) subtracted from it leaves the
+//! attitude response to the gust alone, free of the hover's own motion
+//! (`docs/tuned_gains.py`).
 
 use std::f64::consts::PI;
 
-use super::summary::{AttitudeDeg, GustPulseSummary};
+use super::summary::{AttitudeDeg, ExcursionTrace, GustPulseSummary};
 
 /// Duration of the gust's rise and fall \[s\]: about the roll and pitch attitude loops'
 /// period (ω_c 4–10 rad/s), where a gust disturbs them most.
@@ -20,6 +24,10 @@ pub const GUST_LENGTH_S: f64 = 1.0;
 /// Largest body-axis gust component \[m/s\] accepted: a severe gust by MIL-F-8785C's
 /// tables at low altitude is about 15 m/s.
 pub const MAX_GUST_M_S: f64 = 20.0;
+
+/// Spacing of the excursion's trace in the summary \[s\] (50 Hz: ten samples per period
+/// of the fastest attitude loop's crossover, 30 rad/s).
+pub const TRACE_STEP_S: f64 = 0.02;
 
 /// A planned gust: its onset after the test's end and its peak air velocity.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,13 +81,15 @@ impl GustPulse {
 }
 
 /// The aircraft's response to the gust, followed tick by tick.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct GustResponse {
     plan: GustPulse,
     /// φ, θ at the onset \[rad\].
     onset: Option<[f64; 2]>,
     /// Peak |φ − φ_onset|, |θ − θ_onset| \[rad\].
     peak: [f64; 2],
+    /// φ − φ_onset, θ − θ_onset every [`TRACE_STEP_S`] from the onset \[rad\].
+    trace: Vec<[f64; 2]>,
 }
 
 impl GustResponse {
@@ -89,6 +99,7 @@ impl GustResponse {
             plan,
             onset: None,
             peak: [0.0; 2],
+            trace: Vec::new(),
         }
     }
 
@@ -99,6 +110,12 @@ impl GustResponse {
             let onset = *self.onset.get_or_insert([attitude[0], attitude[1]]);
             for (peak, (now, start)) in self.peak.iter_mut().zip(attitude.iter().zip(onset)) {
                 *peak = peak.max((now - start).abs());
+            }
+            // The first tick at or after each multiple of the step from the onset.
+            let due = self.trace.len() as f64 * TRACE_STEP_S;
+            if t - self.plan.at_s >= due - 1e-9 {
+                self.trace
+                    .push([attitude[0] - onset[0], attitude[1] - onset[1]]);
             }
         }
         self.plan.wind(t)
@@ -114,8 +131,27 @@ impl GustResponse {
                 phi: self.peak[0].to_degrees(),
                 theta: self.peak[1].to_degrees(),
             },
+            excursion_deg: ExcursionTrace {
+                step_s: TRACE_STEP_S,
+                // 10⁻⁴ degree: far below any attitude the simulator resolves that matters,
+                // and it keeps the summary small.
+                phi: self
+                    .trace
+                    .iter()
+                    .map(|e| round4(e[0].to_degrees()))
+                    .collect(),
+                theta: self
+                    .trace
+                    .iter()
+                    .map(|e| round4(e[1].to_degrees()))
+                    .collect(),
+            },
         })
     }
+}
+
+fn round4(x: f64) -> f64 {
+    (x * 1e4).round() / 1e4
 }
 
 #[cfg(test)]
@@ -164,5 +200,26 @@ mod tests {
         assert!((summary.peak_excursion_deg.phi - 0.05f64.to_degrees()).abs() < 1e-9);
         assert!((summary.peak_excursion_deg.theta - 0.05f64.to_degrees()).abs() < 1e-9);
         assert_eq!(summary.length_s, GUST_LENGTH_S);
+        // The trace: the onset, then one sample per step (the ticks here 0.5 s apart).
+        assert_eq!(summary.excursion_deg.phi.len(), 3);
+        assert_eq!(summary.excursion_deg.phi[0], 0.0);
+        assert!((summary.excursion_deg.phi[1] - round4(0.05f64.to_degrees())).abs() < 1e-12);
+        assert!((summary.excursion_deg.theta[2] - round4(0.05f64.to_degrees())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_trace_samples_every_step_from_the_onset() {
+        let mut response = GustResponse::new(GustPulse::parse("1:0,3,0").unwrap());
+        let tick = 0.005;
+        for k in 0..=400 {
+            let t = k as f64 * tick;
+            response.step(t, [0.01 * t, 0.0, 0.0]);
+        }
+        let summary = response.summary().unwrap();
+        // 1 s flown from the onset at 50 Hz: 51 samples, each 0.02 s of φ-rate 0.01 rad/s.
+        assert_eq!(summary.excursion_deg.phi.len(), 51);
+        let step = round4((0.01 * TRACE_STEP_S).to_degrees());
+        assert!((summary.excursion_deg.phi[1] - step).abs() < 2e-4);
+        assert!((summary.excursion_deg.phi[50] - round4(0.01f64.to_degrees())).abs() < 2e-4);
     }
 }

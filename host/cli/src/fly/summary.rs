@@ -72,7 +72,7 @@ pub struct AfterTest {
 }
 
 /// A discrete gust flown after the test (`fly --gust-pulse`) and the aircraft's response.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GustPulseSummary {
     /// Onset, seconds after the test ended.
     pub at_s: f64,
@@ -83,6 +83,20 @@ pub struct GustPulseSummary {
     /// Peak |φ − φ_onset|, |θ − θ_onset| of the simulated aircraft from the onset to the
     /// end of the flight \[deg\].
     pub peak_excursion_deg: AttitudeDeg,
+    /// φ − φ_onset, θ − θ_onset over that time, one sample per `step_s`.
+    #[serde(default)]
+    pub excursion_deg: ExcursionTrace,
+}
+
+/// An attitude trace sampled at a fixed step (`fly --gust-pulse`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExcursionTrace {
+    /// Spacing of the samples \[s\], the first at the onset.
+    pub step_s: f64,
+    /// φ − φ_onset \[deg\].
+    pub phi: Vec<f64>,
+    /// θ − θ_onset \[deg\].
+    pub theta: Vec<f64>,
 }
 
 /// One flown record.

@@ -65,6 +65,9 @@ pub struct BrokenLoop {
     /// Its coherence min(γ²_du, γ²_dc), bias-corrected, at each (0 where no window
     /// resolves it).
     pub coherence: Vec<f64>,
+    /// The normalized random error of each value ([`random_error`] of its coherence and
+    /// its window's independent averages; infinite where no window resolves it).
+    pub random_error: Vec<f64>,
     /// The lowest frequency the estimate is free of the windows' resolution bias
     /// [rad/s]: [`RESOLVED_PERIODS`] times the lowest the longest window resolves.
     pub resolved_from_rad_s: f64,
@@ -156,6 +159,7 @@ pub fn broken_loop(
         omega,
         values,
         coherence,
+        random_error: least_error,
         resolved_from_rad_s: RESOLVED_PERIODS * lowest_resolved(longest),
     })
 }
