@@ -33,15 +33,10 @@ import json
 import os
 import subprocess
 import sys
+from runs import BINARY, seeds
 
 KEY = ["tau_f", "Lb1s", "Mb1c", "Zcol", "Nped", "Mf_lat", "Mf_lon", "Lf_lat", "Lf_lon"]
 SPEED = ["Mu", "Lv", "Nv"]
-BINARY = os.path.join(os.path.dirname(__file__), "..", "target", "release", "sweephold")
-
-
-def seeds(text):
-    lo, _, hi = text.partition("-")
-    return range(int(lo), int(hi or lo) + 1)
 
 
 def campaign(vehicle, seed, folder, reuse, extra):

@@ -37,16 +37,10 @@ import re
 import subprocess
 import sys
 import tomllib
+from runs import BINARY, ROOT, seeds
 
-ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-BINARY = os.path.join(ROOT, "target", "release", "sweephold")
 KEY = ["tau_f", "Lb1s", "Mb1c", "Zcol", "Nped", "Mf_lat", "Mf_lon", "Lf_lat", "Lf_lon"]
 ON_BOUND_RELATIVE = 1e-3
-
-
-def seeds(text):
-    lo, _, hi = text.partition("-")
-    return range(int(lo), int(hi or lo) + 1)
 
 
 def structure_bounds(vehicle):

@@ -15,19 +15,8 @@ one row per seed and loop and the largest differences. Needs the release build:
 import argparse
 import json
 import os
-import subprocess
 import sys
-
-BINARY = os.path.join(os.path.dirname(__file__), "..", "target", "release", "sweephold")
-
-
-def seeds(text):
-    low, _, high = text.partition("-")
-    return range(int(low), int(high or low) + 1)
-
-
-def run(args):
-    subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
+from runs import BINARY, run, seeds
 
 
 def main():

@@ -27,23 +27,10 @@ import argparse
 import json
 import os
 import shutil
-import subprocess
 import sys
+from runs import BINARY, ROOT, run, seeds
 
-ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-BINARY = os.path.join(ROOT, "target", "release", "sweephold")
 LOOPS = ("roll_attitude", "pitch_attitude", "heading")
-
-
-def seeds(text):
-    low, _, high = text.partition("-")
-    return range(int(low), int(high or low) + 1)
-
-
-def run(args, capture=False):
-    result = subprocess.run(args, check=True, stdout=subprocess.PIPE if capture else subprocess.DEVNULL,
-                            text=True)
-    return result.stdout
 
 
 def aircraft_file(vehicle):

@@ -21,6 +21,7 @@ import json
 import os
 import subprocess
 import sys
+from runs import seeds
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TREX = os.path.join(HERE, "..", "host", "aircraft", "vehicles", "trex700l.toml")
@@ -42,11 +43,6 @@ CASES = {
         ('hub = ["-0.95 m", "0 m", "-0.12 m"]', 'hub = ["-0.8075 m", "0 m", "-0.138 m"]'),  # tail arm -15 %, height +15 %
     ],
 }
-
-
-def seeds(text):
-    lo, _, hi = text.partition("-")
-    return range(int(lo), int(hi or lo) + 1)
 
 
 def main():
