@@ -26,7 +26,13 @@ pub struct DumpSweeps {
 /// error, and so is a dump none of whose tests is used (the first test's reason: its
 /// record's error when it has one, else why it was left out).
 pub fn sweep_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpSweeps> {
-    let tests = chosen_tests(path, Excitation::Sweep, include_aborted, include_aborted)?;
+    let tests = chosen_tests(
+        path,
+        Excitation::Sweep,
+        include_aborted,
+        include_aborted,
+        false,
+    )?;
     Ok(DumpSweeps {
         lines: tests.listing.iter().map(TestListing::line).collect(),
         records: tests
@@ -67,6 +73,9 @@ pub struct DumpTests {
     pub used: Vec<UsedTest>,
     /// Every test with what became of it.
     pub listing: Vec<TestListing>,
+    /// The loop tests among them (listed, never used: their broken loops are measured
+    /// by `margins --measured` and `identify`'s margins stage).
+    pub loop_tests: usize,
 }
 
 /// Every test of the dump `path` with an excitation of any kind (sweep, doublet,
@@ -81,22 +90,43 @@ pub fn excitation_records(
     include_aborted: bool,
     include_partial: bool,
 ) -> anyhow::Result<DumpTests> {
-    chosen_tests(path, Excitation::Any, include_aborted, include_partial)
+    chosen_tests(
+        path,
+        Excitation::Any,
+        include_aborted,
+        include_partial,
+        false,
+    )
+}
+
+/// [`excitation_records`] for `identify`, which also measures the loop tests: a dump
+/// whose tests are all loop tests is taken (nothing used, its loop tests counted).
+pub fn identify_records(path: &Path, include_aborted: bool) -> anyhow::Result<DumpTests> {
+    chosen_tests(
+        path,
+        Excitation::Any,
+        include_aborted,
+        include_aborted,
+        true,
+    )
 }
 
 /// The tests of the dump `path` whose records of `excitation` are used, and every test
-/// with what became of it (the rules of [`sweep_records`] and [`excitation_records`]).
+/// with what became of it (the rules of [`sweep_records`] and [`excitation_records`]);
+/// with `loop_only_ok` a dump of loop tests alone is no error ([`identify_records`]).
 fn chosen_tests(
     path: &Path,
     excitation: Excitation,
     include_aborted: bool,
     include_partial: bool,
+    loop_only_ok: bool,
 ) -> anyhow::Result<DumpTests> {
     let (tests, _) = load_dump_tests(path, excitation)?;
     let file = path.display().to_string();
     let mut used = Vec::new();
     let mut listing = Vec::new();
     let mut refusal: Option<String> = None;
+    let mut loop_tests = 0;
     for TestRecord { test, record } in tests {
         let end = test.end();
         let is_sweep = test.header.test.input.is_sweep();
@@ -111,11 +141,12 @@ fn chosen_tests(
             // airframe's response to it is not an open-loop record, and what it measures
             // is the broken loop (`margins --measured`).
             (_, _) if test.header.test.input.is_loop() => {
+                loop_tests += 1;
                 refusal.get_or_insert(format!(
                     "{file}: test {}: a loop test: `sweephold margins --measured` reads it",
                     test.number
                 ));
-                "left out: a loop test (`margins --measured` reads it)".to_string()
+                "left out: a loop test (`margins --measured` and `identify` measure its broken loop)".to_string()
             }
             (_, Err(error)) if excitation == Excitation::Sweep && !is_sweep => {
                 refusal.get_or_insert(error.to_string());
@@ -154,7 +185,7 @@ fn chosen_tests(
             verdict,
         });
     }
-    if used.is_empty() {
+    if used.is_empty() && !(loop_only_ok && loop_tests > 0) {
         let what = match excitation {
             Excitation::Sweep => "a sweep",
             Excitation::Any => "an excitation",
@@ -164,7 +195,11 @@ fn chosen_tests(
             refusal.unwrap_or_else(|| format!("{file}: no test with {what}"))
         ));
     }
-    Ok(DumpTests { used, listing })
+    Ok(DumpTests {
+        used,
+        listing,
+        loop_tests,
+    })
 }
 
 impl TestListing {

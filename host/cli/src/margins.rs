@@ -20,6 +20,7 @@ use sysid::fit::model::Actuator;
 use sysid::fit::{ModelDocument, ModelStructure};
 use sysid::models;
 
+use crate::artifacts::files;
 use crate::measured_loop;
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json};
 use crate::structures;
@@ -199,6 +200,103 @@ pub fn run(args: &MarginsArgs) -> anyhow::Result<()> {
         text.push_str(&measured_loop::table(&document.measured));
         crate::output::print(&text)
     }
+}
+
+/// Models drawn for the spreads in the margins stage of `campaign` and `identify`: fewer
+/// than the verb's 200, so that the stage stays a small part of the run (each draw
+/// analyses every loop on the full grid); a spread from 60 draws is within about 9 % of
+/// its value (relative standard error 1/√(2·59)). `sweephold margins` on the folder's
+/// `model9.json` gives the 200.
+pub const STAGE_SAMPLES: usize = 60;
+
+/// Frequencies of the loops sampled for the report's plots: the Bode plots need a few
+/// hundred points, not the analysis grid's 2400 (the figures come from margins.json).
+pub const PLOTTED_POINTS: usize = 400;
+
+/// The margins stage of `campaign` and `identify` in `dir`: `margins.json`, the figures of
+/// `args.model` under `args`' law with the loop tests of `args.measured` measured beside
+/// them, and `margins-loops.json`, the nominal loops on [`PLOTTED_POINTS`] frequencies for
+/// the report's plots; the stage's progress line. A model the analysis cannot take
+/// (singular at a frequency of the grid) is reported in the line, not fatal, as a loop test
+/// that cannot be measured is: the fit and the report still stand, and the report says
+/// what is absent.
+pub fn write_stage_files(dir: &Path, args: &MarginsArgs) -> anyhow::Result<String> {
+    let analysis = match analyse(args) {
+        Ok(analysis) => analysis,
+        Err(error) => return Ok(format!("not computed: {error:#}")),
+    };
+    let (measured, unmeasured) = match measured_loop::measure_all(&args.measured) {
+        Ok(measured) => (measured, None),
+        Err(error) => (Vec::new(), Some(format!("{error:#}"))),
+    };
+    let document = WithMeasured {
+        predicted: &analysis.result,
+        measured: measured_loop::compared(&analysis.result, measured),
+    };
+    write_json(&dir.join(files::MARGINS), &document)?;
+    write_json(
+        &dir.join(files::MARGINS_LOOPS),
+        &analysis.sampled(Some(PLOTTED_POINTS))?,
+    )?;
+    let mut line = stage_headline(&analysis.result);
+    if !document.measured.is_empty() {
+        let largest = |pick: &dyn Fn(&measured_loop::Compared) -> Option<f64>| {
+            document
+                .measured
+                .iter()
+                .filter_map(pick)
+                .map(f64::abs)
+                .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b))))
+                .map_or("-".to_string(), |v| format!("{v:.1}"))
+        };
+        line += &format!(
+            "; {} loop tests measured: |dGM| up to {} dB, |dPM| up to {} deg",
+            document.measured.len(),
+            largest(&|c| c.gain_margin_difference_db),
+            largest(&|c| c.phase_margin_difference_deg)
+        );
+    }
+    if let Some(why) = unmeasured {
+        line += &format!("; loop tests not measured: {why}");
+    }
+    Ok(line)
+}
+
+/// The stage's progress line: the least phase and gain margins over the loops, and the
+/// ADS-33 levels (tracking/other) per stick.
+pub fn stage_headline(result: &MarginsDocument) -> String {
+    let least = |pick: &dyn Fn(&control::analysis::LoopFigures) -> Option<f64>| {
+        result
+            .loops
+            .iter()
+            .filter_map(|l| pick(l).map(|v| (v, l.name)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    };
+    let pm = least(&|l| l.min_phase_margin_deg.value)
+        .map_or("-".to_string(), |(v, name)| format!("{v:.1} deg ({name})"));
+    let gm = least(&|l| l.gain_margin_db.value)
+        .map_or("-".to_string(), |(v, name)| format!("{v:.1} dB ({name})"));
+    let level = |l: Option<u8>| l.map_or("-".to_string(), |l| l.to_string());
+    let levels: Vec<String> = result
+        .handling
+        .iter()
+        .map(|h| {
+            format!(
+                "{} {} {}/{}",
+                h.axis,
+                match h.mode {
+                    control::law::LoopMode::Rate => "rate",
+                    control::law::LoopMode::Level => "level",
+                },
+                level(h.level_tracking),
+                level(h.level_other)
+            )
+        })
+        .collect();
+    format!(
+        "least PM {pm}, least GM {gm}; ADS-33 levels T/O {}",
+        levels.join(", ")
+    )
 }
 
 /// `margins.json`: the predicted figures and, with `--measured`, the measured loops

@@ -136,30 +136,57 @@ fn is_excitation(phase: Phase) -> bool {
     matches!(phase, Phase::FadeIn | Phase::Sweep | Phase::FadeOut)
 }
 
-/// The broken loop of the loop test in dump `path`.
-pub fn measure(path: &Path) -> anyhow::Result<MeasuredLoop> {
+/// The broken loop of every loop test in the dump `path` (a loop test's own dump, or a
+/// logger's file holding several tests: each loop test of it, named `FILE test N`). A
+/// dump without a loop test is an error that names what its first test is.
+pub fn measure_dump(path: &Path) -> anyhow::Result<Vec<MeasuredLoop>> {
     check_input_file("loop-test dump", path)?;
     let bytes = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
     let source = path.display().to_string();
     let split = split_tests(&bytes, &source)?;
-    let Some(test) = split
+    let excited: Vec<_> = split
         .tests
         .iter()
-        .find(|test| test.samples.iter().any(|s| is_excitation(s.phase)))
-    else {
+        .filter(|test| test.samples.iter().any(|s| is_excitation(s.phase)))
+        .collect();
+    let Some(first) = excited.first() else {
         bail!("{source}: no test with an excitation");
     };
-    let header = &test.header;
-    if header.test.input != InputKind::LoopSweep {
+    let loops: Vec<_> = excited
+        .iter()
+        .filter(|test| test.header.test.input == InputKind::LoopSweep)
+        .collect();
+    if loops.is_empty() {
         bail!(
             "{source}: the test is a {:?}, not a loop test (fly --input loop)",
-            header.test.input
+            first.header.test.input
         );
     }
+    let several = split.tests.len() > 1;
+    loops
+        .iter()
+        .map(|test| {
+            let name = if several {
+                format!("{} test {}", file_name(path), test.number)
+            } else {
+                file_name(path)
+            };
+            measure_test(&test.header, &test.samples, &source, name)
+        })
+        .collect()
+}
+
+/// The broken loop of one loop test (its Header and Samples), named `name`.
+fn measure_test(
+    header: &sweephold_protocol::Header,
+    samples: &[sweephold_protocol::Sample],
+    source: &str,
+    name_in_document: String,
+) -> anyhow::Result<MeasuredLoop> {
     let axis = header.test.primary;
     let name = predicted_counterpart(axis)
         .ok_or_else(|| anyhow!("{source}: a loop test on {}", axis.name()))?;
-    let record = record_from_samples(header, &test.samples, &source)?;
+    let record = record_from_samples(header, samples, source)?;
     let k = axis.index();
     let (total, injection) = match (record.inputs.get(k), record.references.get(k)) {
         (Some(u), Some(d)) => (&u.values, &d.values),
@@ -180,7 +207,7 @@ pub fn measure(path: &Path) -> anyhow::Result<MeasuredLoop> {
     let (figures, valid_points) = valid_margins(&measured, MAX_RANDOM_ERROR);
     let finite = |v: f64| v.is_finite().then_some(v);
     Ok(MeasuredLoop {
-        source: file_name(path),
+        source: name_in_document,
         name,
         broken_at: axis.name(),
         band_rad_s: band,
@@ -210,9 +237,13 @@ fn file_name(path: &Path) -> String {
     )
 }
 
-/// Every measured loop of `paths`, in order.
+/// Every measured loop of `paths`, in order (each dump's loop tests in its order).
 pub fn measure_all(paths: &[PathBuf]) -> anyhow::Result<Vec<MeasuredLoop>> {
-    paths.iter().map(|path| measure(path)).collect()
+    let mut all = Vec::new();
+    for path in paths {
+        all.extend(measure_dump(path)?);
+    }
+    Ok(all)
 }
 
 /// A measured loop beside its predicted figures.

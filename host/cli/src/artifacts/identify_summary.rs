@@ -14,11 +14,12 @@ use crate::dump_tests::TestListing;
 /// The stages of `identify` as its `summary.json` names them (`timings_s`, `error`), in
 /// run order. The report (the last stage, `report`) is drawn from the summary written
 /// before it, so neither its time nor `total` counts it.
-pub const STAGES: [&str; 5] = [
+pub const STAGES: [&str; 6] = [
     stage::FRF,
     stage::FIT_6DOF,
     stage::FIT_9DOF,
     stage::VERIFY,
+    stage::MARGINS,
     stage::REPORT,
 ];
 
@@ -32,6 +33,9 @@ pub mod stage {
     pub const FIT_9DOF: &str = "fit-9dof";
     /// The verification on the held-out tests.
     pub const VERIFY: &str = "verify";
+    /// The loop margins of the model under the aircraft's board law, with the logs' loop
+    /// tests measured beside them (`margins.json`, `margins-loops.json`).
+    pub const MARGINS: &str = "margins";
     /// `report.html`.
     pub const REPORT: &str = "report";
 }

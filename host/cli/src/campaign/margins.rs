@@ -6,24 +6,16 @@ use std::ffi::OsString;
 
 use super::{verb_args, Campaign};
 use crate::artifacts::files;
-use crate::margins::{analyse, MarginsArgs};
-use crate::output::write_json;
+use crate::margins::{write_stage_files, MarginsArgs};
 
 /// Models drawn for the spreads with `--quick`.
 pub const QUICK_SAMPLES: usize = 40;
 
-/// Models drawn for the spreads in a full campaign: fewer than the verb's 200, so that the
-/// stage stays a small part of the campaign (each draw analyses every loop on the full
-/// grid); a spread from 60 draws is within about 9 % of its value (relative standard
-/// error 1/√(2·59)). `sweephold margins` on the campaign's `model9.json` gives the 200.
-pub const CAMPAIGN_SAMPLES: usize = 60;
-
-/// Frequencies of the loops sampled for the report's plots: the Bode plots need a few
-/// hundred points, not the analysis grid's 2400 (the figures come from margins.json).
-pub const PLOTTED_POINTS: usize = 400;
+pub use crate::margins::{PLOTTED_POINTS, STAGE_SAMPLES as CAMPAIGN_SAMPLES};
 
 impl Campaign<'_> {
-    /// The margins stage: the figures of `model9.json` under the vehicle's board law.
+    /// The margins stage: the figures of `model9.json` under the vehicle's board law
+    /// ([`crate::margins::write_stage_files`]).
     pub(super) fn margins(&mut self) -> anyhow::Result<((), String)> {
         let model = self.dir().join(files::MODEL_9DOF);
         let argv: Vec<OsString> = vec![model.into()];
@@ -36,57 +28,9 @@ impl Campaign<'_> {
         } else {
             CAMPAIGN_SAMPLES
         };
-        // Reported, not fatal (as the truth stage's modes): a model the analysis cannot
-        // take (singular at a frequency of the grid) still has its fit and report; the
-        // report then says margins.json is absent.
-        let analysis = match analyse(&args) {
-            Ok(analysis) => analysis,
-            Err(error) => return Ok(((), format!("not computed: {error:#}"))),
-        };
-        write_json(&self.dir().join(files::MARGINS), &analysis.result)?;
-        write_json(
-            &self.dir().join(files::MARGINS_LOOPS),
-            &analysis.sampled(Some(PLOTTED_POINTS))?,
-        )?;
-        Ok(((), headline(&analysis.result)))
+        let line = write_stage_files(self.dir(), &args)?;
+        Ok(((), line))
     }
-}
-
-/// The stage's progress line: the least phase and gain margins over the loops, and the
-/// ADS-33 levels (tracking/other) per stick.
-fn headline(result: &control::MarginsDocument) -> String {
-    let least = |pick: &dyn Fn(&control::analysis::LoopFigures) -> Option<f64>| {
-        result
-            .loops
-            .iter()
-            .filter_map(|l| pick(l).map(|v| (v, l.name)))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-    };
-    let pm = least(&|l| l.min_phase_margin_deg.value)
-        .map_or("-".to_string(), |(v, name)| format!("{v:.1} deg ({name})"));
-    let gm = least(&|l| l.gain_margin_db.value)
-        .map_or("-".to_string(), |(v, name)| format!("{v:.1} dB ({name})"));
-    let level = |l: Option<u8>| l.map_or("-".to_string(), |l| l.to_string());
-    let levels: Vec<String> = result
-        .handling
-        .iter()
-        .map(|h| {
-            format!(
-                "{} {} {}/{}",
-                h.axis,
-                match h.mode {
-                    control::law::LoopMode::Rate => "rate",
-                    control::law::LoopMode::Level => "level",
-                },
-                level(h.level_tracking),
-                level(h.level_other)
-            )
-        })
-        .collect();
-    format!(
-        "least PM {pm}, least GM {gm}; ADS-33 levels T/O {}",
-        levels.join(", ")
-    )
 }
 
 #[cfg(test)]

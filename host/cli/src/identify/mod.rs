@@ -3,8 +3,9 @@
 //! frequency responses of the sweeps, the 6-DOF then the 9-DOF hybrid fit of the aircraft
 //! file's structure reduced to the outputs the logs hold, with the file's a-priori
 //! constants and trim balance, the verification on the held-out tests (doublets,
-//! 3-2-1-1), `summary.json`, and last `report.html` drawn from the folder's files (the
-//! report's page of an identify folder: no truth in it).
+//! 3-2-1-1), the loop margins of the model with the logs' loop tests measured beside them,
+//! `summary.json`, and last `report.html` drawn from the folder's files (the report's page
+//! of an identify folder: no truth in it).
 //!
 //! The stages are the campaign's own ([`stages`]: `campaign` runs them on what it flew):
 //! one pipeline. Where the campaign asks the simulator — its steady flights for the trim
@@ -31,7 +32,7 @@ use sysid::records::check_one_origin;
 use crate::artifacts::files;
 use crate::artifacts::identify_summary::{stage, IdentifySummary};
 use crate::artifacts::summary::StageFailure;
-use crate::dump_tests::{excitation_records, UsedTest};
+use crate::dump_tests::{identify_records, UsedTest};
 use crate::fit::TrimBalanceArg;
 use crate::output::{check_input_file, refuse_inputs_as_outputs, write_json, StagedFolder};
 use crate::structures::TrimAttitude;
@@ -45,9 +46,11 @@ use stages::Pipeline;
 each test is listed on stderr and in summary.json with what became of it). A folder stands \
 for the dumps (*.bin) directly in it. Sweep tests give the frequency responses (in the \
 order lat, lon, ped, col, each axis's tests in the order given), every other test (doublet, \
-3-2-1-1) is held out for the verification (in the same order). Aborted tests and tests cut off by the end of \
-a file are left out unless --include-aborted. Writes into DIR: frf.json, model6.json, \
-model9.json, verify.json (when there are held-out tests), trim-points.csv (with \
+3-2-1-1) is held out for the verification (in the same order), every loop test (fly --input \
+loop) is measured beside the model's predicted loop in margins.json. Aborted tests and tests \
+cut off by the end of a file are left out unless --include-aborted. Writes into DIR: \
+frf.json, model6.json, model9.json, verify.json (when there are held-out tests), \
+margins.json and margins-loops.json, trim-points.csv (with \
 --steady-flights), summary.json (layout in \
 docs/formats.md) and last report.html, drawn from these files alone (`sweephold report DIR` \
 redraws it byte for byte). The run is built in DIR.partial and replaces DIR only when it completes; \
@@ -176,11 +179,13 @@ fn axis_rank(record: &Record) -> usize {
         .unwrap_or(Axis::ALL.len())
 }
 
-/// What the logs give: the sweeps, the held-out tests, the mean captured trim.
+/// What the logs give: the sweeps, the held-out tests, the mean captured trim, the dumps
+/// holding loop tests.
 struct Tests {
     sweeps: Vec<Record>,
     held_out: Vec<(String, Record)>,
     trim: Option<TrimAttitude>,
+    loop_dumps: Vec<PathBuf>,
 }
 
 /// Read every test of `dumps` into `summary` and [`Tests`].
@@ -193,6 +198,7 @@ fn read_tests(
     let mut sweeps = Vec::new();
     let mut held_out = Vec::new();
     let mut captured: Vec<[f32; 2]> = Vec::new();
+    let mut loop_dumps = Vec::new();
     for path in dumps {
         if crate::logs::log_format(path).is_some() {
             bail!(
@@ -200,8 +206,11 @@ fn read_tests(
                 path.display()
             );
         }
-        let tests = excitation_records(path, include_aborted, include_aborted)?;
+        let tests = identify_records(path, include_aborted)?;
         summary.tests.extend(tests.listing);
+        if tests.loop_tests > 0 {
+            loop_dumps.push(path.clone());
+        }
         let trims = captured_trims(path)?;
         for UsedTest {
             number,
@@ -222,6 +231,12 @@ fn read_tests(
     // Dumps of two vehicles (or flight controllers, or rates) are not one aircraft's.
     check_one_origin(&origins)?;
     if sweeps.is_empty() {
+        if !loop_dumps.is_empty() {
+            bail!(
+                "no completed sweep test in the logs, only loop tests: nothing to identify \
+                 (`sweephold margins MODEL --measured DUMP` measures them against a model)"
+            );
+        }
         bail!("no completed sweep test in the logs: nothing to identify");
     }
     // A stable sort: each axis's tests keep the order they were given in.
@@ -249,6 +264,7 @@ fn read_tests(
         sweeps,
         held_out,
         trim,
+        loop_dumps,
     })
 }
 
@@ -409,6 +425,7 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
         sweeps,
         held_out,
         trim,
+        loop_dumps,
     } = tests;
     let frf = run.stage(stage::FRF, |run| run.pipeline().frequency_responses(sweeps))?;
     let six = run.stage(stage::FIT_6DOF, |run| {
@@ -428,6 +445,9 @@ pub fn identify(args: &IdentifyArgs) -> anyhow::Result<IdentifySummary> {
             Ok(((), line))
         })?;
     }
+    run.stage(stage::MARGINS, |run| {
+        Ok(((), run.pipeline().margins(&loop_dumps)?))
+    })?;
     // The report is drawn from the folder's files, the summary included: written first
     // and not again, so that `sweephold report DIR` redraws the same page.
     run.stage(stage::REPORT, |run| {

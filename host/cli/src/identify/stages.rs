@@ -36,6 +36,7 @@ use crate::artifacts::summary::{
 use crate::artifacts::verification::{VerifiedOutput, VerifiedRecord, VerifyDocument};
 use crate::fit::{FitArgs, TrimBalanceArg};
 use crate::frf::FrfArgs;
+use crate::margins::MarginsArgs;
 use crate::output::write_json;
 use crate::structures::{self, TrimAttitude};
 use crate::vehicle::Vehicle;
@@ -77,6 +78,18 @@ pub struct Responses {
 }
 
 impl Pipeline<'_> {
+    /// The margins stage: `margins.json` of the folder's `model9.json` under the aircraft's
+    /// board law, with every loop test of `loop_dumps` measured beside the prediction, and
+    /// `margins-loops.json` for the report ([`crate::margins::write_stage_files`]).
+    pub fn margins(&self, loop_dumps: &[PathBuf]) -> anyhow::Result<String> {
+        let model = self.dir.join(files::MODEL_9DOF);
+        let mut args: MarginsArgs = verb_args("margins", [model.into_os_string()])?;
+        args.vehicle = Some(self.vehicle.clone());
+        args.samples = crate::margins::STAGE_SAMPLES;
+        args.measured = loop_dumps.to_vec();
+        crate::margins::write_stage_files(self.dir, &args)
+    }
+
     /// The frf stage: the responses of the sweeps `records` (at least one), written to
     /// `frf.json`. For the Bo-105 the valid ranges come from the sweep-reference
     /// estimate's random error ([`RangeSource::SweepReference`](sysid::frf::RangeSource::SweepReference)).

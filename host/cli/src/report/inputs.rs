@@ -288,19 +288,12 @@ impl ReportInputs {
             }
         }
         let verify = read_optional(&dir.join(files::VERIFY))?;
-        let margins: Option<MarginsFile> = if campaign {
-            read_optional(&dir.join(files::MARGINS))?
-        } else {
-            None
-        };
+        // Both campaign and identify folders have the margins stage's files.
+        let margins: Option<MarginsFile> = read_optional(&dir.join(files::MARGINS))?;
         if let Some(Err(why)) = margins.as_ref().map(MarginsFile::check) {
             return Err(corrupt(&dir.join(files::MARGINS), why));
         }
-        let margins_loops = if campaign {
-            read_optional(&dir.join(files::MARGINS_LOOPS))?
-        } else {
-            None
-        };
+        let margins_loops = read_optional(&dir.join(files::MARGINS_LOOPS))?;
         let flown = match (flown, &summary) {
             (Some(flown), _) => flown,
             (None, FolderSummary::Campaign(campaign)) => decode_flown(dir, campaign)?,

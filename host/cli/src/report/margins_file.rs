@@ -99,6 +99,46 @@ pub struct MarginsFile {
     pub loops: Vec<LoopRow>,
     /// The five sticks.
     pub handling: Vec<HandlingRow>,
+    /// The loop tests measured beside the predictions (`margins --measured`, `identify`'s
+    /// margins stage; absent otherwise).
+    #[serde(default)]
+    pub measured: Vec<MeasuredRow>,
+}
+
+/// One loop test's measured broken loop beside the predicted figures of the loop it breaks.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct MeasuredRow {
+    /// The dump it came from (`FILE` or `FILE test N`).
+    pub source: String,
+    /// The predicted loop it breaks.
+    pub name: String,
+    /// Valid points of all.
+    pub valid_points: usize,
+    /// Grid points.
+    pub points: usize,
+    /// Measured crossover [rad/s].
+    pub crossover_rad_s: Option<f64>,
+    /// Measured phase margin \[deg\].
+    pub phase_margin_deg: Option<f64>,
+    /// Measured gain margin \[dB\].
+    pub gain_margin_db: Option<f64>,
+    /// The nominal predicted figures.
+    pub predicted: PredictedRow,
+    /// Measured − predicted gain margin \[dB\].
+    pub gain_margin_difference_db: Option<f64>,
+    /// Measured − predicted phase margin \[deg\].
+    pub phase_margin_difference_deg: Option<f64>,
+}
+
+/// The predicted figures a measured loop is compared with.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct PredictedRow {
+    /// Crossover [rad/s].
+    pub crossover_rad_s: Option<f64>,
+    /// Phase margin \[deg\].
+    pub phase_margin_deg: Option<f64>,
+    /// Gain margin \[dB\].
+    pub gain_margin_db: Option<f64>,
 }
 
 impl MarginsFile {

@@ -140,8 +140,9 @@ with the simulator's truth.",
 }
 
 /// The page of an identify folder: the tests read, then the campaign's sections of the
-/// model without their truth parts. No sweep time history nor coherence curves (they
-/// come from dumps outside the folder) and no loops (identify computes no margins).
+/// model without their truth parts, and the loops with the logs' loop tests measured
+/// beside them. No sweep time history nor coherence curves (they come from dumps outside
+/// the folder).
 fn identify_page(inputs: &ReportInputs, summary: &IdentifySummary) -> String {
     let title = format!(
         "sweephold identify: {} seed {}",
@@ -159,5 +160,6 @@ verification on the held-out tests.",
     body += &sections::modes::modes_section(inputs);
     body += &sections::costs::cost_section(inputs);
     body += &sections::verification::verification_section(inputs);
+    body += &sections::loops::loops_section(inputs);
     html::page(&title, &body)
 }

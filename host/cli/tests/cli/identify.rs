@@ -245,11 +245,15 @@ fn identify_fits_and_verifies_a_board_log_with_every_test_listed_and_no_truth() 
         "model6.json",
         "model9.json",
         "verify.json",
+        "margins.json",
+        "margins-loops.json",
         "summary.json",
         "report.html",
     ] {
         assert!(out.join(file).is_file(), "{file}\n{stderr}");
     }
+    // No loop test in the logs: the predicted margins alone.
+    assert!(json(&out.join("margins.json")).get("measured").is_none());
     // No truth: no truth model, no truth section in the model, none in the summary.
     assert!(!out.join("truth-model9.json").exists());
     assert!(json(&out.join("model9.json"))
@@ -341,6 +345,82 @@ fn identify_fits_and_verifies_a_board_log_with_every_test_listed_and_no_truth() 
         .unwrap()
         .iter()
         .all(|p| !["u", "v", "w"].contains(&p["output"].as_str().unwrap())));
+
+    // Loop tests in a logger's file of their own (two tests): measured in the margins
+    // stage beside the model's predicted loops, as `margins --measured` measures them.
+    let loops = dir.join("loops");
+    fly(
+        &loops,
+        &[
+            "--vehicle",
+            "trex700l",
+            "--seed",
+            "2",
+            "--input",
+            "loop",
+            "--axes",
+            "lat,ped",
+            "--t-rec",
+            "40",
+        ],
+    );
+    let loop_log = dir.join("loops.bin");
+    concatenate(
+        &loop_log,
+        &[loops.join("lat-1.bin"), loops.join("ped-1.bin")],
+    );
+    let with_loops = dir.join("with-loops");
+    let (_, stderr) = ok(&[
+        "identify",
+        s(&log),
+        s(&loop_log),
+        "--vehicle",
+        "trex700l",
+        "--out",
+        s(&with_loops),
+    ]);
+    assert!(stderr.contains("2 loop tests measured"), "{stderr}");
+    let listed = json(&with_loops.join("summary.json"))["tests"].to_string();
+    assert!(listed.contains("lat LoopSweep"), "{listed}");
+    let document = json(&with_loops.join("margins.json"));
+    let measured = document["measured"].as_array().unwrap();
+    let named: Vec<(&str, &str)> = measured
+        .iter()
+        .map(|m| (m["name"].as_str().unwrap(), m["source"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        named,
+        [
+            ("roll_attitude", "loops.bin test 1"),
+            ("heading", "loops.bin test 2")
+        ]
+    );
+    for loop_ in measured {
+        let gm = loop_["gain_margin_difference_db"].as_f64().unwrap();
+        let pm = loop_["phase_margin_difference_deg"].as_f64().unwrap();
+        assert!(gm.abs() < 1.5 && pm.abs() < 10.0, "{loop_}");
+    }
+    // The verb on the same model and loop tests writes the same document.
+    let verb = dir.join("verb-margins.json");
+    ok(&[
+        "margins",
+        s(&with_loops.join("model9.json")),
+        "--vehicle",
+        "trex700l",
+        "--samples",
+        "60",
+        "--measured",
+        s(&loop_log),
+        "--out",
+        s(&verb),
+    ]);
+    assert_eq!(
+        std::fs::read(&verb).unwrap(),
+        std::fs::read(with_loops.join("margins.json")).unwrap()
+    );
+    let report = std::fs::read_to_string(with_loops.join("report.html")).unwrap();
+    assert!(report.contains("Measured in the loop tests"));
+    assert!(report.contains("loops.bin test 2"));
 
     // The same log twice gives the same model, byte for byte.
     let again = dir.join("again");
@@ -568,13 +648,12 @@ fn identify_writes_a_report_without_truth_that_report_redraws_byte_for_byte() {
     assert_eq!(records, 2);
     assert_eq!(verification.matches("<svg").count(), records);
     assert!(verification.contains("TIC"), "{verification}");
-    // No campaign section: no flights, no loops.
-    for campaign_only in [
-        "sweep-input",
-        "cross-coherence",
-        "loops",
-        "campaign-summary",
-    ] {
+    // The model's loops (identify's margins stage), with no loop test to measure here.
+    let loops = report_section(&report, "loops");
+    assert!(loops.contains("Bode"), "{loops}");
+    assert!(!loops.contains("Measured in the loop tests"));
+    // No campaign section: no flights.
+    for campaign_only in ["sweep-input", "cross-coherence", "campaign-summary"] {
         assert!(!report.contains(&format!("<section id=\"{campaign_only}\">")));
     }
 

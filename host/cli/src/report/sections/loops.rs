@@ -10,7 +10,7 @@ use crate::margins::ExportedResponse;
 use crate::plot::{colors, Figure, LegendEntry, Panel, Scale, Series};
 use crate::report::html::{figure, note, section, table, Cell};
 use crate::report::inputs::ReportInputs;
-use crate::report::margins_file::{ChartRow, HandlingRow, LoopRow, MarginsFile};
+use crate::report::margins_file::{ChartRow, HandlingRow, LoopRow, MarginsFile, MeasuredRow};
 use control::analysis::Figure as Spread;
 
 const TITLE: &str = "Loop margins and handling qualities of the identified model";
@@ -36,6 +36,7 @@ line says why): `sweephold margins model9.json` computes the figures.",
     };
     let mut content = note(&explanation(margins));
     content += &loop_table(&margins.loops);
+    content += &measured_table(&margins.measured);
     content += &handling_table(&margins.handling);
     let mut figures = String::new();
     match &inputs.margins_loops {
@@ -138,6 +139,52 @@ fn loop_table(loops: &[LoopRow]) -> String {
             "GM [dB]",
             "ω_180 [rad/s]",
             "DRB [rad/s]",
+        ],
+        &rows,
+    )
+}
+
+/// The loop tests measured beside the prediction (none: nothing).
+fn measured_table(measured: &[MeasuredRow]) -> String {
+    if measured.is_empty() {
+        return String::new();
+    }
+    let cell = |v: Option<f64>, decimals: usize| {
+        Cell::plain(v.map_or("-".to_string(), |v| format!("{v:.decimals$}")))
+    };
+    let pair = |measured: Option<f64>, predicted: Option<f64>, decimals: usize| {
+        let text = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.decimals$}"));
+        Cell::plain(format!("{} / {}", text(measured), text(predicted)))
+    };
+    let rows: Vec<Vec<Cell>> = measured
+        .iter()
+        .map(|m| {
+            vec![
+                Cell::name(m.name.clone()),
+                Cell::plain(m.source.clone()),
+                pair(m.crossover_rad_s, m.predicted.crossover_rad_s, 2),
+                pair(m.phase_margin_deg, m.predicted.phase_margin_deg, 1),
+                cell(m.phase_margin_difference_deg, 1),
+                pair(m.gain_margin_db, m.predicted.gain_margin_db, 1),
+                cell(m.gain_margin_difference_db, 2),
+                Cell::plain(format!("{}/{}", m.valid_points, m.points)),
+            ]
+        })
+        .collect();
+    note(
+        "Measured in the loop tests (the sweep added at the loop's actuator input with the \
+loops closed; each loop's margins from its measured broken loop on the points of random \
+error ≤ 0.15), beside the predicted figures of the loop it breaks.",
+    ) + &table(
+        &[
+            "loop",
+            "loop test",
+            "ω_c meas / pred [rad/s]",
+            "PM meas / pred [deg]",
+            "ΔPM [deg]",
+            "GM meas / pred [dB]",
+            "ΔGM [dB]",
+            "valid points",
         ],
         &rows,
     )
