@@ -21,7 +21,7 @@
 //! sweep the time spent per e-fold of frequency is T/4 and the noise's is T) and sits
 //! below 0.6 near a heading loop's phase crossover, where |L| is −10 to −25 dB and the
 //! loop's output c is small against the gyro noise it carries; there the random error
-//! (about 90 independent one-second windows) is still 0.06–0.14. Measured against the same
+//! (about 90 independent one-second windows) is still 0.05–0.15. Measured against the same
 //! loop tests flown with perfect sensors (docs/decisions/2026-11-27-loop-test-validity.md)
 //! the error grows with the bound's estimate and stays within it.
 //!
@@ -86,6 +86,12 @@ pub struct MeasuredLoop {
     pub gain_margin_db: Option<f64>,
     /// Phase crossover of the gain margin reported [rad/s].
     pub phase_crossover_rad_s: Option<f64>,
+    /// One standard deviation of the phase margin from the random error at the crossover
+    /// (εr rad of phase, [`margin_uncertainty`]) \[deg\].
+    pub phase_margin_random_error_deg: Option<f64>,
+    /// One standard deviation of the gain margin from the random error at the phase
+    /// crossover (εr of |L|, as 20·log10(e)·εr) \[dB\].
+    pub gain_margin_random_error_db: Option<f64>,
     /// The response: frequencies [rad/s], real and imaginary parts, coherence.
     pub response: MeasuredResponse,
 }
@@ -129,6 +135,36 @@ pub fn valid_margins(measured: &BrokenLoop, max_random_error: f64) -> (Margins, 
     }
     let count = valid.omega.len();
     (margins(&valid), count)
+}
+
+/// One standard deviation of the phase margin \[deg\] and of the gain margin \[dB\] from
+/// the random error εr at the crossover and at the phase crossover (each εr of the valid
+/// point nearest in log-frequency). Bendat & Piersol's εr is the normalized random error
+/// of |L|; the phase's standard deviation is about εr radians: so ±57.3·εr° and
+/// ±8.69·εr dB (20·log10(e)·εr). The interpolation between points, which averages two
+/// estimates, is not counted: the figures are an upper bound of that kind.
+pub fn margin_uncertainty(
+    measured: &BrokenLoop,
+    crossover: Option<f64>,
+    phase_crossover: Option<f64>,
+) -> [Option<f64>; 2] {
+    let at = |omega: Option<f64>| -> Option<f64> {
+        let omega = omega?;
+        measured
+            .omega
+            .iter()
+            .zip(&measured.random_error)
+            .filter(|(w, e)| **e <= MAX_RANDOM_ERROR && **w >= measured.resolved_from_rad_s)
+            .min_by(|a, b| {
+                let distance = |w: f64| (w / omega).ln().abs();
+                distance(*a.0).total_cmp(&distance(*b.0))
+            })
+            .map(|(_, e)| *e)
+    };
+    [
+        at(crossover).map(|e| e.to_degrees()),
+        at(phase_crossover).map(|e| 20.0 * std::f64::consts::LOG10_E * e),
+    ]
 }
 
 /// The phases whose Samples carry the sweep.
@@ -206,6 +242,11 @@ fn measure_test(
     .map_err(|e| anyhow!("{source}: {e}"))?;
     let (figures, valid_points) = valid_margins(&measured, MAX_RANDOM_ERROR);
     let finite = |v: f64| v.is_finite().then_some(v);
+    let [phase_margin_random_error_deg, gain_margin_random_error_db] = margin_uncertainty(
+        &measured,
+        figures.crossover_rad_s,
+        figures.phase_crossover_rad_s,
+    );
     Ok(MeasuredLoop {
         source: name_in_document,
         name,
@@ -218,6 +259,8 @@ fn measure_test(
         phase_margin_deg: figures.phase_margin_deg,
         gain_margin_db: figures.gain_margin_db,
         phase_crossover_rad_s: figures.phase_crossover_rad_s,
+        phase_margin_random_error_deg,
+        gain_margin_random_error_db,
         response: MeasuredResponse {
             re: measured.values.iter().map(|v| finite(v.re)).collect(),
             im: measured.values.iter().map(|v| finite(v.im)).collect(),
@@ -315,24 +358,28 @@ pub fn table(loops: &[Compared]) -> String {
     let cell = |v: Option<f64>, decimals: usize| {
         v.map_or("—".to_string(), |v| format!("{v:.decimals$}"))
     };
+    let with_error = |v: Option<f64>, error: Option<f64>, decimals: usize| match (v, error) {
+        (Some(v), Some(e)) => format!("{v:.decimals$}±{e:.decimals$}"),
+        _ => cell(v, decimals),
+    };
     let mut text = String::new();
     let _ = writeln!(
         text,
-        "\nmeasured (loop tests)\n{:<15} {:<4} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  dump",
+        "\nmeasured (loop tests; ± one standard deviation from the random error)\n{:<15} {:<4} {:>9} {:>9} {:>10} {:>9} {:>10} {:>9} {:>9}  dump",
         "loop", "at", "wc", "wc pred", "PM", "PM pred", "GM", "GM pred", "valid"
     );
     for l in loops {
         let m = &l.measured;
         let _ = writeln!(
             text,
-            "{:<15} {:<4} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  {}",
+            "{:<15} {:<4} {:>9} {:>9} {:>10} {:>9} {:>10} {:>9} {:>9}  {}",
             m.name,
             m.broken_at,
             cell(m.crossover_rad_s, 2),
             cell(l.predicted.crossover_rad_s, 2),
-            cell(m.phase_margin_deg, 1),
+            with_error(m.phase_margin_deg, m.phase_margin_random_error_deg, 1),
             cell(l.predicted.phase_margin_deg, 1),
-            cell(m.gain_margin_db, 1),
+            with_error(m.gain_margin_db, m.gain_margin_random_error_db, 1),
             cell(l.predicted.gain_margin_db, 1),
             format!("{}/{}", m.valid_points, m.points),
             m.source
@@ -490,19 +537,29 @@ mod tests {
     /// ten noise seeds the valid points of coherence below 0.6 lie within their random
     /// error of the truth (rms of |L̂/L − 1| against the rms εr), and the gain margin is
     /// measured on every seed within 1 dB of the exact one (−0.05 to +0.8 dB here; the
-    /// band reaches 80 rad/s so that the crossover lies clear of the sweep's fade-out).
+    /// band reaches 80 rad/s so that the crossover lies clear of the sweep's fade-out),
+    /// its rms error within its stated uncertainty ([`margin_uncertainty`]).
     #[test]
     fn points_of_low_coherence_are_valid_within_their_random_error() {
         let known = KnownLoop::new();
         let band = [0.5, 80.0];
         let truth = known.margins(band).gain_margin_db.unwrap();
         let (mut error2, mut bound2, mut low) = (0.0, 0.0, 0usize);
+        let (mut gm_error2, mut gm_sigma2) = (0.0, 0.0);
         for seed in 1..=10 {
             let (d, u) = known.fly(band, 0.025, seed);
             let measured = broken_loop(&d, &u, 200.0, band, &BrokenLoopOptions::default()).unwrap();
             let (found, _) = valid_margins(&measured, MAX_RANDOM_ERROR);
             let gm = found.gain_margin_db.expect("a gain margin on every seed");
             assert!((gm - truth).abs() < 1.0, "seed {seed}: GM {gm} vs {truth}");
+            let [_, sigma] = margin_uncertainty(
+                &measured,
+                found.crossover_rad_s,
+                found.phase_crossover_rad_s,
+            );
+            let sigma = sigma.expect("an uncertainty with every gain margin");
+            gm_error2 += (gm - truth).powi(2);
+            gm_sigma2 += sigma * sigma;
             for k in 0..measured.omega.len() {
                 let (w, e, g) = (
                     measured.omega[k],
@@ -522,6 +579,12 @@ mod tests {
         assert!(
             rms_error < 1.5 * rms_bound,
             "rms error {rms_error} against rms random error {rms_bound}"
+        );
+        // The gain margin's stated uncertainty covers its error over the seeds.
+        let (gm_rms, gm_sigma) = ((gm_error2 / 10.0).sqrt(), (gm_sigma2 / 10.0).sqrt());
+        assert!(
+            gm_rms < 1.5 * gm_sigma && gm_sigma < 2.0,
+            "GM rms error {gm_rms} dB against stated {gm_sigma} dB"
         );
     }
 }

@@ -122,6 +122,12 @@ pub struct MeasuredRow {
     pub phase_margin_deg: Option<f64>,
     /// Measured gain margin \[dB\].
     pub gain_margin_db: Option<f64>,
+    /// One standard deviation of the measured phase margin \[deg\].
+    #[serde(default)]
+    pub phase_margin_random_error_deg: Option<f64>,
+    /// One standard deviation of the measured gain margin \[dB\].
+    #[serde(default)]
+    pub gain_margin_random_error_db: Option<f64>,
     /// The nominal predicted figures.
     pub predicted: PredictedRow,
     /// Measured − predicted gain margin \[dB\].

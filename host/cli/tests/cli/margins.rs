@@ -139,7 +139,10 @@ fn a_board_sim_loop_test_is_measured_beside_the_prediction() {
             String::from_utf8_lossy(&output.stderr)
         );
         let table = String::from_utf8(output.stdout).unwrap();
-        assert!(table.contains("measured (loop tests)"), "{table}");
+        assert!(
+            table.contains("measured (loop tests; ± one standard deviation"),
+            "{table}"
+        );
     }
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     for (dump, bytes) in dumps.iter().zip(&before) {

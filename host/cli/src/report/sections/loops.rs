@@ -152,20 +152,35 @@ fn measured_table(measured: &[MeasuredRow]) -> String {
     let cell = |v: Option<f64>, decimals: usize| {
         Cell::plain(v.map_or("-".to_string(), |v| format!("{v:.decimals$}")))
     };
-    let pair = |measured: Option<f64>, predicted: Option<f64>, decimals: usize| {
-        let text = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.decimals$}"));
-        Cell::plain(format!("{} / {}", text(measured), text(predicted)))
-    };
+    let pair =
+        |measured: Option<f64>, error: Option<f64>, predicted: Option<f64>, decimals: usize| {
+            let text = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.decimals$}"));
+            let measured = match (measured, error) {
+                (Some(v), Some(e)) => format!("{v:.decimals$} ± {e:.decimals$}"),
+                _ => text(measured),
+            };
+            Cell::plain(format!("{measured} / {}", text(predicted)))
+        };
     let rows: Vec<Vec<Cell>> = measured
         .iter()
         .map(|m| {
             vec![
                 Cell::name(m.name.clone()),
                 Cell::plain(m.source.clone()),
-                pair(m.crossover_rad_s, m.predicted.crossover_rad_s, 2),
-                pair(m.phase_margin_deg, m.predicted.phase_margin_deg, 1),
+                pair(m.crossover_rad_s, None, m.predicted.crossover_rad_s, 2),
+                pair(
+                    m.phase_margin_deg,
+                    m.phase_margin_random_error_deg,
+                    m.predicted.phase_margin_deg,
+                    1,
+                ),
                 cell(m.phase_margin_difference_deg, 1),
-                pair(m.gain_margin_db, m.predicted.gain_margin_db, 1),
+                pair(
+                    m.gain_margin_db,
+                    m.gain_margin_random_error_db,
+                    m.predicted.gain_margin_db,
+                    1,
+                ),
                 cell(m.gain_margin_difference_db, 2),
                 Cell::plain(format!("{}/{}", m.valid_points, m.points)),
             ]
@@ -174,7 +189,8 @@ fn measured_table(measured: &[MeasuredRow]) -> String {
     note(
         "Measured in the loop tests (the sweep added at the loop's actuator input with the \
 loops closed; each loop's margins from its measured broken loop on the points of random \
-error ≤ 0.15), beside the predicted figures of the loop it breaks.",
+error ≤ 0.15, ± one standard deviation from the random error at the crossover and at the \
+phase crossover), beside the predicted figures of the loop it breaks.",
     ) + &table(
         &[
             "loop",
