@@ -6,6 +6,7 @@
 //! are `&'static str` constants of the analysis and cannot be read back.
 
 use control::analysis::{Figure, MARGINS_DOCUMENT_VERSION};
+use nalgebra::Complex;
 use serde::Deserialize;
 
 /// One loop broken at its actuator input.
@@ -134,6 +135,49 @@ pub struct MeasuredRow {
     pub gain_margin_difference_db: Option<f64>,
     /// Measured − predicted phase margin \[deg\].
     pub phase_margin_difference_deg: Option<f64>,
+    /// The measured broken loop on its grid.
+    pub response: MeasuredCurve,
+}
+
+/// A measured broken loop on its grid (`margins.json`'s `measured[].response`).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+pub struct MeasuredCurve {
+    /// Frequencies [rad/s].
+    pub omega: Vec<f64>,
+    /// Real parts (null where no window resolves the point).
+    pub re: Vec<Option<f64>>,
+    /// Imaginary parts.
+    pub im: Vec<Option<f64>>,
+    /// Normalized random error of each point (null where no window resolves it).
+    #[serde(default)]
+    pub random_error: Vec<Option<f64>>,
+}
+
+impl MeasuredCurve {
+    /// The points a measured loop's margins use: random error ≤ `max_random_error` (a
+    /// point without one is left out); the others NaN, so that a line breaks there.
+    pub fn valid_values(&self, max_random_error: f64) -> Vec<(f64, Complex<f64>)> {
+        self.omega
+            .iter()
+            .enumerate()
+            .map(|(k, &w)| {
+                let valid = self
+                    .random_error
+                    .get(k)
+                    .copied()
+                    .flatten()
+                    .is_some_and(|e| e <= max_random_error);
+                let value = match (
+                    self.re.get(k).copied().flatten(),
+                    self.im.get(k).copied().flatten(),
+                ) {
+                    (Some(re), Some(im)) if valid => Complex::new(re, im),
+                    _ => Complex::new(f64::NAN, f64::NAN),
+                };
+                (w, value)
+            })
+            .collect()
+    }
 }
 
 /// The predicted figures a measured loop is compared with.
@@ -158,5 +202,27 @@ impl MarginsFile {
                 self.version
             ))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only the points of random error within the bound are drawn; the others, and those no
+    /// window resolves, break the line.
+    #[test]
+    fn a_measured_curve_keeps_its_valid_points_only() {
+        let curve = MeasuredCurve {
+            omega: vec![1.0, 2.0, 3.0, 4.0],
+            re: vec![None, Some(1.0), Some(2.0), Some(3.0)],
+            im: vec![None, Some(0.5), Some(0.0), Some(-1.0)],
+            random_error: vec![None, Some(0.1), Some(0.2), Some(0.15)],
+        };
+        let values = curve.valid_values(0.15);
+        assert_eq!(values.len(), 4);
+        assert!(values[0].1.re.is_nan() && values[2].1.re.is_nan());
+        assert_eq!(values[1], (2.0, Complex::new(1.0, 0.5)));
+        assert_eq!(values[3], (4.0, Complex::new(3.0, -1.0)));
     }
 }

@@ -421,6 +421,9 @@ fn identify_fits_and_verifies_a_board_log_with_every_test_listed_and_no_truth() 
     let report = std::fs::read_to_string(with_loops.join("report.html")).unwrap();
     assert!(report.contains("Measured in the loop tests"));
     assert!(report.contains("loops.bin test 2"));
+    // Each measured loop is drawn over its predicted Bode plot, and says so.
+    assert!(report.contains("black: measured in the loop test loops.bin test 2"));
+    assert!(report.contains("black: measured in the loop test loops.bin test 1"));
 
     // The same log twice gives the same model, byte for byte.
     let again = dir.join("again");

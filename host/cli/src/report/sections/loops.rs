@@ -42,8 +42,13 @@ line says why): `sweephold margins model9.json` computes the figures.",
     match &inputs.margins_loops {
         Some(sampled) => {
             for row in &margins.loops {
+                let measured: Vec<&MeasuredRow> = margins
+                    .measured
+                    .iter()
+                    .filter(|m| m.name == row.name)
+                    .collect();
                 match sampled.loops.iter().find(|l| l.name == row.name) {
-                    Some(response) => figures += &loop_figure(row, response),
+                    Some(response) => figures += &loop_figure(row, response, &measured),
                     None => figures += &note(&format!("{}: no sampled loop.", row.name)),
                 }
             }
@@ -242,8 +247,9 @@ fn vertical(name: &str, color: plotters::style::RGBColor, x: f64, y: &Scale) -> 
     Series::new(name, color, vec![(x, y.min), (x, y.max)])
 }
 
-/// Magnitude and phase of one broken loop, its gain crossovers and phase crossover marked.
-fn loop_figure(row: &LoopRow, response: &ExportedResponse) -> String {
+/// Magnitude and phase of one broken loop, its gain crossovers and phase crossover marked,
+/// and the loop tests that measured it over their valid points.
+fn loop_figure(row: &LoopRow, response: &ExportedResponse, measured: &[&MeasuredRow]) -> String {
     let values: Vec<Complex<f64>> = response
         .re
         .iter()
@@ -284,6 +290,38 @@ fn loop_figure(row: &LoopRow, response: &ExportedResponse) -> String {
             unit,
         );
         let mut series = vec![line];
+        for test in measured {
+            let points = test
+                .response
+                .valid_values(crate::measured_loop::MAX_RANDOM_ERROR);
+            let (omegas, measured_values): (Vec<f64>, Vec<Complex<f64>>) =
+                points.into_iter().unzip();
+            // Point by point (no unwrapping across the invalid points, which are NaN): each
+            // phase is put in the predicted curve's turn below.
+            let measured_db: Vec<f64> = measured_values
+                .iter()
+                .map(|v| 20.0 * v.norm().log10())
+                .collect();
+            let measured_phase: Vec<f64> = measured_values
+                .iter()
+                .map(|v| v.arg().to_degrees())
+                .collect();
+            let shown: Vec<(f64, f64)> = if unit == "dB" {
+                omegas.into_iter().zip(measured_db).collect()
+            } else {
+                // Each measured phase in the turn nearest the predicted one there.
+                omegas
+                    .into_iter()
+                    .zip(measured_phase)
+                    .map(|(w, v)| {
+                        let k = omega.partition_point(|o| *o < w).min(omega.len() - 1);
+                        let turns = ((values[k] - v) / 360.0).round();
+                        (w, v + 360.0 * turns)
+                    })
+                    .collect()
+            };
+            series.push(Series::new("measured", colors::DATA, shown));
+        }
         for [w, _] in &row.all_crossovers {
             series.push(vertical("ω_c", colors::GREEN, *w, &y));
         }
@@ -302,12 +340,25 @@ fn loop_figure(row: &LoopRow, response: &ExportedResponse) -> String {
         LegendEntry::new("gain crossovers ω_c", colors::GREEN),
         LegendEntry::new("phase crossover ω_180", colors::TRUTH).dashed(),
     ];
+    if !measured.is_empty() {
+        fig.legend.push(LegendEntry::new("loop test", colors::DATA));
+    }
     fig.width = HALF_WIDTH;
+    let tests: Vec<&str> = measured.iter().map(|m| m.source.as_str()).collect();
+    let measured_text = if tests.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; black: measured in the loop test {} on its points of random error ≤ {}",
+            tests.join(", "),
+            crate::measured_loop::MAX_RANDOM_ERROR
+        )
+    };
     figure(
         fig.to_html(),
         &format!(
             "{} broken at {}: ω_c {} rad/s, PM {}° (least {}°), GM {} dB at ω_180 {} rad/s, \
-DRB {} rad/s",
+DRB {} rad/s{measured_text}",
             row.name,
             row.broken_at,
             text(&row.crossover_rad_s, 2),
