@@ -111,6 +111,14 @@ pub struct MeasuredResponse {
     pub random_error: Vec<Option<f64>>,
 }
 
+/// Whether the point of a measured loop at `omega` with random error `error` is used:
+/// `error` ≤ `max_random_error` and `omega` at or above `resolved_from` (the frequency the
+/// windows resolve without bias). The margins, their uncertainty and the report's curves
+/// all take the points by this rule.
+pub fn is_valid_point(omega: f64, error: f64, resolved_from: f64, max_random_error: f64) -> bool {
+    error <= max_random_error && omega >= resolved_from
+}
+
 /// The margins of `measured` on its points of random error ≤ `max_random_error` at or
 /// above the frequency its windows resolve without bias (`resolved_from_rad_s`).
 pub fn valid_margins(measured: &BrokenLoop, max_random_error: f64) -> (Margins, usize) {
@@ -124,8 +132,7 @@ pub fn valid_margins(measured: &BrokenLoop, max_random_error: f64) -> (Margins, 
         .zip(&measured.values)
         .zip(&measured.random_error)
     {
-        if *e <= max_random_error
-            && *w >= measured.resolved_from_rad_s
+        if is_valid_point(*w, *e, measured.resolved_from_rad_s, max_random_error)
             && l.re.is_finite()
             && l.im.is_finite()
         {
@@ -154,7 +161,9 @@ pub fn margin_uncertainty(
             .omega
             .iter()
             .zip(&measured.random_error)
-            .filter(|(w, e)| **e <= MAX_RANDOM_ERROR && **w >= measured.resolved_from_rad_s)
+            .filter(|(w, e)| {
+                is_valid_point(**w, **e, measured.resolved_from_rad_s, MAX_RANDOM_ERROR)
+            })
             .min_by(|a, b| {
                 let distance = |w: f64| (w / omega).ln().abs();
                 distance(*a.0).total_cmp(&distance(*b.0))

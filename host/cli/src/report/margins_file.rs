@@ -117,6 +117,10 @@ pub struct MeasuredRow {
     pub valid_points: usize,
     /// Grid points.
     pub points: usize,
+    /// The lowest frequency the measurement uses [rad/s] (0 in documents written before
+    /// it was recorded).
+    #[serde(default)]
+    pub resolved_from_rad_s: f64,
     /// Measured crossover [rad/s].
     pub crossover_rad_s: Option<f64>,
     /// Measured phase margin \[deg\].
@@ -154,9 +158,14 @@ pub struct MeasuredCurve {
 }
 
 impl MeasuredCurve {
-    /// The points a measured loop's margins use: random error ≤ `max_random_error` (a
-    /// point without one is left out); the others NaN, so that a line breaks there.
-    pub fn valid_values(&self, max_random_error: f64) -> Vec<(f64, Complex<f64>)> {
+    /// The points a measured loop's margins use ([`crate::measured_loop::is_valid_point`]:
+    /// random error ≤ `max_random_error` at or above `resolved_from`; a point without a
+    /// random error is left out); the others NaN, so that a line breaks there.
+    pub fn valid_values(
+        &self,
+        max_random_error: f64,
+        resolved_from: f64,
+    ) -> Vec<(f64, Complex<f64>)> {
         self.omega
             .iter()
             .enumerate()
@@ -166,7 +175,9 @@ impl MeasuredCurve {
                     .get(k)
                     .copied()
                     .flatten()
-                    .is_some_and(|e| e <= max_random_error);
+                    .is_some_and(|e| {
+                        crate::measured_loop::is_valid_point(w, e, resolved_from, max_random_error)
+                    });
                 let value = match (
                     self.re.get(k).copied().flatten(),
                     self.im.get(k).copied().flatten(),
@@ -209,8 +220,8 @@ impl MarginsFile {
 mod tests {
     use super::*;
 
-    /// Only the points of random error within the bound are drawn; the others, and those no
-    /// window resolves, break the line.
+    /// Only the points of random error within the bound, at or above the resolved
+    /// frequency, are drawn; the others, and those no window resolves, break the line.
     #[test]
     fn a_measured_curve_keeps_its_valid_points_only() {
         let curve = MeasuredCurve {
@@ -219,10 +230,14 @@ mod tests {
             im: vec![None, Some(0.5), Some(0.0), Some(-1.0)],
             random_error: vec![None, Some(0.1), Some(0.2), Some(0.15)],
         };
-        let values = curve.valid_values(0.15);
+        let values = curve.valid_values(0.15, 0.0);
         assert_eq!(values.len(), 4);
         assert!(values[0].1.re.is_nan() && values[2].1.re.is_nan());
         assert_eq!(values[1], (2.0, Complex::new(1.0, 0.5)));
+        assert_eq!(values[3], (4.0, Complex::new(3.0, -1.0)));
+        // Below the frequency the windows resolve, a point is not drawn either.
+        let values = curve.valid_values(0.15, 3.0);
+        assert!(values[1].1.re.is_nan());
         assert_eq!(values[3], (4.0, Complex::new(3.0, -1.0)));
     }
 }

@@ -291,9 +291,10 @@ fn loop_figure(row: &LoopRow, response: &ExportedResponse, measured: &[&Measured
         );
         let mut series = vec![line];
         for test in measured {
-            let points = test
-                .response
-                .valid_values(crate::measured_loop::MAX_RANDOM_ERROR);
+            let points = test.response.valid_values(
+                crate::measured_loop::MAX_RANDOM_ERROR,
+                test.resolved_from_rad_s,
+            );
             let (omegas, measured_values): (Vec<f64>, Vec<Complex<f64>>) =
                 points.into_iter().unzip();
             // Point by point (no unwrapping across the invalid points, which are NaN): each
