@@ -5,7 +5,8 @@ import os
 import subprocess
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-BINARY = os.path.join(ROOT, "target", "release", "sweephold")
+# SWEEPHOLD_BINARY names another build (an A/B comparison of two builds).
+BINARY = os.environ.get("SWEEPHOLD_BINARY") or os.path.join(ROOT, "target", "release", "sweephold")
 
 
 def seeds(text):

@@ -261,7 +261,7 @@ impl Pipeline<'_> {
         let (started, _notes) = start_from_quasi_steady(&hybrid, &six.to_document())?;
         let starts = [
             (files::MODEL_6DOF.to_string(), started),
-            ("bo105-9dof-hybrid.toml".to_string(), hybrid),
+            (format!("{} (the file's start values)", hybrid.name), hybrid),
         ];
         let options = args.options(trim_points.clone());
         let (result, _outcomes) = fit_from_alternative_starts(&starts, frf, &options)?;
