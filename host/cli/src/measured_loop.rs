@@ -35,6 +35,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail};
 use control::loops::Sampled;
 use control::margins::{margins, Margins};
+use control::tune::upper_margins;
 use serde::Serialize;
 use sweephold_protocol::{Axis, InputKind, Phase};
 use sysid::frf::broken_loop::{broken_loop, BrokenLoop, BrokenLoopOptions};
@@ -86,6 +87,12 @@ pub struct MeasuredLoop {
     pub gain_margin_db: Option<f64>,
     /// Phase crossover of the gain margin reported [rad/s].
     pub phase_crossover_rad_s: Option<f64>,
+    /// The least gain margin over the phase crossovers above the highest gain crossover
+    /// \[dB\], the one `tune` constrains. `gain_margin_db` is python-control's pick, the
+    /// least |GM| over every phase crossover: on a loop whose phase crosses −180° below
+    /// its crossover too (a heading hold's two integrators on a slow yaw pole), that one
+    /// is negative, the gain *reduction* the loop tolerates, and this one is the increase.
+    pub gain_margin_above_crossover_db: Option<f64>,
     /// One standard deviation of the phase margin from the random error at the crossover
     /// (εr rad of phase, [`margin_uncertainty`]) \[deg\].
     pub phase_margin_random_error_deg: Option<f64>,
@@ -122,6 +129,19 @@ pub fn is_valid_point(omega: f64, error: f64, resolved_from: f64, max_random_err
 /// The margins of `measured` on its points of random error ≤ `max_random_error` at or
 /// above the frequency its windows resolve without bias (`resolved_from_rad_s`).
 pub fn valid_margins(measured: &BrokenLoop, max_random_error: f64) -> (Margins, usize) {
+    let valid = valid_points(measured, max_random_error);
+    let count = valid.omega.len();
+    (margins(&valid), count)
+}
+
+/// The gain margin above the highest gain crossover of `measured`'s valid points
+/// ([`MeasuredLoop::gain_margin_above_crossover_db`]).
+pub fn valid_upper_gain_margin(measured: &BrokenLoop, max_random_error: f64) -> Option<f64> {
+    upper_margins(&valid_points(measured, max_random_error)).1
+}
+
+/// The points of `measured` valid by [`is_valid_point`], with finite values.
+fn valid_points(measured: &BrokenLoop, max_random_error: f64) -> Sampled {
     let mut valid = Sampled {
         omega: Vec::new(),
         values: Vec::new(),
@@ -140,8 +160,7 @@ pub fn valid_margins(measured: &BrokenLoop, max_random_error: f64) -> (Margins, 
             valid.values.push(*l);
         }
     }
-    let count = valid.omega.len();
-    (margins(&valid), count)
+    valid
 }
 
 /// One standard deviation of the phase margin \[deg\] and of the gain margin \[dB\] from
@@ -268,6 +287,7 @@ fn measure_test(
         phase_margin_deg: figures.phase_margin_deg,
         gain_margin_db: figures.gain_margin_db,
         phase_crossover_rad_s: figures.phase_crossover_rad_s,
+        gain_margin_above_crossover_db: valid_upper_gain_margin(&measured, MAX_RANDOM_ERROR),
         phase_margin_random_error_deg,
         gain_margin_random_error_db,
         response: MeasuredResponse {
@@ -374,14 +394,14 @@ pub fn table(loops: &[Compared]) -> String {
     let mut text = String::new();
     let _ = writeln!(
         text,
-        "\nmeasured (loop tests; ± one standard deviation from the random error)\n{:<15} {:<4} {:>9} {:>9} {:>10} {:>9} {:>10} {:>9} {:>9}  dump",
-        "loop", "at", "wc", "wc pred", "PM", "PM pred", "GM", "GM pred", "valid"
+        "\nmeasured (loop tests; ± one standard deviation from the random error; GM>wc: above the crossover)\n{:<15} {:<4} {:>9} {:>9} {:>10} {:>9} {:>10} {:>9} {:>7} {:>9}  dump",
+        "loop", "at", "wc", "wc pred", "PM", "PM pred", "GM", "GM pred", "GM>wc", "valid"
     );
     for l in loops {
         let m = &l.measured;
         let _ = writeln!(
             text,
-            "{:<15} {:<4} {:>9} {:>9} {:>10} {:>9} {:>10} {:>9} {:>9}  {}",
+            "{:<15} {:<4} {:>9} {:>9} {:>10} {:>9} {:>10} {:>9} {:>7} {:>9}  {}",
             m.name,
             m.broken_at,
             cell(m.crossover_rad_s, 2),
@@ -390,6 +410,7 @@ pub fn table(loops: &[Compared]) -> String {
             cell(l.predicted.phase_margin_deg, 1),
             with_error(m.gain_margin_db, m.gain_margin_random_error_db, 1),
             cell(l.predicted.gain_margin_db, 1),
+            cell(m.gain_margin_above_crossover_db, 1),
             format!("{}/{}", m.valid_points, m.points),
             m.source
         );
@@ -398,202 +419,4 @@ pub fn table(loops: &[Compared]) -> String {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use control::margins::margins as exact_margins;
-    use nalgebra::Complex;
-    use sysid::random::SplitMix64;
-
-    /// Tischler's exponential sweep (the firmware's), closed form.
-    fn sweep(t: f64, duration: f64, [low, high]: [f64; 2]) -> f64 {
-        let c2 = 1.0 / (4.0f64.exp() - 1.0);
-        let theta = low * t
-            + (high - low) * c2 * ((duration / 4.0) * ((4.0 * t / duration).exp() - 1.0) - t);
-        0.05 * theta.sin()
-    }
-
-    /// The known loop of these tests (sampled at 200 Hz): plant P(z) = b·z^−D/(z − a) (a
-    /// first-order lag and D ticks of delay), controller K(z) = kp + ki·T/(z − 1) on the
-    /// plant's output with white noise of `noise` (rms) on the measurement; the sweep over
-    /// `band` added at the controller's output, 5 s at rest either side, fading in and out
-    /// over 2 s as the firmware flies it.
-    struct KnownLoop {
-        t: f64,
-        a: f64,
-        b: f64,
-        delay: i32,
-        kp: f64,
-        ki: f64,
-    }
-
-    impl KnownLoop {
-        fn new() -> Self {
-            let t = 1.0 / 200.0;
-            let a = (-t / 0.25f64).exp();
-            KnownLoop {
-                t,
-                a,
-                b: (1.0 - a) * 4.0,
-                delay: 6,
-                kp: 1.2,
-                ki: 2.0,
-            }
-        }
-
-        fn exact(&self, omega: f64) -> Complex<f64> {
-            let z = Complex::from_polar(1.0, omega * self.t);
-            let plant = self.b * z.powi(-self.delay) / (z - self.a);
-            let controller = self.kp + self.ki * self.t / (z - 1.0);
-            controller * plant
-        }
-
-        fn margins(&self, band: [f64; 2]) -> Margins {
-            let grid = control::loops::log_grid(band[0], band[1], 2400);
-            exact_margins(&Sampled {
-                values: grid.iter().map(|w| self.exact(*w)).collect(),
-                omega: grid,
-            })
-        }
-
-        /// The injection d and the total u of a 90 s loop test.
-        fn fly(&self, band: [f64; 2], noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
-            let (t, a, b, kp, ki) = (self.t, self.a, self.b, self.kp, self.ki);
-            let duration = 90.0;
-            let lead = 5.0;
-            let n = ((duration + 2.0 * lead) / t) as usize;
-            let fade = |time: f64| {
-                let edge = time.min(duration - time).clamp(0.0, 2.0) / 2.0;
-                0.5 - 0.5 * (std::f64::consts::PI * edge).cos()
-            };
-            let mut random = SplitMix64::new(seed);
-            let (mut x, mut integral) = (0.0, 0.0);
-            let mut history = vec![0.0f64; self.delay as usize + 1];
-            let (mut d, mut u) = (Vec::with_capacity(n), Vec::with_capacity(n));
-            for k in 0..n {
-                let y = history[0] + noise * random.normal_pair().0;
-                let c = -(kp * y + integral);
-                integral += ki * t * y;
-                let time = k as f64 * t - lead;
-                let injection = if (0.0..=duration).contains(&time) {
-                    fade(time) * sweep(time, duration, band)
-                } else {
-                    0.0
-                };
-                let total = c + injection;
-                d.push(injection);
-                u.push(total);
-                x = a * x + b * total;
-                history.rotate_left(1);
-                *history.last_mut().unwrap() = x;
-            }
-            (d, u)
-        }
-    }
-
-    /// The measured broken loop of the known loop matches L = K·P on its valid points and
-    /// its margins match the exact loop's.
-    #[test]
-    fn the_measured_broken_loop_of_a_known_loop_matches_it() {
-        let known = KnownLoop::new();
-        let band = [0.5, 60.0];
-        let (d, u) = known.fly(band, 0.002, 7);
-        let measured = broken_loop(&d, &u, 200.0, band, &BrokenLoopOptions::default()).unwrap();
-        let mut compared = 0;
-        for ((w, l), g) in measured
-            .omega
-            .iter()
-            .zip(&measured.values)
-            .zip(&measured.coherence)
-        {
-            // Below `resolved_from_rad_s` the windows' resolution biases the estimate
-            // (−2.3 dB, −18° at 0.5 rad/s here); at the top the sweep fades out (7.6° at
-            // 58.6 of 60 rad/s).
-            if *g < 0.9 || *w < measured.resolved_from_rad_s || *w > 50.0 {
-                continue;
-            }
-            compared += 1;
-            let truth = known.exact(*w);
-            let db = 20.0 * (l.norm() / truth.norm()).log10();
-            let degrees = (l / truth).arg().to_degrees();
-            assert!(
-                db.abs() < 0.5 && degrees.abs() < 3.0,
-                "{w}: {db} dB, {degrees}°"
-            );
-        }
-        assert!(compared > 100, "{compared} points of coherence ≥ 0.9");
-        assert!(
-            measured.resolved_from_rad_s < 1.5,
-            "{}",
-            measured.resolved_from_rad_s
-        );
-        let truth = known.margins(band);
-        let (found, valid) = valid_margins(&measured, MAX_RANDOM_ERROR);
-        assert!(valid > 150);
-        let pair = |a: Option<f64>, b: Option<f64>| (a.unwrap(), b.unwrap());
-        let (gm, gm_true) = pair(found.gain_margin_db, truth.gain_margin_db);
-        let (pm, pm_true) = pair(found.phase_margin_deg, truth.phase_margin_deg);
-        let (wc, wc_true) = pair(found.crossover_rad_s, truth.crossover_rad_s);
-        // A loop with real margins to find: neither huge nor negative.
-        assert!((3.0..20.0).contains(&gm_true) && (20.0..90.0).contains(&pm_true));
-        assert!((gm - gm_true).abs() < 0.3, "GM {gm} vs {gm_true}");
-        assert!((pm - pm_true).abs() < 1.5, "PM {pm} vs {pm_true}");
-        assert!((wc / wc_true - 1.0).abs() < 0.02, "wc {wc} vs {wc_true}");
-    }
-
-    /// With measurement noise large enough that the coherence near the phase crossover
-    /// (50 rad/s) falls to 0.3–0.5 (the loop's output there small against the noise it
-    /// carries, as on a heading loop), the random error still bounds the estimate: over
-    /// ten noise seeds the valid points of coherence below 0.6 lie within their random
-    /// error of the truth (rms of |L̂/L − 1| against the rms εr), and the gain margin is
-    /// measured on every seed within 1 dB of the exact one (−0.05 to +0.8 dB here; the
-    /// band reaches 80 rad/s so that the crossover lies clear of the sweep's fade-out),
-    /// its rms error within its stated uncertainty ([`margin_uncertainty`]).
-    #[test]
-    fn points_of_low_coherence_are_valid_within_their_random_error() {
-        let known = KnownLoop::new();
-        let band = [0.5, 80.0];
-        let truth = known.margins(band).gain_margin_db.unwrap();
-        let (mut error2, mut bound2, mut low) = (0.0, 0.0, 0usize);
-        let (mut gm_error2, mut gm_sigma2) = (0.0, 0.0);
-        for seed in 1..=10 {
-            let (d, u) = known.fly(band, 0.025, seed);
-            let measured = broken_loop(&d, &u, 200.0, band, &BrokenLoopOptions::default()).unwrap();
-            let (found, _) = valid_margins(&measured, MAX_RANDOM_ERROR);
-            let gm = found.gain_margin_db.expect("a gain margin on every seed");
-            assert!((gm - truth).abs() < 1.0, "seed {seed}: GM {gm} vs {truth}");
-            let [_, sigma] = margin_uncertainty(
-                &measured,
-                found.crossover_rad_s,
-                found.phase_crossover_rad_s,
-            );
-            let sigma = sigma.expect("an uncertainty with every gain margin");
-            gm_error2 += (gm - truth).powi(2);
-            gm_sigma2 += sigma * sigma;
-            for k in 0..measured.omega.len() {
-                let (w, e, g) = (
-                    measured.omega[k],
-                    measured.random_error[k],
-                    measured.coherence[k],
-                );
-                if e <= MAX_RANDOM_ERROR && g < 0.6 && w >= measured.resolved_from_rad_s && w < 50.0
-                {
-                    low += 1;
-                    error2 += (measured.values[k] / known.exact(w) - 1.0).norm_sqr();
-                    bound2 += e * e;
-                }
-            }
-        }
-        assert!(low > 100, "{low} valid points of coherence below 0.6");
-        let (rms_error, rms_bound) = ((error2 / low as f64).sqrt(), (bound2 / low as f64).sqrt());
-        assert!(
-            rms_error < 1.5 * rms_bound,
-            "rms error {rms_error} against rms random error {rms_bound}"
-        );
-        // The gain margin's stated uncertainty covers its error over the seeds.
-        let (gm_rms, gm_sigma) = ((gm_error2 / 10.0).sqrt(), (gm_sigma2 / 10.0).sqrt());
-        assert!(
-            gm_rms < 1.5 * gm_sigma && gm_sigma < 2.0,
-            "GM rms error {gm_rms} dB against stated {gm_sigma} dB"
-        );
-    }
-}
+mod tests;
