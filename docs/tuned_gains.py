@@ -17,7 +17,10 @@ from the attitude at the gust's onset, and the same flight in still air (AT_S:0,
 same board: the same seed and board fly the same flight up to the onset, so the gust
 flight's excursion trace less the still-air one is the attitude response to the gust alone
 (its peak: "gust response"), and the still-air flight's own peak is the floor the raw
-excursion stands on. Prints one row per seed and loop. Needs a build of the CLI:
+excursion stands on. With `--onsets T1,T2,…` the gust is flown at each of those onsets instead
+(seconds after the doublet; each flight flown on for 4 s after its onset) and the response is
+the mean over them, with the per-onset values: one onset's response depends on the hover state
+the gust meets. Prints one row per seed and loop. Needs a build of the CLI:
 
     cargo build --release -p sweephold
     python3 docs/tuned_gains.py --vehicle trex700l --seeds 1-3 --out out/tuned
@@ -80,6 +83,8 @@ def main():
     parser.add_argument("--gust", metavar="AT_S:U,V,W",
                         help="also fly the lateral doublet, then --fly-on with `--gust-pulse AT_S:U,V,W`")
     parser.add_argument("--fly-on", type=float, default=12.0, help="seconds flown on after the doublet")
+    parser.add_argument("--onsets", metavar="T1,T2,...",
+                        help="fly the gust at each of these onsets [s after the doublet] (--fly-on: onset + 4 s) and average")
     parser.add_argument("extra", nargs="*", help="after --: arguments for every campaign")
     args = parser.parse_args()
     if not os.path.isfile(args.binary):
@@ -121,27 +126,38 @@ def main():
                 flown_sweeps.append(aborts(folder))
             flights.append((seed, *flown_sweeps))
         if args.gust:
-            still = args.gust.split(":")[0] + ":0,0,0"
-            gust = {}
-            for label, flash in (("shipped", shipped_flash), ("tuned", tuned_flash)):
-                for kind, pulse in (("still", still), ("gust", args.gust)):
-                    folder = f"{base}-{kind}-{label}"
-                    if not (args.reuse and os.path.isfile(os.path.join(folder, "summary.json"))):
-                        run([args.binary, "fly", "--vehicle", args.vehicle, "--seed", str(seed),
-                             "--axes", "lat", "--input", "doublet", "--fly-on", str(args.fly_on),
-                             "--gust-pulse", pulse, "--out", folder, "--quiet",
-                             "--fc", f"board-sim:{flash}"])
-                    with open(os.path.join(folder, "summary.json")) as f:
-                        gust[kind, label] = json.load(f)["runs"][0]["after"]["gust_pulse"]
+            at, _, wind = args.gust.partition(":")
+            onsets = [float(t) for t in args.onsets.split(",")] if args.onsets else [float(at)]
+            per_onset = {"shipped": [], "tuned": []}
+            for onset in onsets:
+                fly_on = onset + 4.0 if args.onsets else args.fly_on
+                suffix = f"-{onset:g}" if args.onsets else ""
+                gust = {}
+                for label, flash in (("shipped", shipped_flash), ("tuned", tuned_flash)):
+                    for kind, pulse in (("still", f"{onset:g}:0,0,0"), ("gust", f"{onset:g}:{wind}")):
+                        folder = f"{base}-{kind}-{label}{suffix}"
+                        if not (args.reuse and os.path.isfile(os.path.join(folder, "summary.json"))):
+                            run([args.binary, "fly", "--vehicle", args.vehicle, "--seed", str(seed),
+                                 "--axes", "lat", "--input", "doublet", "--fly-on", f"{fly_on:g}",
+                                 "--gust-pulse", pulse, "--out", folder, "--quiet",
+                                 "--fc", f"board-sim:{flash}"])
+                        with open(os.path.join(folder, "summary.json")) as f:
+                            gust[kind, label] = json.load(f)["runs"][0]["after"]["gust_pulse"]
+                for label in ("shipped", "tuned"):
+                    flown, calm = gust["gust", label], gust["still", label]
+                    raw = flown["peak_excursion_deg"]
+                    floor = calm["peak_excursion_deg"]
+                    response = [max((abs(a - b) for a, b in zip(flown["excursion_deg"][k],
+                                                                calm["excursion_deg"][k])), default=0.0)
+                                for k in ("phi", "theta")]
+                    per_onset[label].append(((raw["phi"], raw["theta"]),
+                                             (floor["phi"], floor["theta"]), response))
+            mean = lambda values: sum(values) / len(values)
             figures = {}
-            for label in ("shipped", "tuned"):
-                flown, calm = gust["gust", label], gust["still", label]
-                raw = flown["peak_excursion_deg"]
-                floor = calm["peak_excursion_deg"]
-                response = [max((abs(a - b) for a, b in zip(flown["excursion_deg"][k],
-                                                            calm["excursion_deg"][k])), default=0.0)
-                            for k in ("phi", "theta")]
-                figures[label] = ((raw["phi"], raw["theta"]), (floor["phi"], floor["theta"]), response)
+            for label, runs in per_onset.items():
+                figures[label] = tuple(tuple(mean([r[i][k] for r in runs]) for k in (0, 1))
+                                       for i in range(3))
+                figures[label + " per onset"] = [r[2] for r in runs]
             gusts.append((seed, figures))
         print(f"seed {seed}: tuned parameters on the board: {' '.join(changed)}", file=sys.stderr)
 
@@ -170,10 +186,16 @@ def main():
               f"{shipped[2]:.1f}, {shipped[3]:.1f} shipped, {flown[2]:.1f}, {flown[3]:.1f} tuned deg")
     for seed, figures in gusts:
         (sr, sf, sg), (tr, tf, tg) = figures["shipped"], figures["tuned"]
-        print(f"seed {seed}: gust {args.gust}: gust response (gust flight less still air) |φ|, |θ| "
-              f"shipped {sg[0]:.2f}, {sg[1]:.2f} → tuned {tg[0]:.2f}, {tg[1]:.2f} deg; raw peak "
+        what = f"mean of onsets {args.onsets}" if args.onsets else args.gust
+        print(f"seed {seed}: gust {args.gust} ({what}): gust response (gust flight less still air) "
+              f"|φ|, |θ| shipped {sg[0]:.2f}, {sg[1]:.2f} → tuned {tg[0]:.2f}, {tg[1]:.2f} deg; raw peak "
               f"excursion shipped {sr[0]:.2f}, {sr[1]:.2f} → tuned {tr[0]:.2f}, {tr[1]:.2f} deg "
               f"(still air {sf[0]:.2f}, {sf[1]:.2f} → {tf[0]:.2f}, {tf[1]:.2f})")
+        if args.onsets:
+            for k, axis in ((0, "φ"), (1, "θ")):
+                ship = ", ".join(f"{r[k]:.2f}" for r in figures["shipped per onset"])
+                tune = ", ".join(f"{r[k]:.2f}" for r in figures["tuned per onset"])
+                print(f"seed {seed}: |Δ{axis}| per onset shipped {ship} → tuned {tune} deg")
 
 if __name__ == "__main__":
     main()

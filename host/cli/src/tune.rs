@@ -27,8 +27,8 @@ under the firmware's law as `sweephold margins` computes it (the vehicle's prese
 tick, IMU filter bank, the vehicle's servo where the model has none): Kp and Ki of the \
 roll, pitch and yaw rate loops for a crossover (stated with --crossover, otherwise the \
 highest that meets the constraints, up to 20 rad/s on roll and pitch and 15 rad/s on yaw), \
-then the level gain K_lvl and the heading-hold gain K_psi, each the highest up to a third \
-of its inner loop's crossover. Constraints on every loop broken at its actuator with the \
+then the level gain K_lvl and the heading-hold gain K_psi, each the highest up to half \
+(--outer-fraction) of its inner loop's crossover. Constraints on every loop broken at its actuator with the \
 others closed: phase margin >= 45 deg at its crossover and gain margin >= 6 dB above it, on \
 the identified model and on the 5th percentile of --samples models drawn from the fit's \
 Cramer-Rao bounds; the servo rate for a full Rate-stick step within the aircraft file's \
@@ -68,9 +68,21 @@ pub struct TuneArgs {
     /// Seed of the draws.
     #[arg(long, default_value_t = 1, value_parser = crate::arg_values::seed, allow_hyphen_values = true)]
     pub seed: u64,
+    /// The highest outer-loop gain tried (K_lvl, K_psi, in 1/s) as a fraction of the
+    /// crossover of the rate loop it closes around, 0 < F <= 4.
+    #[arg(long, value_name = "F", default_value_t = TuneOptions::default().outer_fraction, value_parser = outer_fraction)]
+    pub outer_fraction: f64,
     /// What the board adds around the model.
     #[command(flatten)]
     pub law: LawArgs,
+}
+
+/// `--outer-fraction F`: finite, 0 < F <= 4.
+fn outer_fraction(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(f) if f.is_finite() && f > 0.0 && f <= 4.0 => Ok(f),
+        _ => Err("expected a fraction > 0 and <= 4".to_string()),
+    }
 }
 
 /// `--crossover AXIS=RAD_S`.
@@ -186,6 +198,7 @@ pub fn run(args: &TuneArgs) -> anyhow::Result<()> {
         crossovers,
         samples: args.samples,
         seed: args.seed,
+        outer_fraction: args.outer_fraction,
         servo_rate_limit_per_s: (rate_limit.is_finite() && rate_limit > 0.0).then_some(rate_limit),
         ..TuneOptions::default()
     };

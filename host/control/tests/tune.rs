@@ -219,5 +219,15 @@ fn the_tuned_gains_meet_every_constraint_on_the_identified_models() {
             assert!(rate <= shipped.max(4.0) + 1e-9);
         }
         eprintln!("{file} {:?} {:?}", tuned.designed_crossovers, tuned.gains);
+        // The outer gains within their cap: a fraction of the rate loops they close.
+        let cap = |axes: &[usize]| {
+            options.outer_fraction
+                * axes
+                    .iter()
+                    .map(|&a| tuned.designed_crossovers[a])
+                    .fold(f64::INFINITY, f64::min)
+        };
+        assert!(f64::from(tuned.gains.level_gain) <= cap(&[0, 1]).max(0.3) + 1e-6);
+        assert!(f64::from(tuned.gains.heading_gain) <= cap(&[2]).max(0.3) + 1e-6);
     }
 }

@@ -81,6 +81,9 @@ fn tune_refuses_a_crossover_beyond_the_margins_and_bad_arguments() {
             vec!["--crossover", "roll=3", "--crossover", "roll=4"],
             "given twice",
         ),
+        (vec!["--outer-fraction", "0"], "a fraction > 0 and <= 4"),
+        (vec!["--outer-fraction", "nan"], "a fraction > 0 and <= 4"),
+        (vec!["--outer-fraction", "5"], "a fraction > 0 and <= 4"),
     ] {
         let mut all = vec!["tune", model];
         all.extend(args);

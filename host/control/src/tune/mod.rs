@@ -31,7 +31,7 @@
 //!    designed in turn (roll, pitch, yaw), then once more each with the others' new
 //!    gains (the coupling changes g_k a little).
 //! 3. **Outer loops.** `K_lvl` (roll and pitch level loops) and `K_ψ` (heading hold) are
-//!    the highest of log-spaced candidates from 0.3 /s up to `outer_fraction` (1/3) of
+//!    the highest of log-spaced candidates from 0.3 /s up to `outer_fraction` (½) of
 //!    the inner crossover (the lower of roll's and pitch's for `K_lvl`) that meet the
 //!    constraints on the loops they close (roll_attitude and pitch_attitude; heading).
 //!    Where none does, the inner crossovers they close (unless stated) step down by 15 %

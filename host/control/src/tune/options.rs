@@ -23,7 +23,10 @@ pub struct TuneOptions {
     /// The PI's zero as a fraction of the crossover: the candidates tried at each
     /// crossover.
     pub integral_fractions: Vec<f64>,
-    /// Highest outer-loop gain as a fraction of the inner loop's crossover.
+    /// Highest outer-loop gain as a fraction of the inner loop's crossover: ½ (the outer
+    /// loops' own margins are checked, so it only bounds the search; with ⅓ the fbl700's
+    /// pitch attitude loop, its rate loop held low by the servos' rate limit, kept the
+    /// shipped crossover: decision 2026-11-27-outer-loop-cap).
     pub outer_fraction: f64,
     /// Models drawn over the covariance.
     pub samples: usize,
@@ -50,7 +53,7 @@ impl Default for TuneOptions {
             min_gain_margin_db: 6.0,
             percentile: 5.0,
             integral_fractions: vec![0.2, 0.5, 1.0, 2.0, 4.0, 8.0],
-            outer_fraction: 1.0 / 3.0,
+            outer_fraction: 0.5,
             samples: 100,
             seed: 1,
             grid_points: 600,
