@@ -42,7 +42,7 @@ model.json layout are described in the models README of the sysid crate.\n\nGuid
 <= 50 excellent; Cramér–Rao bound <= 20 %, insensitivity <= 10 %, |correlation| <= 0.9.\n\n\
 Physical ranges: every fitted parameter is judged by its part of each F or G entry against \
 that entry's dimension (e.g. 1000 m/s² per stick, 300 /s, 100 rad/s² per m/s); a fit outside \
-is run again with those parameters held at their start values, and exits 1 without a model \
+is run again with those parameters held at the structure file's values, and exits 1 without a model \
 when that fails (docs/method.md, physical ranges).\n\nDegenerate minima: a fit whose model \
 has a parameter outside its physical range or a free one on a bound of its structure file \
 that is not zero (tau_f on its 0.005 s floor; a bound of zero is a sign, and resting there \
@@ -111,7 +111,7 @@ pub struct FitArgs {
     /// derived from the steady-state balance at the points and held (status `trim`) until
     /// they settle; `--trim-balance` says what follows. Implausible, repeated or collinear
     /// points are refused. Like any fit, one whose parameters land outside physical ranges
-    /// is run again with them held at their start values, and no model is written when
+    /// is run again with them held at the structure file's values, and no model is written when
     /// that does not bring them inside.
     #[arg(long, value_name = "FILE")]
     pub trim_points: Option<PathBuf>,
@@ -513,7 +513,7 @@ fn write_report(
         writeln!(
             out,
             "  a degenerate minimum put parameters outside their physical range (value it \
-             gave below): fitted again with them held at their start values:"
+             gave below): fitted again with them held at the structure file's values:"
         )?;
         for dropped in &result.implausible_held {
             writeln!(out, "    {:<10} {:>14.6e}", dropped.name, dropped.value)?;

@@ -24,7 +24,7 @@ pub fn fit(
     }
     let grids = cost::build_pair_grids(&usable, data, options.points_per_pair)?;
     let run = |held: &[String], options: &FitOptions| {
-        let structure = held_at_start(&usable, held, &usable);
+        let structure = held_at_a_priori(&usable, held, &usable);
         let result = fit_on_grids(&structure, &grids, &without_balances(options))?;
         if degenerate_before_trim(&result, &structure, options)? {
             return Ok((result, ()));
@@ -45,7 +45,7 @@ pub fn fit(
 /// minimum was not found twice within its share. Errors only when every set fails (the
 /// first set's error). The last set is the a-priori one (the structure file's own
 /// values): parameters the responses leave undetermined are held at its values in every
-/// set ([`held_at_start`]).
+/// set ([`held_at_a_priori`]).
 pub fn fit_from_alternative_starts(
     starts: &[(String, ModelStructure)],
     data: &FrfDocument,
@@ -68,7 +68,7 @@ pub fn fit_from_alternative_starts(
     let run = |held: &[String], options: &FitOptions| {
         let starts: Vec<(String, ModelStructure)> = starts
             .iter()
-            .map(|(label, structure)| (label.clone(), held_at_start(structure, held, a_priori)))
+            .map(|(label, structure)| (label.clone(), held_at_a_priori(structure, held, a_priori)))
             .collect();
         let (result, (outcomes, usable)) = best_of_start_sets(&starts, data, &grids, options)?;
         if degenerate_before_trim(&result, &usable, options)? {
@@ -230,14 +230,14 @@ const RECOVERED_ACCEPTABLE_COST: f64 = 100.0;
 /// A fit with parameters outside their physical range ([`plausible`]) sits in a
 /// degenerate minimum: the responses do not determine them (a control derivative of 10⁸
 /// that a coupling of 10⁻⁸ cancels fits as well as two ordinary values). Hold those
-/// parameters at their a-priori values ([`held_at_start`]) and run the fit again from the
+/// parameters at their a-priori values ([`held_at_a_priori`]) and run the fit again from the
 /// same start sets (the file's, the equation-error or 6-DOF ones), up to
 /// [`RECOVERY_ROUNDS`] times while a run puts others outside. The first plausible result
 /// whose J_ave is acceptable ([`RECOVERED_ACCEPTABLE_COST`]) wins, recording what it held
 /// ([`FitResult::implausible_held`]); otherwise, or when a run fails, `first` is
 /// returned as it is and the caller refuses it. Only parameters `structure` has free and
 /// outside M are held (a trim-derived one follows the others; a time constant at zero
-/// would make M singular). `run(held)` fits with `held` at their start values.
+/// would make M singular). `run(held)` fits with `held` at their a-priori values.
 fn recover_plausible<X>(
     structure: &ModelStructure,
     first: (FitResult, X),
@@ -316,7 +316,7 @@ fn degenerate_before_trim(
 /// carries that fit's value of them, which the data did not determine either (fbl700,
 /// board-sim, seed 4: the 6-DOF's N_col of 202 against a truth of 18.6, held, and the
 /// trim balance took N_ped to +66 % with it; decision 2026-11-27-held-at-a-priori).
-fn held_at_start(
+fn held_at_a_priori(
     structure: &ModelStructure,
     names: &[String],
     a_priori: &ModelStructure,

@@ -84,7 +84,7 @@ pub struct FitOptions {
     pub trim_balance: trim::TrimBalance,
     /// Whether a fit whose model is degenerate ([`degenerate`](super::degenerate)) is run
     /// again elsewhere (other seeds) and, failing that, with the parameters outside their
-    /// physical range held at their start values ([`plausible`](super::plausible); the
+    /// physical range held at the structure file's values ([`plausible`](super::plausible); the
     /// driver's recovery), the reasons it is still degenerate recorded. Off only where the
     /// fit gives start values and nothing else (the campaign's 6-DOF stage): its minimum
     /// is then taken as it is.

@@ -178,7 +178,7 @@ pub fn implausible_parameters(structure: &ModelStructure, values: &[f64]) -> Vec
     found
 }
 
-/// A parameter the fit held at its start value (or zero) because a minimum put it outside
+/// A parameter the fit held at its a-priori value (the structure file's; or zero) because a minimum put it outside
 /// its physical range (`model.json` `implausible_held`; the fit driver's recovery).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HeldParameter {

@@ -133,7 +133,7 @@ pub struct ModelDocument {
     /// Parameters derived from trim points (absent without them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trim: Option<super::trim::TrimOutcome>,
-    /// Parameters held at their start values because a degenerate minimum put them
+    /// Parameters held at the structure file's values because a degenerate minimum put them
     /// outside their physical range, with the values it gave them ([`super::plausible`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub implausible_held: Vec<super::plausible::HeldParameter>,

@@ -203,7 +203,7 @@ pub struct FitResult {
     /// What the trim points gave (None without trim points or `trim_derived`).
     pub trim: Option<trim::TrimOutcome>,
     /// Parameters a degenerate minimum put outside their physical range, with the values
-    /// it gave them; the fit was repeated with them held at their start values
+    /// it gave them; the fit was repeated with them held at the structure file's values
     /// ([`super::plausible`]; empty when none).
     pub implausible_held: Vec<super::plausible::HeldParameter>,
     /// Why the model is degenerate ([`super::degenerate`]), after the fit's restarts

@@ -22,7 +22,7 @@ fn a_held_parameter_takes_the_a_priori_value_in_every_start_set() {
     let from_six = with_values(&file, &[("Ncol", 202.5), ("Nped", 80.0)]);
     let names = ["Ncol".to_string()];
     for start in [&from_six, &file] {
-        let held = held_at_start(start, &names, &file);
+        let held = held_at_a_priori(start, &names, &file);
         let index = held.parameter_index("Ncol").unwrap();
         assert_eq!(held.parameters[index].kind, ParameterKind::Fixed);
         assert_eq!(value(&held, "Ncol"), value(&file, "Ncol"));
@@ -34,6 +34,6 @@ fn a_held_parameter_takes_the_a_priori_value_in_every_start_set() {
     }
     // An a-priori value outside the physical range is held at zero.
     let wild = with_values(&file, &[("Ncol", 1e7)]);
-    let held = held_at_start(&from_six, &names, &wild);
+    let held = held_at_a_priori(&from_six, &names, &wild);
     assert_eq!(value(&held, "Ncol"), 0.0);
 }
