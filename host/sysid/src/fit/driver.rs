@@ -45,7 +45,7 @@ pub fn fit(
 /// minimum was not found twice within its share. Errors only when every set fails (the
 /// first set's error). The last set is the a-priori one (the structure file's own
 /// values): parameters the responses leave undetermined are held at its values in every
-/// set ([`held_at_a_priori`]).
+/// set.
 pub fn fit_from_alternative_starts(
     starts: &[(String, ModelStructure)],
     data: &FrfDocument,
